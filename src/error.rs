@@ -1,0 +1,134 @@
+//! The error type of the library. Every variant carries the context a user needs to fix
+//! the problem: the parameter or file and key, the offending value and the allowed range,
+//! or the step at which a run went unstable.
+
+use std::path::PathBuf;
+
+/// Result alias used throughout the crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Errors of langevin-fem.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A parameter (command-line flag or struct field) is outside its allowed range.
+    #[error("{name} must be {allowed}, got {value}")]
+    InvalidParameter {
+        /// Name of the parameter or flag, e.g. `bending_rigidity` or `--x`.
+        name: String,
+        /// The value as given.
+        value: String,
+        /// The allowed range, e.g. `> 0` or `in [0, 1]`.
+        allowed: String,
+    },
+    /// A scene file is invalid.
+    #[error("{file}: key `{key}`: {message}")]
+    Scene {
+        /// The scene file.
+        file: PathBuf,
+        /// The offending key (dotted path), or `-` for a parse error.
+        key: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// A time step is above the stability limit of an explicit integrator.
+    #[error(
+        "time step dt = {dt:e} exceeds the stability limit {limit:e} of the {integrator} integrator \
+         (2/lambda_max); use a smaller dt or a stable integrator such as {suggestion}"
+    )]
+    UnstableTimeStep {
+        /// Integrator name.
+        integrator: String,
+        /// Requested time step.
+        dt: f64,
+        /// The stability limit.
+        limit: f64,
+        /// A stable integrator to use instead.
+        suggestion: String,
+    },
+    /// The state became non-finite during a run.
+    #[error("run became unstable at step {step} (t = {time:e}): {detail}")]
+    Diverged {
+        /// Step index at which the non-finite state was detected.
+        step: u64,
+        /// Simulation time at that step.
+        time: f64,
+        /// What was non-finite.
+        detail: String,
+    },
+    /// A numerical routine failed (e.g. a factorization of a matrix that should be
+    /// positive definite).
+    #[error("numerical failure in {routine}: {detail}")]
+    Numerical {
+        /// The routine.
+        routine: String,
+        /// What went wrong.
+        detail: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidParameter`].
+    pub fn invalid(
+        name: impl Into<String>,
+        value: impl std::fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Io`].
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// Process exit code for this error: 2 for bad input (parameters, scene files,
+    /// a time step above the stability limit), 3 for failures during a run.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::InvalidParameter { .. }
+            | Error::Scene { .. }
+            | Error::UnstableTimeStep { .. } => 2,
+            Error::Diverged { .. } | Error::Numerical { .. } | Error::Io { .. } => 3,
+        }
+    }
+}
+
+/// Checks that `value` is finite and strictly positive.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn require_positive(name: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(name, value, "finite and > 0"))
+    }
+}
+
+/// Checks that `value` is finite and lies in the closed interval `[lo, hi]`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn require_in_range(name: &str, value: f64, lo: f64, hi: f64) -> Result<()> {
+    if value.is_finite() && value >= lo && value <= hi {
+        Ok(())
+    } else {
+        Err(Error::invalid(name, value, format!("in [{lo}, {hi}]")))
+    }
+}

@@ -1,0 +1,61 @@
+//! The machine-readable result of a verification run (`summary.json`).
+
+use serde::{Deserialize, Serialize};
+
+/// One statistical or deterministic check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckResult {
+    /// Unique name within the scene, e.g. `mode-variance/n=3`.
+    pub name: String,
+    /// Kind of check, e.g. `chi2-variance`, `ks`, `z-test`, `deterministic`.
+    pub kind: String,
+    /// Whether the check passed (after the family-wise correction).
+    pub passed: bool,
+    /// Raw (unadjusted) p-value, for statistical checks.
+    pub p_value: Option<f64>,
+    /// Holm-adjusted p-value over the scene's family of checks.
+    pub p_adjusted: Option<f64>,
+    /// The estimate from the simulation.
+    pub estimate: Option<f64>,
+    /// The exact reference it is compared with.
+    pub reference: Option<f64>,
+    /// Standard error of the estimate.
+    pub std_error: Option<f64>,
+    /// Which reference is used: `discrete` (exact for the discretized system and
+    /// integrator) or `continuum`.
+    pub reference_kind: String,
+    /// Free-text detail for a reader (what was compared, sample size, …).
+    pub detail: String,
+}
+
+/// The result of one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneSummary {
+    /// Scene name (file stem).
+    pub name: String,
+    /// Whether every check passed.
+    pub passed: bool,
+    /// Wall time of the scene in seconds (the only non-deterministic field).
+    pub wall_seconds: f64,
+    /// Relative paths (from the output directory) of the figures written for the scene.
+    pub figures: Vec<String>,
+    /// Relative paths of the CSV tables written for the scene.
+    pub tables: Vec<String>,
+    /// Notes for a reader (e.g. how a ratio changes with element count).
+    pub notes: Vec<String>,
+    /// The checks.
+    pub checks: Vec<CheckResult>,
+}
+
+/// The result of a verification run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Budget name: `quick`, `standard` or `full`.
+    pub budget: String,
+    /// Family-wise significance level used in each scene.
+    pub alpha: f64,
+    /// Whether every scene passed.
+    pub passed: bool,
+    /// The scenes.
+    pub scenes: Vec<SceneSummary>,
+}
