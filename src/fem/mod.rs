@@ -1,1 +1,27 @@
-//! (placeholder: filled in by the fem work.)
+//! Finite-element model of the filament (`physics.md` §3): Hermite-cubic beam elements,
+//! banded assembly over the free DOFs of a hinged beam, the paper's element-uniform noise
+//! (eq. 5) and consistent noise, generalized modes of `(K, C)` and the exact stationary
+//! covariances of the discrete system.
+//!
+//! - [`mesh`]: node coordinates on `[0, L]` (uniform, graded, explicit).
+//! - [`hermite`]: shape functions and element matrices `C_e`, `K_e`, `G_e`, `b_e`.
+//! - [`banded`]: symmetric banded matrices, banded Cholesky, inertia counts.
+//! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
+//! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
+//! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
+
+pub mod banded;
+pub mod beam;
+pub mod hermite;
+pub mod mesh;
+pub mod modal;
+pub mod noise;
+
+pub use banded::{BandedCholesky, SymBanded};
+pub use beam::{BeamModel, ElementLoad, UNIFORM_RATE_FACTOR};
+pub use mesh::Mesh;
+pub use modal::{
+    GeneralizedModes, continuous_stationary_covariance, discrete_stationary_covariance,
+    generalized_modes, modal_noise_covariance, nodal_covariance,
+};
+pub use noise::{NoiseGenerator, NoiseModel};

@@ -21,6 +21,9 @@ pub struct CheckResult {
     pub reference: Option<f64>,
     /// Standard error of the estimate.
     pub std_error: Option<f64>,
+    /// The continuum value of the same quantity (eq. 2–4), for comparison: the gap
+    /// between `reference` and `continuum` is the discretization (or integrator) error.
+    pub continuum: Option<f64>,
     /// Which reference is used: `discrete` (exact for the discretized system and
     /// integrator) or `continuum`.
     pub reference_kind: String,

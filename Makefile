@@ -1,0 +1,41 @@
+# langevin-fem — build, verify, test.
+#
+#   make verify            quick verification suite (CI), reports in reports/
+#   make verify BUDGET=full   publication-grade error bars
+#   make test              all tests (unit, integration, statistical validation, golden)
+#   make check             fmt --check, clippy -D warnings, tests
+#   make bench             benchmarks (benches/), see README performance table
+#   make golden            re-run golden snapshots, accept changes, show the diff
+
+CARGO  ?= cargo
+BUDGET ?= quick
+OUT    ?= reports
+BIN     = target/release/langevin-fem
+
+.PHONY: all build verify test check bench golden clean
+
+all: build
+
+build:
+	$(CARGO) build --release --locked
+
+verify: build
+	$(BIN) verify --budget $(BUDGET) --out $(OUT)
+
+test:
+	$(CARGO) test --locked
+
+check:
+	$(CARGO) fmt --check
+	$(CARGO) clippy --locked --all-targets -- -D warnings
+	$(CARGO) test --locked
+
+bench:
+	$(CARGO) bench --locked
+
+golden:
+	INSTA_UPDATE=always $(CARGO) test --locked --test golden
+	git --no-pager diff --stat -- golden/
+
+clean:
+	$(CARGO) clean

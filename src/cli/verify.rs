@@ -1,0 +1,88 @@
+//! `langevin-fem verify`: run verification scenes and write reports.
+
+use clap::Args;
+use langevin_fem::error::{Error, Result};
+use langevin_fem::verify::{Budget, VerifyOptions, resolve_scenes, run_verification};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Scene to run: a name from the scene directory or a path to a .toml file
+    /// (repeatable; default: every scene).
+    #[arg(long = "scene", value_name = "NAME")]
+    scenes: Vec<String>,
+    /// Statistics budget.
+    #[arg(long, value_enum, default_value = "quick")]
+    budget: BudgetArg,
+    /// Output directory for summary.json, index.html and per-scene figures and tables.
+    #[arg(long, default_value = "reports")]
+    out: PathBuf,
+    /// Directory holding the scene files.
+    #[arg(long, default_value = "verification")]
+    scene_dir: PathBuf,
+    /// Family-wise significance level per scene (Holm correction).
+    #[arg(long, default_value_t = 0.01)]
+    alpha: f64,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum BudgetArg {
+    Quick,
+    Standard,
+    Full,
+}
+
+/// Runs the verification; exit code 0 if every check passes, 1 otherwise.
+pub fn run(args: VerifyArgs) -> Result<i32> {
+    if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
+        return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
+    }
+    let budget = match args.budget {
+        BudgetArg::Quick => Budget::Quick,
+        BudgetArg::Standard => Budget::Standard,
+        BudgetArg::Full => Budget::Full,
+    };
+    let scenes = resolve_scenes(&args.scenes, &args.scene_dir)?;
+    if scenes.is_empty() {
+        return Err(Error::invalid(
+            "--scene-dir",
+            args.scene_dir.display(),
+            "a directory containing at least one scene (*.toml)",
+        ));
+    }
+    let summary = run_verification(&VerifyOptions {
+        scenes,
+        budget,
+        out: args.out.clone(),
+        alpha: args.alpha,
+        progress: std::io::stderr().is_terminal(),
+    })?;
+    for scene in &summary.scenes {
+        let failed: Vec<&str> = scene
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.name.as_str())
+            .collect();
+        eprintln!(
+            "{:<24} {}  {} checks, {} failed, {:.1} s",
+            scene.name,
+            if scene.passed { "PASS" } else { "FAIL" },
+            scene.checks.len(),
+            failed.len(),
+            scene.wall_seconds
+        );
+        for f in failed {
+            eprintln!("    failed: {f}");
+        }
+    }
+    eprintln!(
+        "{} (budget {}, family-wise alpha {} per scene, Holm); report: {}",
+        if summary.passed { "PASSED" } else { "FAILED" },
+        summary.budget,
+        summary.alpha,
+        args.out.join("index.html").display()
+    );
+    Ok(if summary.passed { 0 } else { 1 })
+}

@@ -1,0 +1,185 @@
+//! Random nodal forces: the paper's element-uniform load (eq. 5) and consistent noise.
+//!
+//! **Convention.** Over a step `Δt` the random nodal force on the free DOFs is
+//! `F = sqrt(2kT/Δt)·ζ`, where the generator draws `ζ` with covariance `Σ_ζ`:
+//!
+//! - [`NoiseModel::Consistent`]: `Σ_ζ = C` (the damping matrix, including ξ), so
+//!   `cov F = 2kT·C/Δt` exactly — the discrete fluctuation–dissipation relation.
+//!   Drawn as `ζ = L z` with `C = LLᵀ` (banded Cholesky) and `z` iid `N(0, 1)`, one normal
+//!   per free DOF.
+//! - [`NoiseModel::ElementUniform`] (eq. 5): a uniform load `f_e` per element and step,
+//!   `var f_e = 2ξkT/(h_e Δt)`, turned into nodal forces through `b_e = ∫ N dx`:
+//!   `ζ = Σ_e sqrt(ξ/h_e)·z_e·b_e`, one normal per element, so
+//!   `Σ_ζ = Σ_e (ξ/h_e) b_e b_eᵀ` and `cov F = Σ_e (2ξkT/(h_e Δt)) b_e b_eᵀ ≠ 2kT·C/Δt`.
+
+use super::banded::BandedCholesky;
+use super::beam::{BeamModel, ElementLoad};
+use crate::error::Result;
+use nalgebra::DMatrix;
+use rand::RngExt;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+/// Which random nodal force to apply (see the module docs for the covariances).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseModel {
+    /// Uniform load per element and step, eq. (5): `Σ_ζ = Σ_e (ξ/h_e) b_e b_eᵀ`.
+    ElementUniform,
+    /// Consistent nodal noise: `Σ_ζ = C`, so `cov F = 2kT·C/Δt`.
+    Consistent,
+}
+
+impl NoiseModel {
+    /// Both models.
+    pub const ALL: [NoiseModel; 2] = [NoiseModel::ElementUniform, NoiseModel::Consistent];
+
+    /// The kebab-case name used in scene files and reports:
+    /// `"element-uniform"` or `"consistent"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            NoiseModel::ElementUniform => "element-uniform",
+            NoiseModel::Consistent => "consistent",
+        }
+    }
+}
+
+impl std::fmt::Display for NoiseModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Source {
+    Consistent(BandedCholesky),
+    ElementUniform {
+        /// `sqrt(ξ/h_e)` per element.
+        amplitude: Vec<f64>,
+        loads: Vec<ElementLoad>,
+    },
+}
+
+/// Draws the standardized noise vector `ζ` (covariance `Σ_ζ`) over the free DOFs of a
+/// [`BeamModel`]; the caller scales it by `sqrt(2kT/Δt)`.
+#[derive(Debug, Clone)]
+pub struct NoiseGenerator {
+    model: NoiseModel,
+    n: usize,
+    source: Source,
+    covariance: DMatrix<f64>,
+}
+
+impl NoiseGenerator {
+    /// Prepares the generator (for [`NoiseModel::Consistent`], the banded Cholesky
+    /// factor of `C`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Numerical`] if `C` is not positive definite.
+    pub fn new(model: NoiseModel, beam: &BeamModel) -> Result<Self> {
+        let n = beam.n_dofs();
+        let (source, covariance) = match model {
+            NoiseModel::Consistent => (
+                Source::Consistent(beam.damping().cholesky()?),
+                beam.damping().to_dense(),
+            ),
+            NoiseModel::ElementUniform => {
+                let xi = beam.params().drag;
+                let mesh = beam.mesh();
+                let amplitude: Vec<f64> = (0..mesh.n_elements())
+                    .map(|e| (xi / mesh.element_length(e)).sqrt())
+                    .collect();
+                let loads = beam.load_vectors().to_vec();
+                let mut cov = DMatrix::zeros(n, n);
+                for (a, (b, dofs)) in amplitude.iter().zip(&loads) {
+                    for p in 0..4 {
+                        for q in 0..4 {
+                            if let (Some(i), Some(j)) = (dofs[p], dofs[q]) {
+                                cov[(i, j)] += a * a * b[p] * b[q];
+                            }
+                        }
+                    }
+                }
+                (Source::ElementUniform { amplitude, loads }, cov)
+            }
+        };
+        Ok(NoiseGenerator {
+            model,
+            n,
+            source,
+            covariance,
+        })
+    }
+
+    /// The noise model.
+    pub fn model(&self) -> NoiseModel {
+        self.model
+    }
+
+    /// Number of free DOFs (length of the drawn vector).
+    pub fn n_dofs(&self) -> usize {
+        self.n
+    }
+
+    /// Draws `ζ` into `out` in `O(n)`. Draw order is fixed: for
+    /// [`NoiseModel::Consistent`] `z_0 … z_{n−1}` (free-DOF order), then `ζ = L z`; for
+    /// [`NoiseModel::ElementUniform`] `z_0 … z_{N−1}` (element order),
+    /// `ζ = Σ_e sqrt(ξ/h_e) z_e b_e`.
+    ///
+    /// # Panics
+    /// If `out.len() != n_dofs()`.
+    pub fn draw<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [f64]) {
+        assert_eq!(out.len(), self.n, "NoiseGenerator::draw: wrong length");
+        match &self.source {
+            Source::Consistent(l) => {
+                for v in out.iter_mut() {
+                    *v = rng.sample(StandardNormal);
+                }
+                l.mul_lower_in_place(out);
+            }
+            Source::ElementUniform { amplitude, loads } => {
+                out.fill(0.0);
+                for (a, (b, dofs)) in amplitude.iter().zip(loads) {
+                    let z: f64 = rng.sample(StandardNormal);
+                    let f = a * z;
+                    for (bv, d) in b.iter().zip(dofs) {
+                        if let Some(i) = d {
+                            out[*i] += f * bv;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Standard normals consumed per draw: `n` (consistent) or `N` elements
+    /// (element-uniform).
+    pub fn draws_per_step(&self) -> usize {
+        match &self.source {
+            Source::Consistent(_) => self.n,
+            Source::ElementUniform { amplitude, .. } => amplitude.len(),
+        }
+    }
+
+    /// Dense `Σ_ζ` over the free DOFs: `C` (consistent) or `Σ_e (ξ/h_e) b_e b_eᵀ`
+    /// (element-uniform).
+    pub fn covariance(&self) -> DMatrix<f64> {
+        self.covariance.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_serde() {
+        assert_eq!(NoiseModel::ElementUniform.name(), "element-uniform");
+        assert_eq!(NoiseModel::Consistent.name(), "consistent");
+        let s = serde_json::to_string(&NoiseModel::ElementUniform).unwrap();
+        assert_eq!(s, "\"element-uniform\"");
+        let m: NoiseModel = serde_json::from_str("\"consistent\"").unwrap();
+        assert_eq!(m, NoiseModel::Consistent);
+        assert!(serde_json::from_str::<NoiseModel>("\"uniform\"").is_err());
+    }
+}

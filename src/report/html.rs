@@ -1,0 +1,348 @@
+//! The HTML index of a verification run (`index.html`).
+//!
+//! A single static, self-contained page: inline CSS, no scripts, no external resources.
+//! Figures are referenced by their relative paths (they live next to `index.html`), so
+//! the output directory can be moved or archived as a whole. All text from the summary
+//! is HTML-escaped. The wall times are the only content that differs between two runs
+//! with the same seeds.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::Result;
+use crate::verify::summary::{CheckResult, SceneSummary, Summary};
+
+use super::io::write_atomic;
+
+const CSS: &str = "\
+body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
+margin:2em auto;max-width:1200px;padding:0 1em;color:#1f2328;line-height:1.45}
+h1{margin-bottom:.2em}
+h2{margin-top:2em;border-bottom:1px solid #d0d7de;padding-bottom:.2em}
+table{border-collapse:collapse;margin:.8em 0;font-size:.92em}
+th,td{border:1px solid #d0d7de;padding:.3em .55em;vertical-align:top}
+th{background:#f6f8fa;text-align:left}
+td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+td.detail{max-width:28em}
+.badge{display:inline-block;padding:.05em .5em;border-radius:.3em;font-weight:bold;\
+font-size:.85em;vertical-align:middle}
+.badge.pass,td.pass{background:#dafbe1;color:#116329}
+.badge.fail,td.fail{background:#ffebe9;color:#a40e26}
+td.pass,td.fail{font-weight:bold;text-align:center}
+tr.fail{background:#fff5f4}
+.verdict{font-size:1.6em;margin:.3em 0}
+.meta{color:#57606a}
+.figures{display:flex;flex-wrap:wrap;gap:1em}
+figure{margin:0;border:1px solid #d0d7de;padding:.4em;background:#fff}
+figure img{display:block;width:100%;max-width:800px;height:auto}
+figcaption{font-size:.85em;color:#57606a;text-align:center;font-family:monospace}
+code{font-size:.95em}
+";
+
+/// Renders the HTML index page for `summary`.
+///
+/// Content: the overall verdict, the budget and the family-wise significance level α
+/// (Holm-corrected within each scene), a table of scenes, and per scene its notes, its
+/// figures embedded as `<img>` with the file name as caption, links to its CSV tables and
+/// the table of its checks (estimate, reference, standard error, raw and Holm-adjusted
+/// p-values to 4 significant digits, `—` where a value does not apply).
+pub fn render_index(summary: &Summary) -> String {
+    let mut h = String::with_capacity(16 * 1024);
+    let verdict = pass_fail(summary.passed);
+    let n_scenes = summary.scenes.len();
+    let n_failed_scenes = summary.scenes.iter().filter(|s| !s.passed).count();
+    let n_checks: usize = summary.scenes.iter().map(|s| s.checks.len()).sum();
+    let n_failed_checks: usize = summary
+        .scenes
+        .iter()
+        .map(|s| s.checks.iter().filter(|c| !c.passed).count())
+        .sum();
+    let total_wall: f64 = summary.scenes.iter().map(|s| s.wall_seconds).sum();
+
+    h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+    h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n");
+    let _ = writeln!(
+        h,
+        "<title>langevin-fem verification: {verdict} ({})</title>",
+        esc(&summary.budget)
+    );
+    let _ = writeln!(h, "<style>\n{CSS}</style>\n</head>\n<body>");
+    h.push_str("<h1>langevin-fem verification report</h1>\n");
+    let _ = writeln!(
+        h,
+        "<p class=\"verdict\">Overall result: <span class=\"badge {}\">{verdict}</span></p>",
+        verdict.to_ascii_lowercase()
+    );
+    let _ = writeln!(
+        h,
+        "<p>{} of {n_scenes} scene{} passed; {} of {n_checks} check{} failed. \
+         Total wall time {}.</p>",
+        n_scenes - n_failed_scenes,
+        plural(n_scenes),
+        n_failed_checks,
+        plural(n_checks),
+        fmt_seconds(total_wall)
+    );
+    let _ = writeln!(
+        h,
+        "<p>Budget: <b>{}</b>. Family-wise significance level α = {} per scene: the \
+         p-values of the checks of a scene form one family and are Holm-corrected \
+         (Holm–Bonferroni step-down), so that the probability of any false failure in a \
+         scene whose simulation is correct is at most α. The tables show raw and \
+         Holm-adjusted p-values. Reference kind <code>discrete</code>: exact for the \
+         discretized system and time integrator; <code>continuum</code>: exact for the \
+         continuum model.</p>",
+        esc(&summary.budget),
+        fmt_alpha(summary.alpha)
+    );
+
+    scenes_table(&mut h, summary);
+    for (i, scene) in summary.scenes.iter().enumerate() {
+        scene_section(&mut h, i, scene);
+    }
+    h.push_str("</body>\n</html>\n");
+    h
+}
+
+/// Writes [`render_index`] of `summary` to `out_dir/index.html`, atomically.
+///
+/// # Errors
+/// [`crate::Error::Io`] naming the file if it cannot be written.
+pub fn write_index(out_dir: &Path, summary: &Summary) -> Result<()> {
+    write_atomic(
+        &out_dir.join("index.html"),
+        render_index(summary).as_bytes(),
+    )
+}
+
+fn scenes_table(h: &mut String, summary: &Summary) {
+    h.push_str(
+        "<h2>Scenes</h2>\n<table>\n<thead><tr><th>Scene</th><th>Result</th>\
+                <th>Wall time</th><th>Checks</th><th>Failed checks</th></tr></thead>\n<tbody>\n",
+    );
+    for (i, s) in summary.scenes.iter().enumerate() {
+        let failed = s.checks.iter().filter(|c| !c.passed).count();
+        let verdict = pass_fail(s.passed);
+        let _ = writeln!(
+            h,
+            "<tr><td><a href=\"#scene-{i}\">{}</a></td><td class=\"{}\">{verdict}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{failed}</td></tr>",
+            esc(&s.name),
+            verdict.to_ascii_lowercase(),
+            fmt_seconds(s.wall_seconds),
+            s.checks.len(),
+        );
+    }
+    h.push_str("</tbody>\n</table>\n");
+}
+
+fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
+    let verdict = pass_fail(s.passed);
+    let failed = s.checks.iter().filter(|c| !c.passed).count();
+    let _ = writeln!(
+        h,
+        "<section id=\"scene-{i}\">\n<h2>{} <span class=\"badge {}\">{verdict}</span></h2>",
+        esc(&s.name),
+        verdict.to_ascii_lowercase()
+    );
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\">Wall time {}; {} check{}, {failed} failed.</p>",
+        fmt_seconds(s.wall_seconds),
+        s.checks.len(),
+        plural(s.checks.len())
+    );
+
+    if !s.notes.is_empty() {
+        h.push_str("<ul class=\"notes\">\n");
+        for note in &s.notes {
+            let _ = writeln!(h, "<li>{}</li>", esc(note));
+        }
+        h.push_str("</ul>\n");
+    }
+
+    if !s.figures.is_empty() {
+        h.push_str("<div class=\"figures\">\n");
+        for fig in &s.figures {
+            let href = esc(&url_path(fig));
+            let name = esc(file_name(fig));
+            let _ = writeln!(
+                h,
+                "<figure><a href=\"{href}\"><img src=\"{href}\" alt=\"{name}\"></a>\
+                 <figcaption>{name}</figcaption></figure>"
+            );
+        }
+        h.push_str("</div>\n");
+    }
+
+    if !s.tables.is_empty() {
+        h.push_str("<p>Tables (CSV): ");
+        for (k, table) in s.tables.iter().enumerate() {
+            if k > 0 {
+                h.push_str(", ");
+            }
+            let _ = write!(
+                h,
+                "<a href=\"{}\">{}</a>",
+                esc(&url_path(table)),
+                esc(file_name(table))
+            );
+        }
+        h.push_str("</p>\n");
+    }
+
+    if s.checks.is_empty() {
+        h.push_str("<p class=\"meta\">No checks.</p>\n");
+    } else {
+        checks_table(h, &s.checks);
+    }
+    h.push_str("</section>\n");
+}
+
+fn checks_table(h: &mut String, checks: &[CheckResult]) {
+    h.push_str(
+        "<table class=\"checks\">\n<thead><tr><th>Check</th><th>Kind</th><th>Reference kind</th>\
+         <th>Estimate</th><th>Reference</th><th>Continuum</th><th>Std. error</th><th>p</th>\
+         <th>Holm-adjusted p</th><th>Result</th><th>Detail</th></tr></thead>\n<tbody>\n",
+    );
+    for c in checks {
+        let verdict = pass_fail(c.passed);
+        let class = verdict.to_ascii_lowercase();
+        let _ = writeln!(
+            h,
+            "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
+             <td class=\"{class}\">{verdict}</td>\
+             <td class=\"detail\">{}</td></tr>",
+            esc(&c.name),
+            esc(&c.kind),
+            esc(&c.reference_kind),
+            fmt4(c.estimate),
+            fmt4(c.reference),
+            fmt4(c.continuum),
+            fmt4(c.std_error),
+            fmt4(c.p_value),
+            fmt4(c.p_adjusted),
+            esc(&c.detail),
+        );
+    }
+    h.push_str("</tbody>\n</table>\n");
+}
+
+fn pass_fail(passed: bool) -> &'static str {
+    if passed { "PASS" } else { "FAIL" }
+}
+
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}
+
+/// Escapes text for HTML element content and double- or single-quoted attributes.
+fn esc(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// A relative file path as a URL path: `\` becomes `/`, bytes other than unreserved
+/// characters and `/` are percent-encoded (plain paths are unchanged).
+fn url_path(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    for &b in path.replace('\\', "/").as_bytes() {
+        if b.is_ascii_alphanumeric() || matches!(b, b'-' | b'.' | b'_' | b'~' | b'/') {
+            out.push(char::from(b));
+        } else {
+            let _ = write!(out, "%{b:02X}");
+        }
+    }
+    out
+}
+
+/// The last component of a `/`- or `\`-separated relative path.
+fn file_name(path: &str) -> &str {
+    path.rsplit(['/', '\\']).next().unwrap_or(path)
+}
+
+/// A number to 4 significant digits: fixed-point for magnitudes in `[1e-3, 1e5)`,
+/// scientific otherwise; `—` for `None`.
+fn fmt4(value: Option<f64>) -> String {
+    let Some(v) = value else {
+        return "—".to_string();
+    };
+    if v.is_nan() {
+        return "NaN".to_string();
+    }
+    if v.is_infinite() {
+        return if v > 0.0 { "∞" } else { "−∞" }.to_string();
+    }
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    // The exponent after rounding to 4 significant digits (9.9996 → 1.000e1).
+    let sci = format!("{v:.3e}");
+    let exp: i32 = sci
+        .rsplit('e')
+        .next()
+        .and_then(|e| e.parse().ok())
+        .unwrap_or(0);
+    if (-3..5).contains(&exp) {
+        let decimals = usize::try_from(3 - exp).unwrap_or(0);
+        format!("{v:.decimals$}")
+    } else {
+        sci
+    }
+}
+
+fn fmt_alpha(alpha: f64) -> String {
+    // α is a configuration value such as 0.01: print it as given.
+    if alpha.is_finite() && alpha > 0.0 {
+        format!("{alpha}")
+    } else {
+        fmt4(Some(alpha))
+    }
+}
+
+fn fmt_seconds(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        "—".to_string()
+    } else if seconds < 10.0 {
+        format!("{seconds:.2} s")
+    } else if seconds < 600.0 {
+        format!("{seconds:.1} s")
+    } else {
+        format!("{:.1} min", seconds / 60.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn four_significant_digits() {
+        assert_eq!(fmt4(None), "—");
+        assert_eq!(fmt4(Some(0.5)), "0.5000");
+        assert_eq!(fmt4(Some(9.99996)), "10.00");
+        assert_eq!(fmt4(Some(123.456)), "123.5");
+        assert_eq!(fmt4(Some(1.23456e-7)), "1.235e-7");
+        assert_eq!(fmt4(Some(-0.00123456)), "-0.001235");
+        assert_eq!(fmt4(Some(123_456.0)), "1.235e5");
+    }
+
+    #[test]
+    fn paths() {
+        assert_eq!(url_path("a b/c&d.svg"), "a%20b/c%26d.svg");
+        assert_eq!(url_path("scene/fig-1.svg"), "scene/fig-1.svg");
+        assert_eq!(file_name("scene/fig-1.svg"), "fig-1.svg");
+    }
+}

@@ -1,0 +1,595 @@
+//! Linear hinged filament: simulation of an ensemble and the exact references every
+//! check is judged against.
+//!
+//! Two models share this code: the finite-element filament ([`ModelKind::Fem`], any
+//! integrator and noise model) and the exact modal simulator of eq. (2)
+//! ([`ModelKind::Spectral`]), which is the self-check of the references and the checks.
+//!
+//! For each run the exact *discrete* reference is the stationary covariance of the
+//! discretized system under this integrator and time step (see [`crate::dynamics`]), and
+//! the *continuum* reference is the modal solution of eq. (2) (per-mode variance
+//! 2kTL³/(π⁴n⁴EI), rate λ_n, profile kT x²(L−x)²/(3EI L), eq. 4).
+
+use crate::dynamics::{Integrator, IntegratorKind, build_integrator};
+use crate::error::{Error, Result};
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::fem::modal::{
+    GeneralizedModes, discrete_stationary_covariance, generalized_modes, modal_noise_covariance,
+};
+use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::rng::TrajectoryRng;
+use crate::spectral::HingedBeam;
+use crate::spectral::simulator::ModalSimulator;
+use crate::verify::scene::{ModelKind, RunSpec, Scene};
+use nalgebra::{DMatrix, DVector};
+
+/// Exact references for one mode of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeReference {
+    /// Mode number (1-based).
+    pub n: usize,
+    /// Stationary variance of the modal amplitude for this discretization, noise model,
+    /// integrator and time step.
+    pub variance_discrete: f64,
+    /// The same under equipartition for this discretization (kT/λ_i of the discrete
+    /// modes; the spectral model: its own σ_n²). The ratio variance/equipartition is what
+    /// the element-uniform noise table reports.
+    pub variance_equipartition: f64,
+    /// The continuum stationary variance of the same mode (eq. 4, t = η → ∞).
+    pub variance_continuum: f64,
+    /// One-step multiplier m of the modal amplitude (the AR(1) coefficient per step).
+    pub multiplier: f64,
+    /// Relaxation rate of the discrete mode, −ln(m)/Δt (`None` if m ≤ 0).
+    pub rate_discrete: Option<f64>,
+    /// The continuum relaxation rate λ_n = π⁴n⁴EI/(ξL⁴).
+    pub rate_continuum: f64,
+}
+
+/// Exact references for the two-time correlation at one point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoTimeReference {
+    /// Positions and times (physical units).
+    pub x: f64,
+    /// Second position.
+    pub y: f64,
+    /// Earlier time t (a whole number of steps).
+    pub t: f64,
+    /// Later time η (a whole number of steps).
+    pub eta: f64,
+    /// Step index of t.
+    pub t_step: u64,
+    /// Step index of η.
+    pub eta_step: u64,
+    /// ⟨w(x,t) w(y,η)⟩ for the discrete system from rest.
+    pub discrete: f64,
+    /// Eq. (4).
+    pub continuum: f64,
+}
+
+/// Everything a run's checks are judged against.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearReference {
+    /// Per checked mode.
+    pub modes: Vec<ModeReference>,
+    /// Profile positions (physical units).
+    pub profile_x: Vec<f64>,
+    /// ⟨w²(x)⟩ of the discrete system at `profile_x`.
+    pub profile_discrete: Vec<f64>,
+    /// ⟨w²(x)⟩ of the continuum (closed form).
+    pub profile_continuum: Vec<f64>,
+    /// Two-time points.
+    pub two_time: Vec<TwoTimeReference>,
+    /// Time step.
+    pub dt: f64,
+    /// Largest rate of the discrete system (λ_max).
+    pub max_rate: f64,
+}
+
+/// A filament being simulated: advances all its transverse components by one step and
+/// reports the observables.
+trait Sampler {
+    /// One step of every component.
+    fn step(&mut self, rng: &mut TrajectoryRng);
+    /// Whether the state is finite.
+    fn is_finite(&self) -> bool;
+    /// Modal amplitudes, component-major: `out[c * n_modes + i]`.
+    fn modes(&self, out: &mut [f64]);
+    /// Deflections at `xs`, component-major: `out[c * xs.len() + j]`.
+    fn deflections(&self, xs: &[f64], out: &mut [f64]);
+}
+
+struct FemSampler<'a> {
+    beam: &'a BeamModel,
+    projector: &'a DMatrix<f64>,
+    integrator: Box<dyn Integrator>,
+    states: Vec<Vec<f64>>,
+}
+
+impl Sampler for FemSampler<'_> {
+    fn step(&mut self, rng: &mut TrajectoryRng) {
+        for s in &mut self.states {
+            self.integrator.step(s, rng);
+        }
+    }
+    fn is_finite(&self) -> bool {
+        self.states.iter().flatten().all(|v| v.is_finite())
+    }
+    fn modes(&self, out: &mut [f64]) {
+        let m = self.projector.nrows();
+        for (c, s) in self.states.iter().enumerate() {
+            for i in 0..m {
+                out[c * m + i] = self
+                    .projector
+                    .row(i)
+                    .iter()
+                    .zip(s)
+                    .map(|(p, w)| p * w)
+                    .sum();
+            }
+        }
+    }
+    fn deflections(&self, xs: &[f64], out: &mut [f64]) {
+        for (c, s) in self.states.iter().enumerate() {
+            for (j, &x) in xs.iter().enumerate() {
+                out[c * xs.len() + j] = self.beam.deflection_at(s, x);
+            }
+        }
+    }
+}
+
+struct SpectralSampler {
+    sims: Vec<ModalSimulator>,
+    n_modes: usize,
+}
+
+impl Sampler for SpectralSampler {
+    fn step(&mut self, rng: &mut TrajectoryRng) {
+        for s in &mut self.sims {
+            s.step(rng);
+        }
+    }
+    fn is_finite(&self) -> bool {
+        self.sims
+            .iter()
+            .all(|s| s.amplitudes().iter().all(|a| a.is_finite()))
+    }
+    fn modes(&self, out: &mut [f64]) {
+        for (c, s) in self.sims.iter().enumerate() {
+            out[c * self.n_modes..(c + 1) * self.n_modes]
+                .copy_from_slice(&s.amplitudes()[..self.n_modes]);
+        }
+    }
+    fn deflections(&self, xs: &[f64], out: &mut [f64]) {
+        for (c, s) in self.sims.iter().enumerate() {
+            for (j, &x) in xs.iter().enumerate() {
+                out[c * xs.len() + j] = s.deflection(x);
+            }
+        }
+    }
+}
+
+/// Largest number of samples of one series in one trajectory: fast modes are recorded
+/// at their own cadence over the first `MAX_SAMPLES` samples only, which bounds memory
+/// while keeping their relative error far below that of the slow modes.
+pub const MAX_SAMPLES: usize = 1 << 16;
+
+/// What one trajectory recorded.
+#[derive(Debug, Clone, Default)]
+pub struct TrajectoryRecord {
+    /// Modal amplitude series: `modes[c * n_modes + i]` is the series of mode i+1 of
+    /// component c, sampled every `mode_every[i]` steps after burn-in, at most
+    /// [`MAX_SAMPLES`] samples.
+    pub modes: Vec<Vec<f64>>,
+    /// Deflection series at the profile points: `profile[c * n_points + j]`, every
+    /// `profile_every` steps, at most [`MAX_SAMPLES`] samples.
+    pub profile: Vec<Vec<f64>>,
+    /// Two-time products w(x,t)·w(y,η), `two_time[c * n_points + j]`.
+    pub two_time: Vec<f64>,
+}
+
+/// A prepared run of a linear scene: model, references and sampling plan.
+pub struct LinearRun {
+    /// The run specification.
+    pub spec: RunSpec,
+    /// Number of transverse components (1 in 2D, 2 in 3D).
+    pub components: usize,
+    /// Exact references.
+    pub reference: LinearReference,
+    /// Steps between samples of each checked mode.
+    pub mode_every: Vec<u64>,
+    /// Steps between samples of the profile deflections.
+    pub profile_every: u64,
+    /// Burn-in steps.
+    pub burn_in_steps: u64,
+    model: Model,
+}
+
+enum Model {
+    Fem {
+        beam: Box<BeamModel>,
+        modes: Option<GeneralizedModes>,
+        projector: DMatrix<f64>,
+        noise: NoiseModel,
+        integrator: IntegratorKind,
+    },
+    Spectral {
+        beam: HingedBeam,
+        n_modes: usize,
+    },
+}
+
+impl LinearRun {
+    /// Prepares run `spec` of `scene`: builds the model, checks the time step against the
+    /// stability limit, and computes every exact reference.
+    ///
+    /// # Errors
+    /// [`Error::UnstableTimeStep`] for an explicit integrator above its limit; numerical
+    /// failures of the reference computations.
+    pub fn prepare(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
+        let p = scene.filament;
+        let continuum = HingedBeam::new(p)?;
+        let tau1 = p.tau1();
+        let dt = spec.dt_tau1 * tau1;
+        let kt = p.kt;
+        let n_check = scene.sampling.modes;
+        let profile_x: Vec<f64> = scene
+            .sampling
+            .profile_points
+            .iter()
+            .map(|f| f * p.length)
+            .collect();
+        let profile_continuum: Vec<f64> = profile_x
+            .iter()
+            .map(|&x| continuum.profile_variance(x))
+            .collect();
+        let components = scene.dims - 1;
+        let steps = |t: f64| (t / dt).round() as u64;
+
+        let (model, modes, profile_discrete, two_time, max_rate) = match scene.model {
+            ModelKind::Spectral => {
+                let n_modes = scene.mesh.elements;
+                let mut refs = Vec::new();
+                for n in 1..=n_check {
+                    let rate = continuum.mode_rate(n);
+                    let var = continuum.mode_variance(n);
+                    refs.push(ModeReference {
+                        n,
+                        variance_discrete: var,
+                        variance_equipartition: var,
+                        variance_continuum: var,
+                        multiplier: (-rate * dt).exp(),
+                        rate_discrete: Some(rate),
+                        rate_continuum: rate,
+                    });
+                }
+                // The simulator carries n_modes modes: its exact profile is the truncated sum.
+                let profile_discrete = profile_x
+                    .iter()
+                    .map(|&x| continuum.profile_variance_series(x, n_modes).value)
+                    .collect();
+                let mut tt = Vec::new();
+                for q in &scene.sampling.two_time {
+                    let (x, y) = (q[0] * p.length, q[1] * p.length);
+                    let (ts, es) = (steps(q[2] * tau1), steps(q[3] * tau1));
+                    let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+                    tt.push(TwoTimeReference {
+                        x,
+                        y,
+                        t,
+                        eta,
+                        t_step: ts,
+                        eta_step: es,
+                        discrete: continuum
+                            .correlation_truncated(x, y, t, eta, n_modes)?
+                            .value,
+                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                    });
+                }
+                let max_rate = continuum.mode_rate(n_modes);
+                (
+                    Model::Spectral {
+                        beam: continuum,
+                        n_modes,
+                    },
+                    refs,
+                    profile_discrete,
+                    tt,
+                    max_rate,
+                )
+            }
+            ModelKind::Fem => {
+                let mesh = if scene.mesh.grading == 1.0 {
+                    Mesh::uniform(p.length, scene.mesh.elements)?
+                } else {
+                    Mesh::graded(p.length, scene.mesh.elements, scene.mesh.grading)?
+                };
+                let beam = BeamModel::new(p, mesh)?;
+                let gm = generalized_modes(&beam)?;
+                let max_rate = gm.rates[gm.rates.len() - 1];
+                // Fails early with the stability limit if the step is too large.
+                build_integrator(spec.integrator, &beam, spec.noise, dt, max_rate, Some(&gm))?;
+                let sigma_zeta = NoiseGenerator::new(spec.noise, &beam)?.covariance();
+                let sigma_q = modal_noise_covariance(&gm, &sigma_zeta);
+                let (m, g): (Vec<f64>, Vec<f64>) = gm
+                    .rates
+                    .iter()
+                    .map(|&r| spec.integrator.modal_form(r, dt, kt))
+                    .unzip();
+                let s = discrete_stationary_covariance(&sigma_q, &m, &g)?;
+                let mut refs = Vec::new();
+                for i in 0..n_check {
+                    let n = i + 1;
+                    let rate = gm.rates[i];
+                    refs.push(ModeReference {
+                        n,
+                        variance_discrete: s[(i, i)],
+                        variance_equipartition: kt / rate,
+                        variance_continuum: kt / continuum.mode_rate(n),
+                        multiplier: m[i],
+                        rate_discrete: (m[i] > 0.0).then(|| -m[i].ln() / dt),
+                        rate_continuum: continuum.mode_rate(n),
+                    });
+                }
+                // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
+                let probe = |x: f64| -> DVector<f64> {
+                    let mut e = vec![0.0; beam.n_dofs()];
+                    let mut v = DVector::zeros(beam.n_dofs());
+                    for k in 0..beam.n_dofs() {
+                        e[k] = 1.0;
+                        v[k] = beam.deflection_at(&e, x);
+                        e[k] = 0.0;
+                    }
+                    gm.vectors.transpose() * v
+                };
+                let profile_discrete = profile_x
+                    .iter()
+                    .map(|&x| {
+                        let a = probe(x);
+                        (a.transpose() * &s * &a)[(0, 0)]
+                    })
+                    .collect();
+                let mut tt = Vec::new();
+                for q in &scene.sampling.two_time {
+                    let (x, y) = (q[0] * p.length, q[1] * p.length);
+                    let (ts, es) = (steps(q[2] * tau1).max(1), steps(q[3] * tau1).max(1));
+                    let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+                    // From rest: S_k,ij = g_i g_j Σq_ij (1 − (m_i m_j)^k)/(1 − m_i m_j), then
+                    // ⟨q(η) q(t)ᵀ⟩ = diag(m^{η−t}) S_t.
+                    let n = gm.rates.len();
+                    let mut st = DMatrix::zeros(n, n);
+                    for i in 0..n {
+                        for j in 0..n {
+                            let mm = m[i] * m[j];
+                            let transient = if mm == 1.0 {
+                                0.0
+                            } else {
+                                1.0 - mm.powf(ts as f64)
+                            };
+                            st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * transient / (1.0 - mm)
+                                * m[i].powf((es - ts) as f64);
+                        }
+                    }
+                    let (ax, ay) = (probe(x), probe(y));
+                    tt.push(TwoTimeReference {
+                        x,
+                        y,
+                        t,
+                        eta,
+                        t_step: ts,
+                        eta_step: es,
+                        discrete: (ay.transpose() * &st * &ax)[(0, 0)],
+                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                    });
+                }
+                let projector = gm.projector(&beam, n_check);
+                let keep_modes = spec.integrator == IntegratorKind::ExactModal;
+                (
+                    Model::Fem {
+                        beam: Box::new(beam),
+                        modes: keep_modes.then_some(gm),
+                        projector,
+                        noise: spec.noise,
+                        integrator: spec.integrator,
+                    },
+                    refs,
+                    profile_discrete,
+                    tt,
+                    max_rate,
+                )
+            }
+        };
+
+        // Each mode is sampled about twice per relaxation time; the profile four times
+        // per relaxation time of mode 1.
+        let every = |rate: f64| ((0.5 / rate) / dt).floor().max(1.0) as u64;
+        let mode_every: Vec<u64> = modes
+            .iter()
+            .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))
+            .collect();
+        let profile_every = every(4.0 * modes[0].rate_discrete.unwrap_or(modes[0].rate_continuum));
+        let burn_in_steps = steps(scene.sampling.burn_in_tau1 * tau1);
+        Ok(LinearRun {
+            spec: spec.clone(),
+            components,
+            reference: LinearReference {
+                modes,
+                profile_x,
+                profile_discrete,
+                profile_continuum,
+                two_time,
+                dt,
+                max_rate,
+            },
+            mode_every,
+            profile_every,
+            burn_in_steps,
+            model,
+        })
+    }
+
+    /// Number of sampling steps for a sampled duration (physical time units).
+    pub fn sampled_steps(&self, duration: f64) -> u64 {
+        ((duration / self.reference.dt).round() as u64).max(1)
+    }
+
+    /// Time between samples of mode `i` (0-based).
+    pub fn mode_dt(&self, i: usize) -> f64 {
+        self.mode_every[i] as f64 * self.reference.dt
+    }
+
+    fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {
+        Ok(match &self.model {
+            Model::Fem {
+                beam,
+                modes,
+                projector,
+                noise,
+                integrator,
+            } => Box::new(FemSampler {
+                beam,
+                projector,
+                integrator: build_integrator(
+                    *integrator,
+                    beam,
+                    *noise,
+                    self.reference.dt,
+                    self.reference.max_rate,
+                    modes.as_ref(),
+                )?,
+                states: vec![vec![0.0; beam.n_dofs()]; self.components],
+            }),
+            Model::Spectral { beam, n_modes } => {
+                let mut sims = Vec::new();
+                for _ in 0..self.components {
+                    let mut s = ModalSimulator::new(*beam, *n_modes, self.reference.dt)?;
+                    s.set_rest();
+                    sims.push(s);
+                }
+                Box::new(SpectralSampler {
+                    sims,
+                    n_modes: self.reference.modes.len(),
+                })
+            }
+        })
+    }
+
+    /// Runs `steps` steps from rest and returns, every `every` steps, the checked modal
+    /// amplitudes and the profile deflections (component-major): a short deterministic
+    /// trace for golden snapshots.
+    ///
+    /// # Errors
+    /// [`Error::Diverged`] if the state becomes non-finite.
+    pub fn trace(&self, rng: &mut TrajectoryRng, steps: u64, every: u64) -> Result<Vec<Vec<f64>>> {
+        let mut sampler = self.sampler()?;
+        let r = &self.reference;
+        let mut m = vec![0.0; self.components * r.modes.len()];
+        let mut p = vec![0.0; self.components * r.profile_x.len()];
+        let mut out = Vec::new();
+        for step in 1..=steps {
+            sampler.step(rng);
+            if !sampler.is_finite() {
+                return Err(Error::Diverged {
+                    step,
+                    time: step as f64 * r.dt,
+                    detail: format!("non-finite deflection with {}", self.spec.integrator),
+                });
+            }
+            if step % every.max(1) == 0 {
+                sampler.modes(&mut m);
+                sampler.deflections(&r.profile_x, &mut p);
+                out.push(m.iter().chain(&p).copied().collect());
+            }
+        }
+        Ok(out)
+    }
+
+    /// Simulates one trajectory from rest: burn-in (recording the two-time products on
+    /// the way) and then `sampled_steps` steps, recording every series at its cadence.
+    /// With `sampled_steps = 0` only the two-time part is run, up to the largest η.
+    ///
+    /// # Errors
+    /// [`Error::Diverged`] naming the step and time at which the state became non-finite.
+    pub fn simulate(
+        &self,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<TrajectoryRecord> {
+        let mut sampler = self.sampler()?;
+        let r = &self.reference;
+        let nm = r.modes.len();
+        let c = self.components;
+        let np = r.profile_x.len();
+        let tt = &r.two_time;
+        let last_tt = tt.iter().map(|q| q.eta_step).max().unwrap_or(0);
+        let total = if sampled_steps == 0 {
+            last_tt
+        } else {
+            self.burn_in_steps.max(last_tt) + sampled_steps
+        };
+        let start = total - sampled_steps;
+        let cap = |every: u64| ((sampled_steps / every) as usize).min(MAX_SAMPLES);
+        let mut rec = TrajectoryRecord {
+            modes: (0..c * nm)
+                .map(|k| Vec::with_capacity(cap(self.mode_every[k % nm])))
+                .collect(),
+            profile: vec![Vec::with_capacity(cap(self.profile_every)); c * np],
+            two_time: vec![0.0; c * tt.len()],
+        };
+        // w(x, t) at the earlier time of each two-time point, per component.
+        let mut at_t = vec![0.0; c * tt.len()];
+        let mut buf_m = vec![0.0; c * nm];
+        let mut buf_p = vec![0.0; c * np];
+        let mut one = vec![0.0; c];
+        for step in 1..=total {
+            sampler.step(rng);
+            if !sampler.is_finite() {
+                return Err(Error::Diverged {
+                    step,
+                    time: step as f64 * r.dt,
+                    detail: format!(
+                        "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
+                        self.spec.integrator,
+                        r.dt,
+                        r.max_rate * r.dt
+                    ),
+                });
+            }
+            for (j, q) in tt.iter().enumerate() {
+                if step == q.t_step {
+                    sampler.deflections(&[q.x], &mut one);
+                    for k in 0..c {
+                        at_t[k * tt.len() + j] = one[k];
+                    }
+                }
+                if step == q.eta_step {
+                    sampler.deflections(&[q.y], &mut one);
+                    for k in 0..c {
+                        rec.two_time[k * tt.len() + j] = at_t[k * tt.len() + j] * one[k];
+                    }
+                }
+            }
+            if step <= start {
+                continue;
+            }
+            let since = step - start;
+            if self.mode_every.iter().any(|&e| since.is_multiple_of(e)) {
+                sampler.modes(&mut buf_m);
+                for (k, s) in rec.modes.iter_mut().enumerate() {
+                    if since.is_multiple_of(self.mode_every[k % nm]) && s.len() < MAX_SAMPLES {
+                        s.push(buf_m[k]);
+                    }
+                }
+            }
+            if since.is_multiple_of(self.profile_every)
+                && rec.profile.first().is_some_and(|s| s.len() < MAX_SAMPLES)
+            {
+                sampler.deflections(&r.profile_x, &mut buf_p);
+                for (s, v) in rec.profile.iter_mut().zip(&buf_p) {
+                    s.push(*v);
+                }
+            }
+        }
+        Ok(rec)
+    }
+}

@@ -1,0 +1,493 @@
+//! The verification runner: runs scenes, applies the family-wise correction, writes
+//! `summary.json`, per-scene CSV tables and SVG figures, and `index.html`.
+
+use crate::error::{Error, Result};
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::fem::modal::{generalized_modes, modal_noise_covariance};
+use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::report::{Figure, Series, SeriesStyle, write_csv, write_index, write_json};
+use crate::rng::{derive_seed, trajectory_rng};
+use crate::stats;
+use crate::verify::checks::{LinearEstimates, linear_checks};
+use crate::verify::linear::LinearRun;
+use crate::verify::scene::{Budget, ModelKind, Scene};
+use crate::verify::summary::{SceneSummary, Summary};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of a verification run.
+#[derive(Debug, Clone)]
+pub struct VerifyOptions {
+    /// Scene files to run.
+    pub scenes: Vec<PathBuf>,
+    /// Budget.
+    pub budget: Budget,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Family-wise significance level per scene (Holm).
+    pub alpha: f64,
+    /// Show a progress bar (only drawn on a terminal).
+    pub progress: bool,
+}
+
+/// Element counts of the element-uniform noise study (theory only).
+const NOISE_STUDY_ELEMENTS: [usize; 6] = [5, 10, 20, 40, 80, 160];
+
+/// Runs every scene and writes the reports.
+///
+/// # Errors
+/// Bad scene files ([`Error::Scene`]), time steps above a stability limit, diverging
+/// runs, I/O failures.
+pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
+    let scenes: Vec<Scene> = opts
+        .scenes
+        .iter()
+        .map(|p| Scene::load(p))
+        .collect::<Result<_>>()?;
+    // Prepare every run first so that bad input is reported before any long work.
+    let mut prepared = Vec::new();
+    for scene in &scenes {
+        let runs: Vec<LinearRun> = scene
+            .runs
+            .iter()
+            .map(|spec| LinearRun::prepare(scene, spec))
+            .collect::<Result<_>>()?;
+        prepared.push(runs);
+    }
+    let total: u64 = scenes
+        .iter()
+        .flat_map(|s| s.runs.iter())
+        .map(|r| {
+            let e = r.ensemble(opts.budget);
+            (e.trajectories + e.two_time_trajectories) as u64
+        })
+        .sum();
+    let bar = if opts.progress {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories  {msg}",
+    ) {
+        bar.set_style(style);
+    }
+    let mut summaries = Vec::new();
+    for (scene, runs) in scenes.iter().zip(&prepared) {
+        bar.set_message(scene.name.clone());
+        summaries.push(run_scene(scene, runs, opts, &bar)?);
+    }
+    bar.finish_and_clear();
+    let summary = Summary {
+        budget: opts.budget.name().to_string(),
+        alpha: opts.alpha,
+        passed: summaries.iter().all(|s| s.passed),
+        scenes: summaries,
+    };
+    write_json(&opts.out.join("summary.json"), &summary)?;
+    write_index(&opts.out, &summary)?;
+    Ok(summary)
+}
+
+fn run_scene(
+    scene: &Scene,
+    runs: &[LinearRun],
+    opts: &VerifyOptions,
+    bar: &ProgressBar,
+) -> Result<SceneSummary> {
+    let start = Instant::now();
+    let dir = opts.out.join(&scene.name);
+    let mut checks = Vec::new();
+    let mut figures = Vec::new();
+    let mut tables = Vec::new();
+    let mut notes = vec![scene.description.clone()];
+    for run in runs {
+        let e = run.spec.ensemble(opts.budget);
+        let seed = derive_seed(scene.seed, &run.spec.name);
+        let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+        let records = (0..e.trajectories as u64)
+            .into_par_iter()
+            .map(|j| {
+                let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
+                bar.inc(1);
+                rec
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let extra = (0..e.two_time_trajectories as u64)
+            .into_par_iter()
+            .map(|j| {
+                let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
+                bar.inc(1);
+                rec.map(|r| r.two_time)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let two_time: Vec<Vec<f64>> = records
+            .iter()
+            .map(|r| r.two_time.clone())
+            .chain(extra)
+            .collect();
+        let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)?;
+        checks.extend(run_checks);
+        notes.extend(
+            est.skipped
+                .iter()
+                .map(|s| format!("not evaluated at this budget: {s}")),
+        );
+        let name = &run.spec.name;
+        notes.push(format!(
+            "run {name}: {} with {} noise, dt = {:.4e} tau1 (lambda_max dt = {:.3e}), {} trajectories x {} tau1 after {} tau1 burn-in, mode 1 sampled every {} steps",
+            run.spec.integrator,
+            run.spec.noise.name(),
+            run.spec.dt_tau1,
+            run.reference.max_rate * run.reference.dt,
+            e.trajectories,
+            e.duration_tau1,
+            scene.sampling.burn_in_tau1,
+            run.mode_every[0]
+        ));
+        write_run_outputs(&dir, run, &est, &mut figures, &mut tables)?;
+        if scene.model == ModelKind::Fem && run.spec.noise == NoiseModel::ElementUniform {
+            notes.push(noise_study(scene, &dir, &mut figures, &mut tables)?);
+        }
+    }
+    let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
+    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, opts.alpha)) {
+        c.p_adjusted = Some(adj);
+        c.passed = !reject;
+    }
+    let rel = |v: Vec<PathBuf>| -> Vec<String> {
+        v.iter()
+            .map(|p| {
+                p.strip_prefix(&opts.out)
+                    .unwrap_or(p)
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect()
+    };
+    Ok(SceneSummary {
+        name: scene.name.clone(),
+        passed: checks.iter().all(|c| c.passed),
+        wall_seconds: start.elapsed().as_secs_f64(),
+        figures: rel(figures),
+        tables: rel(tables),
+        notes,
+        checks,
+    })
+}
+
+fn write_run_outputs(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    figures: &mut Vec<PathBuf>,
+    tables: &mut Vec<PathBuf>,
+) -> Result<()> {
+    let r = &run.reference;
+    let name = &run.spec.name;
+    let modes: Vec<_> = r.modes.iter().zip(&est.modes).collect();
+
+    if est.modes.iter().any(|m| m.variance.1 > 0.0) {
+        let path = dir.join(format!("{name}-modes.csv"));
+        let rows: Vec<Vec<f64>> = modes
+            .iter()
+            .map(|(mr, me)| {
+                let eq = mr.variance_equipartition;
+                vec![
+                    mr.n as f64,
+                    mr.variance_discrete / eq,
+                    me.variance.0 / eq,
+                    me.variance.1 / eq,
+                ]
+            })
+            .collect();
+        write_csv(
+            &path,
+            &["mode", "predicted_ratio", "simulated_ratio", "std_error"],
+            &rows,
+        )?;
+        tables.push(path);
+        let fig = Figure::new(
+            format!("{name}: modal variance / equipartition (kT/lambda_i of the discrete modes)"),
+            "mode n",
+            "variance ratio",
+        )
+        .series(
+            Series::markers(
+                "simulated (±1 s.e.)",
+                rows.iter().map(|r| (r[0], r[2])).collect(),
+            )
+            .with_errors(rows.iter().map(|r| r[3]).collect()),
+        )
+        .series(Series::line(
+            "exact discrete reference",
+            rows.iter().map(|r| (r[0], r[1])).collect(),
+        ))
+        .series(
+            Series::line(
+                "continuum (kT/lambda_n) / equipartition",
+                modes
+                    .iter()
+                    .map(|(mr, _)| {
+                        (
+                            mr.n as f64,
+                            mr.variance_continuum / mr.variance_equipartition,
+                        )
+                    })
+                    .collect(),
+            )
+            .dashed(),
+        )
+        .hline(1.0, "equipartition");
+        let path = dir.join(format!("{name}-modes.svg"));
+        fig.write_svg(&path)?;
+        figures.push(path);
+    }
+
+    let stats_path = dir.join(format!("{name}-mode-statistics.csv"));
+    let rows: Vec<Vec<f64>> = modes
+        .iter()
+        .map(|(mr, me)| {
+            vec![
+                mr.n as f64,
+                me.variance.0,
+                me.variance.1,
+                mr.variance_discrete,
+                mr.variance_continuum,
+                me.rate.0,
+                me.rate.1,
+                mr.rate_discrete.unwrap_or(f64::NAN),
+                mr.rate_continuum,
+            ]
+        })
+        .collect();
+    write_csv(
+        &stats_path,
+        &[
+            "mode",
+            "variance",
+            "variance_std_error",
+            "variance_discrete",
+            "variance_continuum",
+            "rate",
+            "rate_std_error",
+            "rate_discrete",
+            "rate_continuum",
+        ],
+        &rows,
+    )?;
+    tables.push(stats_path);
+
+    if est.modes.iter().any(|m| m.rate.0.is_finite()) {
+        let fig = Figure::new(
+            format!("{name}: relaxation rate / continuum rate lambda_n"),
+            "mode n",
+            "rate ratio",
+        )
+        .series(
+            Series::markers(
+                "simulated (±1 s.e.)",
+                rows.iter().map(|r| (r[0], r[5] / r[8])).collect(),
+            )
+            .with_errors(rows.iter().map(|r| r[6] / r[8]).collect()),
+        )
+        .series(Series::line(
+            "exact discrete: -ln(m)/dt",
+            rows.iter().map(|r| (r[0], r[7] / r[8])).collect(),
+        ))
+        .hline(1.0, "continuum");
+        let path = dir.join(format!("{name}-rates.svg"));
+        fig.write_svg(&path)?;
+        figures.push(path);
+    }
+
+    if !est.profile.is_empty() {
+        let path = dir.join(format!("{name}-profile.csv"));
+        let rows: Vec<Vec<f64>> = (0..est.profile.len())
+            .map(|j| {
+                vec![
+                    r.profile_x[j],
+                    est.profile[j].0,
+                    est.profile[j].1,
+                    r.profile_discrete[j],
+                    r.profile_continuum[j],
+                ]
+            })
+            .collect();
+        write_csv(
+            &path,
+            &["x", "variance", "std_error", "discrete", "continuum"],
+            &rows,
+        )?;
+        tables.push(path);
+    }
+
+    if !est.two_time.is_empty() {
+        let path = dir.join(format!("{name}-two-time.csv"));
+        let rows: Vec<Vec<f64>> = r
+            .two_time
+            .iter()
+            .zip(&est.two_time)
+            .map(|(q, e)| vec![q.x, q.y, q.t, q.eta, e.0, e.1, q.discrete, q.continuum])
+            .collect();
+        write_csv(
+            &path,
+            &[
+                "x",
+                "y",
+                "t",
+                "eta",
+                "correlation",
+                "std_error",
+                "discrete",
+                "continuum",
+            ],
+            &rows,
+        )?;
+        tables.push(path);
+    }
+
+    let spectra: Vec<_> = est
+        .modes
+        .iter()
+        .filter_map(|m| m.spectrum.as_ref().map(|s| (m.n, s)))
+        .collect();
+    if !spectra.is_empty() {
+        let mut rows = Vec::new();
+        let mut fig = Figure::new(
+            format!("{name}: modal power spectra (Welch) vs exact expectation"),
+            "frequency",
+            "one-sided PSD",
+        )
+        .log_x()
+        .log_y();
+        for (n, (f, p, e)) in &spectra {
+            for k in 1..f.len() {
+                rows.push(vec![*n as f64, f[k], p[k], e[k]]);
+            }
+            if [1, 3, 6].contains(n) {
+                fig = fig
+                    .series(Series::markers(
+                        format!("mode {n}: simulated"),
+                        f.iter().zip(p).skip(1).map(|(a, b)| (*a, *b)).collect(),
+                    ))
+                    .series(Series::line(
+                        format!("mode {n}: exact"),
+                        f.iter().zip(e).skip(1).map(|(a, b)| (*a, *b)).collect(),
+                    ));
+            }
+        }
+        let path = dir.join(format!("{name}-spectrum.csv"));
+        write_csv(&path, &["mode", "frequency", "psd", "expected"], &rows)?;
+        tables.push(path);
+        let path = dir.join(format!("{name}-spectrum.svg"));
+        fig.write_svg(&path)?;
+        figures.push(path);
+    }
+    Ok(())
+}
+
+/// Predicted stationary variance of the discrete modes relative to equipartition under
+/// the paper's element-uniform noise (eq. 5), `(ΦᵀΣ_ζΦ)_ii`, against element count, for
+/// any integrator whose consistent-noise variance is exact (continuous time).
+fn noise_study(
+    scene: &Scene,
+    dir: &Path,
+    figures: &mut Vec<PathBuf>,
+    tables: &mut Vec<PathBuf>,
+) -> Result<String> {
+    let n_modes = 6;
+    let mut rows = Vec::new();
+    for &ne in &NOISE_STUDY_ELEMENTS {
+        let beam = BeamModel::new(scene.filament, Mesh::uniform(scene.filament.length, ne)?)?;
+        let gm = generalized_modes(&beam)?;
+        let sq = modal_noise_covariance(
+            &gm,
+            &NoiseGenerator::new(NoiseModel::ElementUniform, &beam)?.covariance(),
+        );
+        let mut row = vec![ne as f64];
+        row.extend((0..n_modes).map(|i| {
+            if i < gm.rates.len() {
+                sq[(i, i)]
+            } else {
+                f64::NAN
+            }
+        }));
+        rows.push(row);
+    }
+    let path = dir.join("element-uniform-vs-elements.csv");
+    write_csv(
+        &path,
+        &[
+            "elements", "mode1", "mode2", "mode3", "mode4", "mode5", "mode6",
+        ],
+        &rows,
+    )?;
+    tables.push(path);
+    let mut fig = Figure::new(
+        "element-uniform noise (eq. 5): 1 - variance/equipartition vs element count",
+        "elements",
+        "1 - ratio",
+    )
+    .log_x()
+    .log_y();
+    for i in 0..n_modes {
+        fig = fig.series(
+            Series::line(
+                format!("mode {}", i + 1),
+                rows.iter().map(|r| (r[0], 1.0 - r[i + 1])).collect(),
+            )
+            .with_style(SeriesStyle::LineMarkers),
+        );
+    }
+    let path = dir.join("element-uniform-vs-elements.svg");
+    fig.write_svg(&path)?;
+    figures.push(path);
+    // Observed order of the deficit of mode 1 between the two finest meshes.
+    let k = rows.len() - 1;
+    let order = ((1.0 - rows[k - 1][1]) / (1.0 - rows[k][1])).log2();
+    let at10 = &rows[1];
+    Ok(format!(
+        "element-uniform noise (eq. 5) under-excites the discrete modes: with 10 elements modes 1-6 get {} of equipartition; the deficit of each mode falls as h^{order:.2} with element count (mode 1 at 160 elements: {:.2e}); see element-uniform-vs-elements.csv",
+        at10[1..]
+            .iter()
+            .map(|v| format!("{v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        1.0 - rows[k][1]
+    ))
+}
+
+/// Resolves `--scene` arguments (names or paths) against `scene_dir`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming an unknown scene and listing the known ones.
+pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>> {
+    let known = Scene::discover(scene_dir)?;
+    if names.is_empty() {
+        return Ok(known);
+    }
+    names
+        .iter()
+        .map(|n| {
+            let p = PathBuf::from(n);
+            if p.extension().is_some_and(|x| x == "toml") && p.exists() {
+                return Ok(p);
+            }
+            known
+                .iter()
+                .find(|k| k.file_stem().is_some_and(|s| s == n.as_str()))
+                .cloned()
+                .ok_or_else(|| {
+                    let names: Vec<String> = known
+                        .iter()
+                        .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                        .collect();
+                    Error::invalid("--scene", n, format!("one of: {}", names.join(", ")))
+                })
+        })
+        .collect()
+}

@@ -1,0 +1,547 @@
+//! Tests of the finite-element model (`src/fem`) against closed forms, dense linear
+//! algebra and the continuum solution of eq. (2).
+
+use langevin_fem::FilamentParams;
+use langevin_fem::fem::{
+    BeamModel, GeneralizedModes, Mesh, NoiseGenerator, NoiseModel, UNIFORM_RATE_FACTOR,
+    continuous_stationary_covariance, discrete_stationary_covariance, generalized_modes,
+    modal_noise_covariance, nodal_covariance,
+};
+use langevin_fem::rng::trajectory_rng;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+/// Non-unit parameters so that every scaling is exercised.
+fn params() -> FilamentParams {
+    FilamentParams {
+        length: 2.0,
+        bending_rigidity: 3.0,
+        stretch_rigidity: 1e6,
+        drag: 0.7,
+        kt: 1.3,
+    }
+}
+
+fn beam(mesh: Mesh) -> BeamModel {
+    BeamModel::new(params(), mesh).unwrap()
+}
+
+fn uniform(n: usize) -> BeamModel {
+    beam(Mesh::uniform(params().length, n).unwrap())
+}
+
+fn graded(n: usize, ratio: f64) -> BeamModel {
+    beam(Mesh::graded(params().length, n, ratio).unwrap())
+}
+
+/// Continuum rate λ_n = π⁴n⁴EI/(ξL⁴).
+fn continuum_rate(p: &FilamentParams, n: usize) -> f64 {
+    (PI * n as f64).powi(4) * p.bending_rigidity / (p.drag * p.length.powi(4))
+}
+
+fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax() / b.amax()
+}
+
+#[test]
+fn max_rate_uniform_factor_is_2520_and_euler_limit() {
+    let p = params();
+    for &n in &[1usize, 2, 3, 10, 37, 200, 1000] {
+        let b = uniform(n);
+        let h = p.length / n as f64;
+        let lmax = b.max_rate().unwrap();
+        let c = lmax * p.drag * h.powi(4) / p.bending_rigidity;
+        println!("N = {n:5}: lambda_max * xi h^4 / EI = {c:.12}");
+        assert!(
+            (c / UNIFORM_RATE_FACTOR - 1.0).abs() < 1e-10,
+            "N = {n}: c = {c}"
+        );
+        if n <= 40 {
+            let dense = generalized_modes(&b).unwrap().rates.max();
+            assert!(
+                (lmax / dense - 1.0).abs() < 1e-10,
+                "N = {n}: {lmax} vs {dense}"
+            );
+        }
+    }
+    // explicit Euler limit for 10 elements: 2/λ_max = 2π⁴/(2520·10⁴)·τ1 ≈ 7.73e-6 τ1
+    let b = uniform(10);
+    let limit = b.explicit_euler_dt_limit().unwrap() / p.tau1();
+    let expected = 2.0 * PI.powi(4) / (2520.0 * 1e4);
+    println!("explicit Euler limit, 10 elements: dt < {limit:.4e} tau1");
+    assert!((limit / expected - 1.0).abs() < 1e-10);
+}
+
+#[test]
+fn max_rate_graded_matches_dense_eigenvalue() {
+    let p = params();
+    for &(n, ratio) in &[(2usize, 3.0), (7, 0.1), (16, 5.0), (25, 0.02)] {
+        let b = graded(n, ratio);
+        let lmax = b.max_rate().unwrap();
+        let dense = generalized_modes(&b).unwrap().rates.max();
+        let hmin = b.mesh().min_element_length();
+        let c = lmax * p.drag * hmin.powi(4) / p.bending_rigidity;
+        println!("graded N = {n}, ratio {ratio}: lambda_max * xi hmin^4/EI = {c:.4}");
+        assert!((lmax / dense - 1.0).abs() < 1e-10, "{lmax} vs {dense}");
+    }
+}
+
+#[test]
+fn dof_layout_interpolation_and_assembled_forms_are_exact_for_cubics() {
+    let p = params();
+    let l = p.length;
+    let b = graded(6, 0.4);
+    let n = b.n_dofs();
+    assert_eq!(n, 12);
+    let nodes = b.mesh().nodes().to_vec();
+    assert_eq!(b.node_deflection_index(0), None);
+    assert_eq!(b.node_deflection_index(6), None);
+    assert_eq!(b.node_deflection_index(7), None);
+    assert_eq!(b.node_deflection_index(1), Some(1));
+    assert_eq!(b.node_rotation_index(0), Some(0));
+    assert_eq!(b.node_rotation_index(6), Some(11));
+    assert_eq!(b.element_dofs(0), [None, Some(0), Some(1), Some(2)]);
+    assert_eq!(b.element_dofs(5), [Some(9), Some(10), None, Some(11)]);
+    assert_eq!(b.load_vectors().len(), 6);
+    // cubic with w(0) = w(L) = 0
+    let w = |x: f64| x * (l - x) * (x + 0.3);
+    let dw = |x: f64| -3.0 * x * x + 2.0 * (l - 0.3) * x + 0.3 * l;
+    let mut state = vec![0.0; n];
+    for (i, &x) in nodes.iter().enumerate() {
+        if let Some(k) = b.node_deflection_index(i) {
+            state[k] = w(x);
+        }
+        state[b.node_rotation_index(i).unwrap()] = dw(x);
+    }
+    for k in 0..=50 {
+        let x = l * k as f64 / 50.0;
+        assert!((b.deflection_at(&state, x) - w(x)).abs() < 1e-13);
+    }
+    assert!(b.deflection_at(&state, -0.1).is_nan());
+    assert!(b.deflection_at(&state, l * 1.01).is_nan());
+    // ∫w dx, ∫w'² dx, EI∫w''² dx and ξ∫w² dx by exact polynomial integration
+    let integrate = |f: &dyn Fn(f64) -> f64| {
+        // Simpson on a fine grid is exact for these polynomials only up to cubic; use
+        // Gauss–Legendre with 5 points on 8 panels (exact to degree 9)
+        let g = [
+            (0.0, 128.0 / 225.0),
+            (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+            (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+            (-0.906_179_845_938_664, 0.236_926_885_056_189_08),
+            (0.906_179_845_938_664, 0.236_926_885_056_189_08),
+        ];
+        let panels = 8;
+        let hp = l / panels as f64;
+        let mut s = 0.0;
+        for k in 0..panels {
+            for &(t, wq) in &g {
+                s += 0.5 * hp * wq * f(hp * (k as f64 + 0.5 * (t + 1.0)));
+            }
+        }
+        s
+    };
+    let bvec = b.assembled_load_vector();
+    let int_w: f64 = bvec.iter().zip(&state).map(|(a, c)| a * c).sum();
+    assert!((int_w - integrate(&|x| w(x))).abs() < 1e-12);
+    let gq = b.geometric().quadratic_form(&state);
+    assert!((gq - integrate(&|x| dw(x) * dw(x))).abs() < 1e-11);
+    let d2w = |x: f64| -6.0 * x + 2.0 * (l - 0.3);
+    let kq = b.stiffness().quadratic_form(&state);
+    assert!((kq - p.bending_rigidity * integrate(&|x| d2w(x) * d2w(x))).abs() < 1e-10);
+    let cq = b.damping().quadratic_form(&state);
+    assert!((cq - p.drag * integrate(&|x| w(x) * w(x))).abs() < 1e-12);
+}
+
+fn check_modes(b: &BeamModel, m: &GeneralizedModes) {
+    let c = b.damping().to_dense();
+    let k = b.stiffness().to_dense();
+    let phi = &m.vectors;
+    let n = b.n_dofs();
+    let ctc = phi.transpose() * &c * phi;
+    assert!((ctc - DMatrix::<f64>::identity(n, n)).amax() < 1e-9);
+    let ktk = phi.transpose() * &k * phi;
+    for i in 0..n {
+        for j in 0..n {
+            let expect = if i == j { m.rates[i] } else { 0.0 };
+            let scale = (m.rates[i] * m.rates[j]).sqrt();
+            assert!(
+                (ktk[(i, j)] - expect).abs() < 1e-9 * scale,
+                "K-orthogonality ({i},{j}): {} vs {expect}",
+                ktk[(i, j)]
+            );
+        }
+    }
+    for i in 1..n {
+        assert!(m.rates[i] > m.rates[i - 1]);
+    }
+    let proj = m.projector(b, 4);
+    assert_eq!(proj.nrows(), 4);
+    let pq = &proj * phi;
+    for i in 0..4 {
+        for j in 0..n {
+            let e = if i == j { 1.0 } else { 0.0 };
+            assert!((pq[(i, j)] - e).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn generalized_modes_are_orthonormal_and_match_continuum_shapes() {
+    let p = params();
+    for b in [uniform(12), graded(9, 0.2), graded(5, 4.0)] {
+        let m = generalized_modes(&b).unwrap();
+        check_modes(&b, &m);
+    }
+    // low modes approach φ_n(x) = sqrt(2/(ξL)) sin(nπx/L) at the nodes, with positive sign
+    let b = uniform(40);
+    let m = generalized_modes(&b).unwrap();
+    let amp = (2.0 / (p.drag * p.length)).sqrt();
+    for mode in 0..4 {
+        let mut err: f64 = 0.0;
+        for (i, &x) in b.mesh().nodes().iter().enumerate() {
+            if let Some(k) = b.node_deflection_index(i) {
+                let exact = amp * ((mode + 1) as f64 * PI * x / p.length).sin();
+                err = err.max((m.vectors[(k, mode)] - exact).abs());
+            }
+        }
+        println!(
+            "mode {}: max nodal |phi - phi_continuum| = {err:.2e} (amp {amp:.3})",
+            mode + 1
+        );
+        assert!(err < 1e-4 * amp, "mode {}: {err}", mode + 1);
+    }
+}
+
+#[test]
+fn rates_converge_to_continuum_at_fourth_order() {
+    let p = params();
+    let ns = [2usize, 4, 8, 16];
+    let modes = 3;
+    let mut errs = vec![vec![0.0; ns.len()]; modes];
+    for (a, &n) in ns.iter().enumerate() {
+        let m = generalized_modes(&uniform(n)).unwrap();
+        for (i, row) in errs.iter_mut().enumerate() {
+            let exact = continuum_rate(&p, i + 1);
+            let rel = m.rates[i] / exact - 1.0;
+            // conforming Rayleigh–Ritz: upper bounds
+            assert!(rel > 0.0, "N = {n}, mode {}: {rel}", i + 1);
+            row[a] = rel;
+        }
+    }
+    for (i, row) in errs.iter().enumerate() {
+        let orders: Vec<f64> = row.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        println!(
+            "mode {}: rel. errors {:?}, observed orders {:?}",
+            i + 1,
+            row.iter().map(|e| format!("{e:.3e}")).collect::<Vec<_>>(),
+            orders.iter().map(|o| format!("{o:.3}")).collect::<Vec<_>>()
+        );
+        let last = orders[orders.len() - 1];
+        assert!((last - 4.0).abs() < 0.15, "mode {}: order {last}", i + 1);
+    }
+}
+
+/// kT·x²(L−x)²/(3·EI·L): the continuum equipartition profile ⟨w²(x)⟩.
+fn continuum_variance(p: &FilamentParams, x: f64) -> f64 {
+    let l = p.length;
+    p.kt * x * x * (l - x) * (l - x) / (3.0 * p.bending_rigidity * l)
+}
+
+#[test]
+fn consistent_noise_gives_kt_k_inverse_and_exact_nodal_variances() {
+    let p = params();
+    // the closed form equals the modal series Σ 2kT L³ sin²(nπx/L)/(π⁴n⁴EI)
+    for &x in &[0.1, 0.77, 1.0, 1.9] {
+        let series: f64 = (1..=4000)
+            .map(|n| {
+                let nf = n as f64;
+                2.0 * p.kt * p.length.powi(3) * (nf * PI * x / p.length).sin().powi(2)
+                    / (PI.powi(4) * nf.powi(4) * p.bending_rigidity)
+            })
+            .sum();
+        assert!((series / continuum_variance(&p, x) - 1.0).abs() < 1e-9);
+    }
+    for b in [uniform(10), graded(12, 0.3), graded(7, 6.0)] {
+        let n = b.n_dofs();
+        let gen_ = NoiseGenerator::new(NoiseModel::Consistent, &b).unwrap();
+        let sigma_zeta = gen_.covariance();
+        assert_eq!(sigma_zeta, b.damping().to_dense());
+        let modes = generalized_modes(&b).unwrap();
+        let sigma_q = modal_noise_covariance(&modes, &sigma_zeta);
+        assert!((&sigma_q - DMatrix::<f64>::identity(n, n)).amax() < 1e-9);
+        let s = continuous_stationary_covariance(&sigma_q, &modes.rates, p.kt);
+        let nodal = nodal_covariance(&modes, &s);
+        let kinv = b
+            .stiffness()
+            .to_dense()
+            .cholesky()
+            .unwrap()
+            .inverse()
+            .scale(p.kt);
+        let d_modal = rel_diff(&nodal, &kinv);
+        // banded route: kT (K⁻¹)_kk by banded Cholesky solves
+        let chol = b.stiffness().cholesky().unwrap();
+        let mut worst_banded: f64 = 0.0;
+        let mut worst_modal: f64 = 0.0;
+        for (i, &x) in b.mesh().nodes().iter().enumerate() {
+            let Some(k) = b.node_deflection_index(i) else {
+                continue;
+            };
+            let mut e = vec![0.0; n];
+            e[k] = 1.0;
+            chol.solve_in_place(&mut e);
+            let exact = continuum_variance(&p, x);
+            worst_banded = worst_banded.max((p.kt * e[k] / exact - 1.0).abs());
+            worst_modal = worst_modal.max((nodal[(k, k)] / exact - 1.0).abs());
+        }
+        println!(
+            "N = {}: modal kT K^-1 rel diff {d_modal:.2e}; nodal variance vs continuum: \
+             banded {worst_banded:.2e}, modal {worst_modal:.2e}",
+            b.mesh().n_elements()
+        );
+        assert!(d_modal < 1e-9);
+        assert!(worst_banded < 1e-12);
+        assert!(worst_modal < 1e-10);
+    }
+}
+
+/// `(C⁻¹, A = −C⁻¹K, B = 2kT C⁻¹ Σ_ζ C⁻¹)` of `ẇ = A w + C⁻¹F`.
+fn drift_and_diffusion(b: &BeamModel, sigma_zeta: &DMatrix<f64>) -> (DMatrix<f64>, DMatrix<f64>) {
+    let kt = b.params().kt;
+    let cinv = b.damping().to_dense().try_inverse().unwrap();
+    let a = -(&cinv * b.stiffness().to_dense());
+    let bm = (&cinv * sigma_zeta * &cinv).scale(2.0 * kt);
+    (a, bm)
+}
+
+#[test]
+fn continuous_covariance_solves_lyapunov_for_element_uniform_noise() {
+    let p = params();
+    for b in [uniform(3), graded(3, 0.25)] {
+        let n = b.n_dofs();
+        let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &b)
+            .unwrap()
+            .covariance();
+        let modes = generalized_modes(&b).unwrap();
+        let sigma_q = modal_noise_covariance(&modes, &sigma_zeta);
+        let s = continuous_stationary_covariance(&sigma_q, &modes.rates, p.kt);
+        let nodal = nodal_covariance(&modes, &s);
+        let (a, bm) = drift_and_diffusion(&b, &sigma_zeta);
+        let resid = &a * &nodal + &nodal * a.transpose() + &bm;
+        let r = resid.amax() / bm.amax();
+        // independent route: (I⊗A + A⊗I) vec P = −vec B
+        let id = DMatrix::<f64>::identity(n, n);
+        let big = id.kronecker(&a) + a.kronecker(&id);
+        let rhs = -DVector::from_column_slice(bm.as_slice());
+        let vecp = big.lu().solve(&rhs).unwrap();
+        let pk = DMatrix::from_column_slice(n, n, vecp.as_slice());
+        let d = rel_diff(&nodal, &pk);
+        println!("Lyapunov residual {r:.2e}, modal vs Kronecker {d:.2e}");
+        assert!(r < 1e-10);
+        assert!(d < 1e-9);
+        // element-uniform noise is not kT K⁻¹
+        let kinv = b.stiffness().to_dense().try_inverse().unwrap().scale(p.kt);
+        assert!(rel_diff(&nodal, &kinv) > 1e-3);
+    }
+}
+
+/// Stationary covariance of `x ← M x + noise(cov N)` by Smith's doubling iteration
+/// (`S ← S + M_k S M_kᵀ`, `M_k ← M_k²`), run to convergence.
+fn iterate_stationary(m: &DMatrix<f64>, noise: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut s = noise.clone();
+    let mut mk = m.clone();
+    for _ in 0..64 {
+        s = &s + &mk * &s * mk.transpose();
+        mk = &mk * &mk;
+        if mk.amax() < 1e-300 {
+            break;
+        }
+    }
+    s
+}
+
+#[test]
+fn discrete_covariance_matches_iterated_recursion() {
+    let p = params();
+    let kt = p.kt;
+    let b = graded(3, 0.5);
+    let n = b.n_dofs();
+    let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &b)
+        .unwrap()
+        .covariance();
+    let modes = generalized_modes(&b).unwrap();
+    let sigma_q = modal_noise_covariance(&modes, &sigma_zeta);
+    let c = b.damping().to_dense();
+    let k = b.stiffness().to_dense();
+    let lmax = b.max_rate().unwrap();
+    let l1 = modes.rates[0];
+    // (name, Δt, θ): θ = 0 explicit Euler, 1 backward Euler, ½ Crank–Nicolson.
+    let cases = [
+        ("explicit Euler", 1.0 / lmax, 0.0),
+        ("backward Euler", 10.0 / l1, 1.0),
+        ("Crank-Nicolson", 100.0 / l1, 0.5),
+    ];
+    for (name, dt, theta) in cases {
+        // (C + θΔtK) w' = (C − (1−θ)ΔtK) w + sqrt(2kTΔt) ζ
+        let lhs = &c + k.scale(theta * dt);
+        let lhs_inv = lhs.try_inverse().unwrap();
+        let m_nodal = &lhs_inv * (&c - k.scale((1.0 - theta) * dt));
+        let noise = (&lhs_inv * &sigma_zeta * lhs_inv.transpose()).scale(2.0 * kt * dt);
+        let iterated = iterate_stationary(&m_nodal, &noise);
+        let mult: Vec<f64> = modes
+            .rates
+            .iter()
+            .map(|l| (1.0 - (1.0 - theta) * l * dt) / (1.0 + theta * l * dt))
+            .collect();
+        let gain: Vec<f64> = modes
+            .rates
+            .iter()
+            .map(|l| (2.0 * kt * dt).sqrt() / (1.0 + theta * l * dt))
+            .collect();
+        let s = discrete_stationary_covariance(&sigma_q, &mult, &gain).unwrap();
+        let nodal = nodal_covariance(&modes, &s);
+        let d = rel_diff(&nodal, &iterated);
+        println!(
+            "{name}: dt*lambda in [{:.3e}, {:.3e}], m in [{:.4}, {:.4}], rel diff {d:.2e}",
+            dt * l1,
+            dt * modes.rates[n - 1],
+            mult.iter().cloned().fold(f64::INFINITY, f64::min),
+            mult.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+        );
+        assert!(d < 1e-8, "{name}: {d}");
+    }
+    // truncation to the leading modes is the leading block
+    let mult = [0.5, -0.2];
+    let gain = [1.0, 2.0];
+    let s2 = discrete_stationary_covariance(&sigma_q, &mult, &gain).unwrap();
+    assert_eq!(s2.nrows(), 2);
+    assert!((s2[(1, 0)] - 2.0 * sigma_q[(1, 0)] / 1.1).abs() < 1e-14 * s2.amax());
+}
+
+#[test]
+fn discrete_covariance_rejects_unstable_modes() {
+    let sq = DMatrix::<f64>::identity(3, 3);
+    let err = discrete_stationary_covariance(&sq, &[0.5, -1.0, 0.1], &[1.0; 3]).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("mode 2"), "{msg}");
+    assert!(discrete_stationary_covariance(&sq, &[0.5, 1.5, 0.1], &[1.0; 3]).is_err());
+    assert!(discrete_stationary_covariance(&sq, &[0.5, f64::NAN, 0.1], &[1.0; 3]).is_err());
+    assert!(discrete_stationary_covariance(&sq, &[0.5], &[1.0, 1.0]).is_err());
+    assert!(discrete_stationary_covariance(&sq, &[0.5; 4], &[1.0; 4]).is_err());
+}
+
+#[test]
+fn element_uniform_modal_variance_ratios_tend_to_one() {
+    let ns = [5usize, 10, 20, 40];
+    let n_modes = 6;
+    let mut table = vec![vec![0.0; ns.len()]; n_modes];
+    for (a, &n) in ns.iter().enumerate() {
+        let b = uniform(n);
+        let modes = generalized_modes(&b).unwrap();
+        let sz = NoiseGenerator::new(NoiseModel::ElementUniform, &b)
+            .unwrap()
+            .covariance();
+        let sq = modal_noise_covariance(&modes, &sz);
+        for (i, row) in table.iter_mut().enumerate() {
+            row[a] = sq[(i, i)];
+        }
+        // graded meshes obey the same Cauchy–Schwarz bound
+        let bg = graded(n, 0.3);
+        let mg = generalized_modes(&bg).unwrap();
+        let szg = NoiseGenerator::new(NoiseModel::ElementUniform, &bg)
+            .unwrap()
+            .covariance();
+        let sqg = modal_noise_covariance(&mg, &szg);
+        for i in 0..bg.n_dofs() {
+            assert!(sqg[(i, i)] <= 1.0 + 1e-9 && sqg[(i, i)] >= -1e-12);
+        }
+    }
+    println!("element-uniform noise: stationary modal variance / (kT/lambda_i) = Sigma_q,ii");
+    println!("mode | N = 5      N = 10     N = 20     N = 40   | order 20->40");
+    for (i, row) in table.iter().enumerate() {
+        let order = ((1.0 - row[2]) / (1.0 - row[3])).log2();
+        println!(
+            "{:4} | {:.6}  {:.6}  {:.6}  {:.6} | {order:.3}",
+            i + 1,
+            row[0],
+            row[1],
+            row[2],
+            row[3]
+        );
+        for a in 0..ns.len() {
+            // Σ_q,ii = Σ_e h_e·mean_e(w)² / ∫w² ≤ 1 (Cauchy–Schwarz per element)
+            assert!(row[a] <= 1.0 + 1e-9 && row[a] > 0.0);
+            // monotone once the mode is resolved (mode number < N on the coarser mesh;
+            // mode N of N elements vanishes at every node and is not sine-like)
+            if a > 0 && ns[a - 1] > i + 1 {
+                assert!(row[a] > row[a - 1], "mode {} not converging", i + 1);
+            }
+        }
+        // deficit 1 − Σ_q,ii ≈ (iπh/L)²/12 → second order in h
+        assert!((order - 2.0).abs() < 0.1, "mode {}: order {order}", i + 1);
+        assert!(1.0 - row[3] < 0.03);
+    }
+}
+
+#[test]
+fn noise_generator_sample_covariance_matches() {
+    let b = graded(4, 0.5);
+    let n = b.n_dofs();
+    let samples = 40_000;
+    for (idx, model) in NoiseModel::ALL.into_iter().enumerate() {
+        let g = NoiseGenerator::new(model, &b).unwrap();
+        assert_eq!(g.model(), model);
+        assert_eq!(
+            g.draws_per_step(),
+            match model {
+                NoiseModel::Consistent => n,
+                NoiseModel::ElementUniform => 4,
+            }
+        );
+        let sigma = g.covariance();
+        let mut rng = trajectory_rng(20_240_601, idx as u64);
+        let mut z = vec![0.0; n];
+        let mut sum = DVector::<f64>::zeros(n);
+        let mut sum2 = DMatrix::<f64>::zeros(n, n);
+        for _ in 0..samples {
+            g.draw(&mut rng, &mut z);
+            let v = DVector::from_column_slice(&z);
+            sum += &v;
+            sum2 += &v * v.transpose();
+        }
+        let m = samples as f64;
+        let mean = sum / m;
+        let cov = sum2 / m;
+        let mut worst: f64 = 0.0;
+        for i in 0..n {
+            let se_mean = (sigma[(i, i)] / m).sqrt();
+            worst = worst.max((mean[i] / se_mean).abs());
+            for j in 0..n {
+                // var of x_i x_j for Gaussians: Σ_ii Σ_jj + Σ_ij²
+                let se = ((sigma[(i, i)] * sigma[(j, j)] + sigma[(i, j)].powi(2)) / m).sqrt();
+                worst = worst.max(((cov[(i, j)] - sigma[(i, j)]) / se).abs());
+            }
+        }
+        println!("{model}: worst |z-score| over means and covariances = {worst:.2}");
+        assert!(worst < 5.0, "{model}: {worst}");
+        // determinism
+        let mut r1 = trajectory_rng(1, 2);
+        let mut r2 = trajectory_rng(1, 2);
+        let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
+        g.draw(&mut r1, &mut a1);
+        g.draw(&mut r2, &mut a2);
+        assert_eq!(a1, a2);
+    }
+}
+
+#[test]
+fn invalid_inputs_are_errors() {
+    let mut p = params();
+    p.drag = -1.0;
+    assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
+    let p = params();
+    assert!(BeamModel::new(p, Mesh::uniform(2.5, 4).unwrap()).is_err());
+    let mut p = params();
+    p.kt = f64::NAN;
+    assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
+}

@@ -1,0 +1,386 @@
+//! Integration tests of the report layer: atomic writers, CSV/JSON output, SVG figures and
+//! the HTML index.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use langevin_fem::Error;
+use langevin_fem::report::{
+    Figure, Series, render_index, write_atomic, write_csv, write_index, write_json,
+};
+use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
+
+/// A fresh directory under the system temp directory, unique per test, process and time.
+fn temp_dir(test: &str) -> PathBuf {
+    let nanos = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .expect("clock after 1970")
+        .as_nanos();
+    let dir = std::env::temp_dir().join(format!(
+        "langevin_fem_report_{test}_{}_{nanos}",
+        std::process::id()
+    ));
+    fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+fn file_names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .expect("read dir")
+        .map(|e| {
+            e.expect("dir entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// The contents of all SVG `<text>` elements, trimmed and with entities decoded.
+fn svg_texts(svg: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = svg;
+    while let Some(start) = rest.find("<text") {
+        rest = &rest[start..];
+        let open_end = rest.find('>').expect("text tag closed");
+        let close = rest.find("</text>").expect("text element closed");
+        out.push(
+            rest[open_end + 1..close]
+                .trim()
+                .replace("&lt;", "<")
+                .replace("&gt;", ">")
+                .replace("&quot;", "\"")
+                .replace("&apos;", "'")
+                .replace("&amp;", "&"),
+        );
+        rest = &rest[close..];
+    }
+    out
+}
+
+// write_atomic creates missing parent directories, replaces existing content and leaves no
+// temporary file behind; a failed write names the destination path.
+#[test]
+fn write_atomic_replaces_content_and_leaves_no_temp_files() {
+    let dir = temp_dir("atomic");
+    let path = dir.join("nested").join("deeper").join("out.txt");
+    write_atomic(&path, b"first version, longer than the second").expect("first write");
+    assert_eq!(
+        fs::read(&path).unwrap(),
+        b"first version, longer than the second"
+    );
+    write_atomic(&path, b"second").expect("second write");
+    assert_eq!(fs::read(&path).unwrap(), b"second");
+    assert_eq!(file_names(path.parent().unwrap()), vec!["out.txt"]);
+
+    // A regular file where a directory is needed: the error names the path.
+    let blocked = dir
+        .join("nested")
+        .join("deeper")
+        .join("out.txt")
+        .join("x.txt");
+    let err = write_atomic(&blocked, b"x").expect_err("parent is a file");
+    assert!(matches!(err, Error::Io { .. }), "{err:?}");
+    assert!(err.to_string().contains("out.txt"), "{err}");
+    assert_eq!(file_names(path.parent().unwrap()), vec!["out.txt"]);
+
+    fs::remove_dir_all(&dir).ok();
+}
+
+// write_csv refuses a row whose length differs from the header (and writes nothing).
+#[test]
+fn write_csv_rejects_ragged_rows() {
+    let dir = temp_dir("csv_ragged");
+    let path = dir.join("ragged.csv");
+    let err = write_csv(&path, &["n", "variance"], &[vec![1.0, 0.5], vec![2.0]])
+        .expect_err("ragged rows");
+    assert!(matches!(err, Error::InvalidParameter { .. }), "{err:?}");
+    let msg = err.to_string();
+    assert!(msg.contains("row 1") && msg.contains("ragged.csv"), "{msg}");
+    assert!(!path.exists());
+    assert!(file_names(&dir).is_empty());
+    fs::remove_dir_all(&dir).ok();
+}
+
+// write_csv prints numbers with round-trip precision: every value, including extreme
+// magnitudes, subnormals, signed zero and non-finite values, parses back bit-identically.
+#[test]
+fn write_csv_round_trips_numbers() {
+    let dir = temp_dir("csv_roundtrip");
+    let path = dir.join("t.csv");
+    let values = [
+        0.1,
+        1.0 / 3.0,
+        std::f64::consts::PI,
+        -2.5e17,
+        6.022_140_76e23,
+        1e-5,
+        1.234_567_890_123_456_7e-4,
+        123_456.789,
+        f64::MIN_POSITIVE,
+        5e-324,
+        f64::MAX,
+        -0.0,
+        0.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+    ];
+    let rows: Vec<Vec<f64>> = values.chunks(4).map(<[f64]>::to_vec).collect();
+    write_csv(&path, &["a", "b, with comma", "c", "d"], &rows).expect("write csv");
+
+    let text = fs::read_to_string(&path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("a,\"b, with comma\",c,d"));
+    let parsed: Vec<f64> = lines
+        .flat_map(|line| line.split(','))
+        .map(|field| field.parse::<f64>().expect("number parses"))
+        .collect();
+    assert_eq!(parsed.len(), values.len());
+    for (got, want) in parsed.iter().zip(values) {
+        if want.is_nan() {
+            assert!(got.is_nan());
+        } else {
+            assert_eq!(got.to_bits(), want.to_bits(), "{got} vs {want}");
+        }
+    }
+    assert!(text.contains(",nan\n"), "{text}");
+    assert!(text.ends_with('\n'));
+    fs::remove_dir_all(&dir).ok();
+}
+
+// write_json writes exactly serde_json's pretty form plus a trailing newline, which
+// deserializes to the same structure. (Floats are compared only through the text: without
+// serde_json's `float_roundtrip` feature its parser may be off by one ulp.)
+#[test]
+fn write_json_is_pretty_and_round_trips() {
+    let dir = temp_dir("json");
+    let path = dir.join("summary.json");
+    let summary = sample_summary();
+    write_json(&path, &summary).expect("write json");
+    let text = fs::read_to_string(&path).unwrap();
+    assert!(text.ends_with("}\n"));
+    assert!(text.contains("\n  \"budget\": \"quick\""), "{text}");
+    assert_eq!(text, serde_json::to_string_pretty(&summary).unwrap() + "\n");
+    let back: Summary = serde_json::from_str(&text).expect("parse back");
+    assert_eq!(back.scenes.len(), summary.scenes.len());
+    assert_eq!(
+        back.scenes[1].checks[0].name,
+        summary.scenes[1].checks[0].name
+    );
+    fs::remove_dir_all(&dir).ok();
+}
+
+// A figure with two series, error bars, a reference line and log axes renders an SVG whose
+// <text> elements contain the title, both axis labels and every legend label, and a
+// second render is byte-identical.
+#[test]
+fn figure_with_errors_and_log_axes_renders_labels_deterministically() {
+    let n: Vec<f64> = (1..=12).map(f64::from).collect();
+    let estimate: Vec<(f64, f64)> = n.iter().map(|&k| (k, 2.0 / (k * k * k * k))).collect();
+    let errors: Vec<f64> = estimate.iter().map(|&(_, v)| 0.1 * v).collect();
+    let exact: Vec<(f64, f64)> = n.iter().map(|&k| (k, 2.0 / (k * k * k * k))).collect();
+    let fig = Figure::new(
+        "Mode variances <a_n²> vs mode number",
+        "mode number n",
+        "variance ⟨a_n²⟩ (µm²)",
+    )
+    .log_x()
+    .log_y()
+    .series(Series::markers("simulation ± 1 s.e.", estimate).with_errors(errors))
+    .series(Series::line("exact (discrete)", exact).dashed())
+    .hline(1e-3, "resolution limit");
+
+    let svg = fig.render_svg().expect("render");
+    assert!(svg.starts_with("<svg"), "{}", &svg[..80.min(svg.len())]);
+    assert!(svg.trim_end().ends_with("</svg>"));
+    let texts = svg_texts(&svg);
+    for want in [
+        "Mode variances <a_n²> vs mode number",
+        "mode number n",
+        "variance ⟨a_n²⟩ (µm²)",
+        "simulation ± 1 s.e.",
+        "exact (discrete)",
+        "resolution limit",
+    ] {
+        assert!(
+            texts.iter().any(|t| t == want),
+            "missing text {want:?} in {texts:?}"
+        );
+    }
+    // The markup itself is escaped.
+    assert!(svg.contains("&lt;a_n²&gt;"));
+    // Decade tick labels on the log axes.
+    assert!(texts.iter().any(|t| t == "10⁰"), "{texts:?}");
+    // Two series colours and error bars (vertical polylines in the first colour).
+    assert!(svg.contains("#1F77B4") && svg.contains("#FF7F0E"));
+
+    let again = fig.render_svg().expect("second render");
+    assert_eq!(svg, again, "rendering is not deterministic");
+}
+
+// Non-finite points, non-positive values on a log axis, mismatched data and a figure without
+// any drawable point: rendering does not fail (except for the mismatched error bars), and
+// the figure says what it left out.
+#[test]
+fn figure_with_nan_and_nonpositive_on_log_axis_does_not_fail() {
+    let dir = temp_dir("figure_robust");
+    let fig = Figure::new("robustness", "t", "C(t)")
+        .log_y()
+        .series(
+            Series::line(
+                "autocorrelation",
+                vec![
+                    (0.0, 1.0),
+                    (1.0, 0.5),
+                    (2.0, f64::NAN),
+                    (3.0, 0.1),
+                    (4.0, 0.0),
+                    (5.0, -0.02),
+                    (f64::INFINITY, 0.3),
+                    (6.0, 0.01),
+                ],
+            )
+            .with_errors(vec![0.1, 0.6, 0.1, 0.2, 0.1, 0.1, 0.1, f64::NAN]),
+        )
+        .hline(-1.0, "not drawable on a log axis");
+    let path = dir.join("figs").join("robust.svg");
+    fig.write_svg(&path).expect("renders despite bad points");
+    let svg = fs::read_to_string(&path).unwrap();
+    let texts = svg_texts(&svg);
+    assert!(
+        texts.iter().any(|t| t == "4 points and 1 reference line not shown (non-finite, or not positive on a log axis)"),
+        "{texts:?}"
+    );
+
+    let empty = Figure::new("nothing yet", "x", "y")
+        .log_x()
+        .series(Series::markers(
+            "all NaN",
+            vec![(f64::NAN, 1.0), (-1.0, 2.0)],
+        ));
+    let svg = empty.render_svg().expect("empty figure renders");
+    assert!(
+        svg_texts(&svg)
+            .iter()
+            .any(|t| t == "no finite data to plot")
+    );
+    let svg = Figure::new("no series", "x", "y")
+        .render_svg()
+        .expect("figure without series renders");
+    assert!(
+        svg_texts(&svg)
+            .iter()
+            .any(|t| t == "no finite data to plot")
+    );
+
+    let bad = Figure::new("bad", "x", "y")
+        .series(Series::markers("s", vec![(1.0, 1.0), (2.0, 2.0)]).with_errors(vec![0.1]));
+    let err = bad.render_svg().expect_err("error-bar count mismatch");
+    assert!(matches!(err, Error::InvalidParameter { .. }), "{err:?}");
+    fs::remove_dir_all(&dir).ok();
+}
+
+fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
+    CheckResult {
+        name: name.to_string(),
+        kind: "chi2-variance".to_string(),
+        passed,
+        p_value: p,
+        p_adjusted: p.map(|p| (3.0 * p).min(1.0)),
+        estimate: Some(0.123_456_7),
+        reference: Some(0.125),
+        std_error: None,
+        continuum: Some(0.126),
+        reference_kind: "discrete".to_string(),
+        detail: "n = 4000 samples & 3 lags".to_string(),
+    }
+}
+
+fn sample_summary() -> Summary {
+    Summary {
+        budget: "quick".to_string(),
+        alpha: 0.01,
+        passed: false,
+        scenes: vec![
+            SceneSummary {
+                name: "clamped_free".to_string(),
+                passed: true,
+                wall_seconds: 1.25,
+                figures: vec![
+                    "clamped_free/mode_variance.svg".to_string(),
+                    "clamped_free/autocorrelation.svg".to_string(),
+                ],
+                tables: vec!["clamped_free/mode_variance.csv".to_string()],
+                notes: vec!["ratio → 1 as elements increase".to_string()],
+                checks: vec![
+                    check("mode-variance/n=1", true, Some(0.42)),
+                    check("energy/equipartition", true, None),
+                ],
+            },
+            SceneSummary {
+                name: "pinned".to_string(),
+                passed: false,
+                wall_seconds: 12.5,
+                figures: vec!["pinned/msd.svg".to_string()],
+                tables: vec![],
+                notes: vec![],
+                checks: vec![
+                    check("msd/<script>alert(1)</script>", true, Some(0.3)),
+                    check("msd/late-time", false, Some(1.234_567e-9)),
+                ],
+            },
+        ],
+    }
+}
+
+// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
+// check name stays text), marks the failing check, and write_index writes the same page.
+#[test]
+fn index_html_lists_figures_and_checks_and_escapes_text() {
+    let summary = sample_summary();
+    let html = render_index(&summary);
+
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    for scene in &summary.scenes {
+        for fig in &scene.figures {
+            assert!(
+                html.contains(&format!("<img src=\"{fig}\"")),
+                "missing {fig}"
+            );
+        }
+        for table in &scene.tables {
+            assert!(
+                html.contains(&format!("href=\"{table}\"")),
+                "missing {table}"
+            );
+        }
+        for c in &scene.checks {
+            let escaped = c.name.replace('<', "&lt;").replace('>', "&gt;");
+            assert!(html.contains(&escaped), "missing check {}", c.name);
+        }
+    }
+    assert!(!html.contains("<script"), "unescaped script tag");
+    assert!(html.contains("msd/&lt;script&gt;alert(1)&lt;/script&gt;"));
+    assert!(html.contains("n = 4000 samples &amp; 3 lags"));
+    // The failing check's row is marked, and so are its scene and the whole run.
+    assert!(html.contains("<tr class=\"fail\"><td>msd/late-time</td>"));
+    assert!(html.contains("<td class=\"fail\">FAIL</td>"));
+    assert!(html.contains("<tr class=\"pass\"><td>mode-variance/n=1</td>"));
+    assert!(html.contains("Overall result: <span class=\"badge fail\">FAIL</span>"));
+    // Numbers to 4 significant digits, a dash where there is no value, Holm mentioned.
+    assert!(html.contains(">0.1235<") && html.contains(">1.235e-9<"));
+    assert!(html.contains(">—<"));
+    assert!(html.contains("Holm"));
+    // Self-contained: no scripts, no external resources.
+    assert!(!html.contains("http://") && !html.contains("https://"));
+
+    let dir = temp_dir("index");
+    write_index(&dir, &summary).expect("write index");
+    assert_eq!(fs::read_to_string(dir.join("index.html")).unwrap(), html);
+    assert_eq!(file_names(&dir), vec!["index.html"]);
+    fs::remove_dir_all(&dir).ok();
+}
