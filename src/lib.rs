@@ -23,6 +23,7 @@ pub mod report;
 pub mod rng;
 pub mod spectral;
 pub mod stats;
+pub mod theory;
 pub mod verify;
 
 pub use error::{Error, Result};

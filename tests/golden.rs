@@ -2,8 +2,10 @@
 //!
 //! What: for every scene in `verification/` and every run in it, the exact references
 //! (per-mode discrete variance, one-step multiplier and rate, profile and two-time
-//! references) and a short fixed-seed trace from rest (modal amplitudes and deflections
-//! every 25 steps for 200 steps), printed to 10 significant digits.
+//! references; for compression scenes the exact ⟨F⟩/F_c0 at every strain) and a short
+//! fixed-seed trace from rest (modal amplitudes and deflections every 25 steps for 200
+//! steps; for compression scenes F/F_c0 after burn-in at the first and last strain),
+//! printed to 10 significant digits.
 //! Why: any change of the numerics — element matrices, noise draws, integrator algebra,
 //! reference formulas, random streams — shows up as a diff in `golden/`. Review with
 //! `git diff golden/` after `make golden`; CI (`CI=true`) fails on any mismatch.
@@ -12,6 +14,7 @@
 
 use langevin_fem::rng::{derive_seed, trajectory_rng};
 use langevin_fem::verify::Scene;
+use langevin_fem::verify::compression::{CompressionRun, CompressionTheoryTable};
 use langevin_fem::verify::linear::LinearRun;
 use std::fmt::Write;
 use std::path::Path;
@@ -24,6 +27,51 @@ fn g(v: f64) -> String {
     format!("{v:.9e}")
 }
 
+/// Compression scenes: the exact theory at every strain, and per run a short trace of
+/// F/F_c0 (burn-in, then 10 samples) at the first and last strain.
+fn compression_snapshot(scene: &Scene, s: &mut String) {
+    let comp = scene.compression.as_ref().expect("compression table");
+    let theory = CompressionTheoryTable::new(scene, comp).expect("theory");
+    writeln!(s, "strain_ratio  theory_discrete  theory_continuum").unwrap();
+    for i in 0..theory.strain_ratios.len() {
+        writeln!(
+            s,
+            "{}  {}  {}",
+            g(theory.strain_ratios[i]),
+            g(theory.discrete[i]),
+            g(theory.continuum[i])
+        )
+        .unwrap();
+    }
+    for spec in &scene.runs {
+        let run = CompressionRun::prepare(scene, comp, spec).expect("run prepares");
+        writeln!(
+            s,
+            "\nrun {}: integrator {}, dt {}",
+            spec.name,
+            spec.integrator,
+            g(run.dt)
+        )
+        .unwrap();
+        for point in [0, run.points() - 1] {
+            let mut rng = trajectory_rng(derive_seed(GOLDEN_SEED, &spec.name), point as u64);
+            let rec = run
+                .simulate(point, &mut rng, 10 * run.sample_every)
+                .expect("trajectory runs");
+            let vals: Vec<String> = rec.force_ratio.iter().map(|v| g(*v)).collect();
+            writeln!(
+                s,
+                "strain {}: accepted {}/{}: {}",
+                g(theory.strain_ratios[point]),
+                rec.accepted,
+                rec.proposed,
+                vals.join(" ")
+            )
+            .unwrap();
+        }
+    }
+}
+
 fn snapshot_of(scene: &Scene) -> String {
     let mut s = String::new();
     writeln!(
@@ -32,6 +80,10 @@ fn snapshot_of(scene: &Scene) -> String {
         scene.name, scene.model, scene.dims
     )
     .unwrap();
+    if scene.compression.is_some() {
+        compression_snapshot(scene, &mut s);
+        return s;
+    }
     for spec in &scene.runs {
         let run = LinearRun::prepare(scene, spec).expect("scene prepares");
         let r = &run.reference;
@@ -45,6 +97,10 @@ fn snapshot_of(scene: &Scene) -> String {
             g(r.max_rate)
         )
         .unwrap();
+        if scene.compression.is_some() {
+            compression_snapshot(scene, &mut s);
+            return s;
+        }
         writeln!(
             s,
             "mode  variance_discrete  variance_continuum  multiplier  rate_discrete"

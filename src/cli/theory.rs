@@ -4,6 +4,9 @@ use clap::{Args, Subcommand};
 use langevin_fem::FilamentParams;
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
 use langevin_fem::spectral::HingedBeam;
+use langevin_fem::theory::{
+    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS, StoredLengthLaw,
+};
 use serde_json::json;
 
 /// Physical parameters shared by the theory subcommands (consistent units; times in the
@@ -11,16 +14,16 @@ use serde_json::json;
 #[derive(Debug, Clone, Args)]
 pub struct PhysicalArgs {
     /// Filament length L.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     length: f64,
     /// Bending rigidity EI.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     bending_rigidity: f64,
     /// Transverse drag per unit length ξ.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     drag: f64,
     /// Thermal energy k_B T.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     kt: f64,
 }
 
@@ -74,7 +77,7 @@ enum Query {
         #[arg(long, allow_negative_numbers = true)]
         eta: f64,
         /// Relative tolerance for the truncation bound of the mode sum.
-        #[arg(long, default_value_t = 1e-12)]
+        #[arg(long, default_value_t = 1e-12, allow_negative_numbers = true)]
         tolerance: f64,
         #[command(flatten)]
         phys: PhysicalArgs,
@@ -87,6 +90,96 @@ enum Query {
         #[command(flatten)]
         phys: PhysicalArgs,
     },
+    /// Exact equilibrium mean compressive force ⟨F⟩/F_c0 of a hinged filament at imposed
+    /// strains ε/ε_c0 (the paper's Fig. 2; no mean-field approximation). Units
+    /// L = kT = ξ = 1, so EI = P and EA = S.
+    Compression {
+        /// Spatial dimension: 2 (planar) or 3.
+        #[arg(long, allow_negative_numbers = true)]
+        dims: i64,
+        /// Comma-separated strain ratios ε/ε_c0, each finite and >= 0.
+        #[arg(long, allow_hyphen_values = true)]
+        strain_ratio: String,
+        /// Number of Hermite-cubic elements (the discretized filament), in [1, 2000];
+        /// without it, the continuum.
+        #[arg(long, allow_negative_numbers = true)]
+        elements: Option<i64>,
+        /// Persistence ratio P = EI/(kT·L), > 0.
+        #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
+        persistence_ratio: f64,
+        /// Stretch ratio S = EA·L/kT, > 0.
+        #[arg(long, default_value_t = 1.0e6, allow_negative_numbers = true)]
+        stretch_ratio: f64,
+    },
+}
+
+/// Parses `--strain-ratio`: a non-empty comma-separated list of finite numbers >= 0.
+fn parse_strain_ratios(list: &str) -> Result<Vec<f64>> {
+    const ALLOWED: &str = "a non-empty comma-separated list of finite numbers >= 0";
+    let items: Vec<&str> = list.split(',').map(str::trim).collect();
+    if items.iter().all(|s| s.is_empty()) {
+        return Err(Error::invalid(
+            "--strain-ratio",
+            format!("{list:?}"),
+            ALLOWED,
+        ));
+    }
+    items
+        .iter()
+        .map(|item| match item.parse::<f64>() {
+            Ok(r) if r.is_finite() && r >= 0.0 => Ok(r),
+            _ => Err(Error::invalid(
+                "--strain-ratio",
+                format!("{item:?}"),
+                ALLOWED,
+            )),
+        })
+        .collect()
+}
+
+/// The compression query: validates the flags and evaluates the exact theory.
+fn compression(
+    dims: i64,
+    strain_ratio: &str,
+    elements: Option<i64>,
+    persistence_ratio: f64,
+    stretch_ratio: f64,
+) -> Result<serde_json::Value> {
+    let dims = match dims {
+        2 | 3 => Dims::from_u32(dims as u32)?,
+        _ => return Err(Error::invalid("--dims", dims, "2 or 3")),
+    };
+    require_positive("--persistence-ratio", persistence_ratio)?;
+    require_positive("--stretch-ratio", stretch_ratio)?;
+    let elements = match elements {
+        None => None,
+        Some(n) if n >= 1 && n <= MAX_DISCRETE_ELEMENTS as i64 => Some(n as usize),
+        Some(n) => {
+            return Err(Error::invalid(
+                "--elements",
+                n,
+                format!("an integer in [1, {MAX_DISCRETE_ELEMENTS}]"),
+            ));
+        }
+    };
+    let ratios = parse_strain_ratios(strain_ratio)?;
+    let params = FilamentParams {
+        length: 1.0,
+        bending_rigidity: persistence_ratio,
+        stretch_rigidity: stretch_ratio,
+        drag: 1.0,
+        kt: 1.0,
+    };
+    let law = match elements {
+        Some(n) => StoredLengthLaw::discrete(&params, dims, n)?,
+        None => StoredLengthLaw::continuum(&params, dims, DEFAULT_CONTINUUM_MODES)?,
+    };
+    let theory = CompressionTheory::new(&params, law)?;
+    let points = ratios
+        .iter()
+        .map(|&r| Ok(json!({ "strain_ratio": r, "force_ratio": theory.force_ratio(r)? })))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(json!({ "dims": dims.as_u32(), "points": points }))
 }
 
 /// Runs a theory query and prints one JSON object.
@@ -131,7 +224,43 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             let n = n as usize;
             json!({ "n": n, "rate": beam.mode_rate(n), "variance": beam.mode_variance(n) })
         }
+        Query::Compression {
+            dims,
+            strain_ratio,
+            elements,
+            persistence_ratio,
+            stretch_ratio,
+        } => compression(
+            dims,
+            &strain_ratio,
+            elements,
+            persistence_ratio,
+            stretch_ratio,
+        )?,
     };
+    if let Some(bad) = non_finite_number(&value) {
+        return Err(Error::invalid(
+            bad,
+            "a non-finite result",
+            "parameters whose result is representable in f64 (rescale the units)",
+        ));
+    }
     println!("{value}");
     Ok(0)
+}
+
+/// The key of the first number in `value` that is not finite (serde_json prints those as
+/// `null`), so that an overflow is an error and not a silent `null`.
+fn non_finite_number(value: &serde_json::Value) -> Option<String> {
+    match value {
+        serde_json::Value::Object(map) => map.iter().find_map(|(k, v)| match v {
+            serde_json::Value::Null => Some(k.clone()),
+            serde_json::Value::Number(n) if n.as_f64().is_some_and(|f| !f.is_finite()) => {
+                Some(k.clone())
+            }
+            other => non_finite_number(other),
+        }),
+        serde_json::Value::Array(items) => items.iter().find_map(non_finite_number),
+        _ => None,
+    }
 }

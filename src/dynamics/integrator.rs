@@ -138,6 +138,14 @@ pub fn build_integrator(
     if !(dt.is_finite() && dt > 0.0) {
         return Err(Error::invalid("dt", dt, "finite and > 0"));
     }
+    if kind == IntegratorKind::MetropolisCrankNicolson {
+        return Err(Error::invalid(
+            "integrator",
+            kind,
+            "euler-maruyama, backward-euler, crank-nicolson or exact-modal for the linear filament \
+             (metropolis-crank-nicolson is for the nonlinear one; on the linear problem it equals crank-nicolson)",
+        ));
+    }
     if let Some(limit) = kind.stability_limit(max_rate)
         && dt >= limit
     {

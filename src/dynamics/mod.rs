@@ -30,6 +30,7 @@
 //! transforms (O(n²)) but is exact in distribution for the linear problem at any Δt.
 
 mod integrator;
+pub mod nonlinear;
 
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
 
@@ -47,6 +48,10 @@ pub enum IntegratorKind {
     CrankNicolson,
     /// Exact Ornstein–Uhlenbeck transition of every generalized mode.
     ExactModal,
+    /// Crank–Nicolson proposal with a Metropolis–Hastings accept/reject step on the exact
+    /// Boltzmann weight: the integrator of the nonlinear (finite-deflection) filament whose
+    /// stationary law is exact at any Δt ([`nonlinear`]).
+    MetropolisCrankNicolson,
 }
 
 impl IntegratorKind {
@@ -65,16 +70,18 @@ impl IntegratorKind {
             IntegratorKind::BackwardEuler => "backward-euler",
             IntegratorKind::CrankNicolson => "crank-nicolson",
             IntegratorKind::ExactModal => "exact-modal",
+            IntegratorKind::MetropolisCrankNicolson => "metropolis-crank-nicolson",
         }
     }
 
-    /// The implicitness θ of the θ-scheme, or `None` for `exact-modal`.
+    /// The implicitness θ of the θ-scheme, or `None` for `exact-modal` and the Metropolis
+    /// scheme.
     pub fn theta(self) -> Option<f64> {
         match self {
             IntegratorKind::EulerMaruyama => Some(0.0),
             IntegratorKind::BackwardEuler => Some(1.0),
             IntegratorKind::CrankNicolson => Some(0.5),
-            IntegratorKind::ExactModal => None,
+            IntegratorKind::ExactModal | IntegratorKind::MetropolisCrankNicolson => None,
         }
     }
 
@@ -93,6 +100,10 @@ impl IntegratorKind {
                     (1.0 - (1.0 - theta) * a) / den,
                     (2.0 * kt * dt).sqrt() / den,
                 )
+            }
+            None if self == IntegratorKind::MetropolisCrankNicolson => {
+                // On the linear problem every Crank–Nicolson proposal is accepted.
+                IntegratorKind::CrankNicolson.modal_form(rate, dt, kt)
             }
             None => {
                 let m = (-a).exp();

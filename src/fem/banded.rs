@@ -191,7 +191,13 @@ impl SymBanded {
                 l[i * w + (i - j)] = s / ljj;
             }
         }
-        Ok(BandedCholesky { n, bw, data: l })
+        let inv_diag = (0..n).map(|j| 1.0 / l[j * w]).collect();
+        Ok(BandedCholesky {
+            n,
+            bw,
+            data: l,
+            inv_diag,
+        })
     }
 
     /// Number of negative eigenvalues of `A`, by Sylvester's law of inertia: the number of
@@ -244,6 +250,8 @@ pub struct BandedCholesky {
     n: usize,
     bw: usize,
     data: Vec<f64>,
+    /// 1/L_jj: multiplications instead of divisions on the serial chain of the solves.
+    inv_diag: Vec<f64>,
 }
 
 impl BandedCholesky {
@@ -277,19 +285,23 @@ impl BandedCholesky {
     pub fn solve_in_place(&self, b: &mut [f64]) {
         assert_eq!(b.len(), self.n, "solve_in_place: wrong length");
         let w = self.bw + 1;
-        for i in 0..self.n {
+        let n = self.n;
+        for i in 0..n {
+            let row = &self.data[i * w..i * w + w];
+            let lo = i.saturating_sub(self.bw);
             let mut s = b[i];
-            for k in i.saturating_sub(self.bw)..i {
-                s -= self.data[i * w + (i - k)] * b[k];
+            for (k, bk) in b[lo..i].iter().enumerate() {
+                s -= row[i - lo - k] * bk;
             }
-            b[i] = s / self.data[i * w];
+            b[i] = s * self.inv_diag[i];
         }
-        for i in (0..self.n).rev() {
+        for i in (0..n).rev() {
+            let hi = (i + w).min(n);
             let mut s = b[i];
-            for k in i + 1..(i + w).min(self.n) {
+            for k in i + 1..hi {
                 s -= self.data[k * w + (k - i)] * b[k];
             }
-            b[i] = s / self.data[i * w];
+            b[i] = s * self.inv_diag[i];
         }
     }
 

@@ -67,7 +67,6 @@ pub struct NoiseGenerator {
     model: NoiseModel,
     n: usize,
     source: Source,
-    covariance: DMatrix<f64>,
 }
 
 impl NoiseGenerator {
@@ -78,11 +77,8 @@ impl NoiseGenerator {
     /// [`crate::Error::Numerical`] if `C` is not positive definite.
     pub fn new(model: NoiseModel, beam: &BeamModel) -> Result<Self> {
         let n = beam.n_dofs();
-        let (source, covariance) = match model {
-            NoiseModel::Consistent => (
-                Source::Consistent(beam.damping().cholesky()?),
-                beam.damping().to_dense(),
-            ),
+        let source = match model {
+            NoiseModel::Consistent => Source::Consistent(beam.damping().cholesky()?),
             NoiseModel::ElementUniform => {
                 let xi = beam.params().drag;
                 let mesh = beam.mesh();
@@ -90,25 +86,10 @@ impl NoiseGenerator {
                     .map(|e| (xi / mesh.element_length(e)).sqrt())
                     .collect();
                 let loads = beam.load_vectors().to_vec();
-                let mut cov = DMatrix::zeros(n, n);
-                for (a, (b, dofs)) in amplitude.iter().zip(&loads) {
-                    for p in 0..4 {
-                        for q in 0..4 {
-                            if let (Some(i), Some(j)) = (dofs[p], dofs[q]) {
-                                cov[(i, j)] += a * a * b[p] * b[q];
-                            }
-                        }
-                    }
-                }
-                (Source::ElementUniform { amplitude, loads }, cov)
+                Source::ElementUniform { amplitude, loads }
             }
         };
-        Ok(NoiseGenerator {
-            model,
-            n,
-            source,
-            covariance,
-        })
+        Ok(NoiseGenerator { model, n, source })
     }
 
     /// The noise model.
@@ -161,10 +142,29 @@ impl NoiseGenerator {
         }
     }
 
-    /// Dense `Σ_ζ` over the free DOFs: `C` (consistent) or `Σ_e (ξ/h_e) b_e b_eᵀ`
-    /// (element-uniform).
+    /// Dense `Σ_ζ` over the free DOFs: `C = L Lᵀ` (consistent) or
+    /// `Σ_e (ξ/h_e) b_e b_eᵀ` (element-uniform). Built on demand (O(n²) memory), so that
+    /// integrators, which only draw, stay O(n).
     pub fn covariance(&self) -> DMatrix<f64> {
-        self.covariance.clone()
+        match &self.source {
+            Source::Consistent(l) => {
+                let l = l.to_dense_lower();
+                &l * l.transpose()
+            }
+            Source::ElementUniform { amplitude, loads } => {
+                let mut cov = DMatrix::zeros(self.n, self.n);
+                for (a, (b, dofs)) in amplitude.iter().zip(loads) {
+                    for p in 0..4 {
+                        for q in 0..4 {
+                            if let (Some(i), Some(j)) = (dofs[p], dofs[q]) {
+                                cov[(i, j)] += a * a * b[p] * b[q];
+                            }
+                        }
+                    }
+                }
+                cov
+            }
+        }
     }
 }
 

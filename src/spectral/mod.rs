@@ -176,7 +176,8 @@ impl HingedBeam {
         let p = &self.params;
         let l = p.length;
         let s = x * (l - x);
-        p.kt * s * s / (3.0 * p.bending_rigidity * l)
+        // s·(s/L) rather than s²/L: no overflow of s² for very long filaments.
+        p.kt * s * (s / l) / (3.0 * p.bending_rigidity)
     }
 
     /// Equilibrium covariance ⟨w(x) w(y)⟩ = kT·G(x,y) in closed form (NaN if x or y is

@@ -247,6 +247,13 @@ impl LinearRun {
         let steps = |t: f64| (t / dt).round() as u64;
 
         let (model, modes, profile_discrete, two_time, max_rate) = match scene.model {
+            ModelKind::Compression => {
+                return Err(Error::invalid(
+                    "model",
+                    "compression",
+                    "fem or spectral for a linear run",
+                ));
+            }
             ModelKind::Spectral => {
                 let n_modes = scene.mesh.elements;
                 let mut refs = Vec::new();

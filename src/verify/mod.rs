@@ -8,6 +8,7 @@
 //! Holm correction over all checks of the scene at the family-wise level α.
 
 pub mod checks;
+pub mod compression;
 pub mod linear;
 pub mod runner;
 pub mod scene;

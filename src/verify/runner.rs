@@ -10,8 +10,11 @@ use crate::report::{Figure, Series, SeriesStyle, write_csv, write_index, write_j
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
+use crate::verify::compression::{
+    CompressionRun, CompressionTheoryTable, compression_checks, force_estimates, halving_check,
+};
 use crate::verify::linear::LinearRun;
-use crate::verify::scene::{Budget, ModelKind, Scene};
+use crate::verify::scene::{Budget, CheckKind, ModelKind, Scene};
 use crate::verify::summary::{SceneSummary, Summary};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -50,19 +53,49 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
     // Prepare every run first so that bad input is reported before any long work.
     let mut prepared = Vec::new();
     for scene in &scenes {
-        let runs: Vec<LinearRun> = scene
-            .runs
-            .iter()
-            .map(|spec| LinearRun::prepare(scene, spec))
-            .collect::<Result<_>>()?;
-        prepared.push(runs);
+        prepared.push(match &scene.compression {
+            Some(comp) => {
+                let runs = scene
+                    .runs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, spec)| {
+                        CompressionRun::prepare(scene, comp, spec)
+                            .map_err(|e| scene.run_error(i, "integrator", e))
+                    })
+                    .collect::<Result<_>>()?;
+                let theory = CompressionTheoryTable::new(scene, comp)
+                    .map_err(|e| scene.run_error(0, "integrator", e))?;
+                Prepared::Compression(theory, runs)
+            }
+            None => Prepared::Linear(
+                scene
+                    .runs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, spec)| {
+                        LinearRun::prepare(scene, spec)
+                            .map_err(|e| scene.run_error(i, "integrator", e))
+                    })
+                    .collect::<Result<_>>()?,
+            ),
+        });
     }
     let total: u64 = scenes
         .iter()
-        .flat_map(|s| s.runs.iter())
-        .map(|r| {
-            let e = r.ensemble(opts.budget);
-            (e.trajectories + e.two_time_trajectories) as u64
+        .map(|s| {
+            let points = s.compression.as_ref().map_or(1, |c| c.strain_ratios.len());
+            s.runs
+                .iter()
+                .map(|r| {
+                    let e = r.ensemble(opts.budget);
+                    if s.compression.is_some() {
+                        (e.trajectories * points) as u64
+                    } else {
+                        (e.trajectories + e.two_time_trajectories) as u64
+                    }
+                })
+                .sum::<u64>()
         })
         .sum();
     let bar = if opts.progress {
@@ -76,9 +109,15 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
         bar.set_style(style);
     }
     let mut summaries = Vec::new();
-    for (scene, runs) in scenes.iter().zip(&prepared) {
+    let mut curves = Vec::new();
+    for (scene, work) in scenes.iter().zip(&prepared) {
         bar.set_message(scene.name.clone());
-        summaries.push(run_scene(scene, runs, opts, &bar)?);
+        summaries.push(match work {
+            Prepared::Linear(runs) => run_scene(scene, runs, opts, &bar)?,
+            Prepared::Compression(theory, runs) => {
+                run_compression_scene(scene, theory, runs, opts, &bar, &mut curves)?
+            }
+        });
     }
     bar.finish_and_clear();
     let summary = Summary {
@@ -90,6 +129,231 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
     write_json(&opts.out.join("summary.json"), &summary)?;
     write_index(&opts.out, &summary)?;
     Ok(summary)
+}
+
+/// The prepared work of one scene.
+enum Prepared {
+    Linear(Vec<LinearRun>),
+    Compression(CompressionTheoryTable, Vec<CompressionRun>),
+}
+
+/// One dimension's simulated and theoretical force–strain curve, for the Fig. 2 figure.
+struct Curve {
+    dims: usize,
+    theory: Vec<(f64, f64, f64)>,
+    simulated: Vec<(f64, f64, f64)>,
+}
+
+fn run_compression_scene(
+    scene: &Scene,
+    theory: &CompressionTheoryTable,
+    runs: &[CompressionRun],
+    opts: &VerifyOptions,
+    bar: &ProgressBar,
+    curves: &mut Vec<Curve>,
+) -> Result<SceneSummary> {
+    let start = Instant::now();
+    let dir = opts.out.join(&scene.name);
+    let mut checks = Vec::new();
+    let mut figures = Vec::new();
+    let mut tables = Vec::new();
+    let mut notes = vec![scene.description.clone()];
+    let mut estimates = Vec::new();
+    let points = theory.strain_ratios.len();
+    let tau1 = scene.filament.tau1();
+    let header = [
+        "strain_ratio",
+        "force_ratio",
+        "std_error",
+        "theory_discrete",
+        "theory_continuum",
+    ];
+    let mut fig = Figure::new(
+        format!(
+            "{}: <F>/F_c0 against imposed strain (exact theory: lines)",
+            scene.name
+        ),
+        "strain / Euler strain",
+        "<F> / Euler load",
+    )
+    .series(Series::line(
+        "exact, discretized filament",
+        theory
+            .strain_ratios
+            .iter()
+            .copied()
+            .zip(theory.discrete.iter().copied())
+            .collect(),
+    ))
+    .series(
+        Series::line(
+            "exact, continuum",
+            theory
+                .strain_ratios
+                .iter()
+                .copied()
+                .zip(theory.continuum.iter().copied())
+                .collect(),
+        )
+        .dashed(),
+    )
+    .hline(1.0, "Euler load");
+    for (k, run) in runs.iter().enumerate() {
+        let e = run.spec.ensemble(opts.budget);
+        let steps = run.sampled_steps(e.duration_tau1 * tau1);
+        let nt = e.trajectories;
+        let flat = (0..points * nt)
+            .into_par_iter()
+            .map(|t| {
+                let (i, j) = (t / nt, t % nt);
+                let seed = derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
+                let rec = run.simulate(i, &mut trajectory_rng(seed, j as u64), steps);
+                bar.inc(1);
+                rec
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let records: Vec<Vec<_>> = flat.chunks(nt).map(<[_]>::to_vec).collect();
+        let budget_key = format!("{}.duration_tau1", opts.budget.name());
+        let est = force_estimates(&records).map_err(|e| scene.run_error(k, &budget_key, e))?;
+        checks.extend(
+            compression_checks(run, run.spec.checks(scene), theory, &records, &est)
+                .map_err(|e| scene.run_error(k, &budget_key, e))?,
+        );
+        notes.push(format!(
+            "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples",
+            run.spec.name,
+            run.spec.integrator,
+            run.spec.noise.name(),
+            run.spec.dt_tau1,
+            nt,
+            e.duration_tau1,
+            scene.compression.as_ref().map_or(0.0, |c| c.burn_in_tau1),
+            est.acceptance,
+            est.max_tau_int
+        ));
+        let rows: Vec<Vec<f64>> = (0..points)
+            .map(|i| {
+                vec![
+                    theory.strain_ratios[i],
+                    est.force[i].0,
+                    est.force[i].1,
+                    theory.discrete[i],
+                    theory.continuum[i],
+                ]
+            })
+            .collect();
+        let path = if k == 0 {
+            dir.join("force-strain.csv")
+        } else {
+            dir.join(format!("{}-force-strain.csv", run.spec.name))
+        };
+        write_csv(&path, &header, &rows)?;
+        tables.push(path);
+        fig = fig.series(
+            Series::markers(
+                format!("simulated: {} (±1 s.e.)", run.spec.name),
+                rows.iter().map(|r| (r[0], r[1])).collect(),
+            )
+            .with_errors(rows.iter().map(|r| r[2]).collect()),
+        );
+        if k == 0 {
+            curves.retain(|c| c.dims != scene.dims);
+            curves.push(Curve {
+                dims: scene.dims,
+                theory: rows.iter().map(|r| (r[0], r[3], r[4])).collect(),
+                simulated: rows.iter().map(|r| (r[0], r[1], r[2])).collect(),
+            });
+        }
+        estimates.push(est);
+    }
+    if let Some(comp) = &scene.compression
+        && let Some([a, b]) = &comp.halving
+        && scene.checks.contains(&CheckKind::DtHalving)
+    {
+        let ia = runs.iter().position(|r| &r.spec.name == a);
+        let ib = runs.iter().position(|r| &r.spec.name == b);
+        if let (Some(ia), Some(ib)) = (ia, ib) {
+            let (check, note) = halving_check([a, b], &estimates[ia], &estimates[ib])?;
+            checks.push(check);
+            notes.push(note);
+        }
+    }
+    let path = dir.join("force-strain.svg");
+    fig.write_svg(&path)?;
+    figures.push(path);
+    figures.push(write_fig2(&opts.out, curves)?);
+    finish_scene(scene, checks, figures, tables, notes, start, opts)
+}
+
+/// The paper's Fig. 2: ⟨F⟩/F_c0 against ε/ε_c0 in 2D and 3D, exact theory (discrete:
+/// solid, continuum: dashed) and simulated points with error bars.
+fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
+    let mut fig = Figure::new(
+        "Fig. 2: compressive force of a thermally fluctuating hinged filament (EI/kTL = 100, EA L/kT = 1e6, 10 elements)",
+        "strain / Euler strain",
+        "<F> / Euler load",
+    )
+    .hline(1.0, "Euler load");
+    for c in curves {
+        let d = c.dims;
+        fig = fig
+            .series(Series::line(
+                format!("{d}D exact (discretized)"),
+                c.theory.iter().map(|t| (t.0, t.1)).collect(),
+            ))
+            .series(
+                Series::line(
+                    format!("{d}D exact (continuum)"),
+                    c.theory.iter().map(|t| (t.0, t.2)).collect(),
+                )
+                .dashed(),
+            )
+            .series(
+                Series::markers(
+                    format!("{d}D simulated (±1 s.e.)"),
+                    c.simulated.iter().map(|t| (t.0, t.1)).collect(),
+                )
+                .with_errors(c.simulated.iter().map(|t| t.2).collect()),
+            );
+    }
+    let path = out.join("fig2.svg");
+    fig.write_svg(&path)?;
+    Ok(path)
+}
+
+fn finish_scene(
+    scene: &Scene,
+    mut checks: Vec<crate::verify::summary::CheckResult>,
+    figures: Vec<PathBuf>,
+    tables: Vec<PathBuf>,
+    notes: Vec<String>,
+    start: Instant,
+    opts: &VerifyOptions,
+) -> Result<SceneSummary> {
+    let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
+    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, opts.alpha)) {
+        c.p_adjusted = Some(adj);
+        c.passed = !reject;
+    }
+    let rel = |v: Vec<PathBuf>| -> Vec<String> {
+        v.iter()
+            .map(|p| {
+                p.strip_prefix(&opts.out)
+                    .unwrap_or(p)
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect()
+    };
+    Ok(SceneSummary {
+        name: scene.name.clone(),
+        passed: checks.iter().all(|c| c.passed),
+        wall_seconds: start.elapsed().as_secs_f64(),
+        figures: rel(figures),
+        tables: rel(tables),
+        notes,
+        checks,
+    })
 }
 
 fn run_scene(
@@ -104,7 +368,7 @@ fn run_scene(
     let mut figures = Vec::new();
     let mut tables = Vec::new();
     let mut notes = vec![scene.description.clone()];
-    for run in runs {
+    for (k, run) in runs.iter().enumerate() {
         let e = run.spec.ensemble(opts.budget);
         let seed = derive_seed(scene.seed, &run.spec.name);
         let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
@@ -129,7 +393,8 @@ fn run_scene(
             .map(|r| r.two_time.clone())
             .chain(extra)
             .collect();
-        let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)?;
+        let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)
+            .map_err(|e| scene.run_error(k, &format!("{}.duration_tau1", opts.budget.name()), e))?;
         checks.extend(run_checks);
         notes.extend(
             est.skipped
@@ -466,9 +731,8 @@ fn noise_study(
 /// # Errors
 /// [`Error::InvalidParameter`] naming an unknown scene and listing the known ones.
 pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>> {
-    let known = Scene::discover(scene_dir)?;
     if names.is_empty() {
-        return Ok(known);
+        return Scene::discover(scene_dir);
     }
     names
         .iter()
@@ -477,6 +741,7 @@ pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>
             if p.extension().is_some_and(|x| x == "toml") && p.exists() {
                 return Ok(p);
             }
+            let known = Scene::discover(scene_dir)?;
             known
                 .iter()
                 .find(|k| k.file_stem().is_some_and(|s| s == n.as_str()))

@@ -84,6 +84,9 @@ pub enum ModelKind {
     /// The exact modal (spectral) simulator of eq. (2): a self-check of the references and
     /// of the statistical checks.
     Spectral,
+    /// The finite-deflection (von Kármán) filament under imposed end-shortening: the
+    /// force–strain curve of the paper's Fig. 2.
+    Compression,
 }
 
 /// The checks a scene can request.
@@ -102,6 +105,42 @@ pub enum CheckKind {
     Spectrum,
     /// Two-time correlation eq. (4) from w(x, 0) = 0 at `two_time` points.
     TwoTime,
+    /// Compression: ⟨F⟩ at every strain against the exact discrete equilibrium theory
+    /// (per-point z-tests and a χ² over all points).
+    ForceStrain,
+    /// Compression: distribution of F at `distribution_strain_ratios` (KS against the
+    /// exact equilibrium law).
+    ForceDistribution,
+    /// Compression: the Δt-halving check between the two runs named in `halving`.
+    DtHalving,
+}
+
+impl CheckKind {
+    /// Whether the check applies to the compression model (otherwise to linear ones).
+    pub fn is_compression(self) -> bool {
+        matches!(
+            self,
+            CheckKind::ForceStrain | CheckKind::ForceDistribution | CheckKind::DtHalving
+        )
+    }
+}
+
+/// The imposed strains and sampling of a compression scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompressionSpec {
+    /// Imposed strains ε/ε_c0 (ε_c0 = π²EI/(EA L²)).
+    pub strain_ratios: Vec<f64>,
+    /// Strains (a subset of `strain_ratios`) where the distribution of F is tested.
+    #[serde(default)]
+    pub distribution_strain_ratios: Vec<f64>,
+    /// Burn-in from rest at each strain, in units of τ1.
+    pub burn_in_tau1: f64,
+    /// Time between samples of F, in units of τ1.
+    pub sample_every_tau1: f64,
+    /// The two runs compared by the Δt-halving check: `[run at Δt, run at Δt/2]`.
+    #[serde(default)]
+    pub halving: Option<[String; 2]>,
 }
 
 /// Discretization of the filament.
@@ -120,7 +159,7 @@ fn one() -> f64 {
 }
 
 /// What is sampled and where.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Sampling {
     /// Burn-in from rest before sampling, in units of τ1.
@@ -192,6 +231,9 @@ pub struct Scene {
     /// Scene name: the file stem (not in the file).
     #[serde(skip)]
     pub name: String,
+    /// The file the scene was read from (not in the file), for messages.
+    #[serde(skip)]
+    pub path: PathBuf,
     /// One-line description for the report.
     pub description: String,
     /// Master seed: every trajectory's generator derives from it, the run name and the
@@ -208,8 +250,12 @@ pub struct Scene {
     pub filament: FilamentParams,
     /// Discretization.
     pub mesh: MeshSpec,
-    /// Sampling plan.
+    /// Sampling plan (linear models).
+    #[serde(default)]
     pub sampling: Sampling,
+    /// Strains and sampling (compression model).
+    #[serde(default)]
+    pub compression: Option<CompressionSpec>,
     /// Integrator/noise/time-step combinations.
     pub runs: Vec<RunSpec>,
 }
@@ -221,7 +267,15 @@ impl Scene {
     /// [`Error::Io`] if unreadable; [`Error::Scene`] naming the file, key, value and
     /// allowed range if invalid.
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let text = String::from_utf8(bytes).map_err(|e| Error::Scene {
+            file: path.to_path_buf(),
+            key: "-".to_string(),
+            message: format!(
+                "not a UTF-8 text file (invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        })?;
         Scene::parse(&text, path)
     }
 
@@ -230,14 +284,24 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] naming the file, key, value and allowed range.
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
-        let mut scene: Scene = toml::from_str(text).map_err(|e| Error::Scene {
-            file: path.to_path_buf(),
-            key: e
-                .span()
-                .map(|s| key_at(text, s.start))
-                .unwrap_or_else(|| "-".to_string()),
-            message: e.message().trim().to_string(),
+        let mut scene: Scene = toml::from_str(text).map_err(|e| {
+            let message = e.message().trim().to_string();
+            let key = match (e.span(), missing_field(&message)) {
+                (Some(s), Some(field)) => match table_at(text, s.start) {
+                    Some(t) => format!("{t}.{field}"),
+                    None => field.to_string(),
+                },
+                (Some(s), None) => key_at(text, s.start),
+                (None, Some(field)) => field.to_string(),
+                (None, None) => "-".to_string(),
+            };
+            Error::Scene {
+                file: path.to_path_buf(),
+                key,
+                message,
+            }
         })?;
+        scene.path = path.to_path_buf();
         scene.name = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -254,6 +318,7 @@ impl Scene {
             message: format!("must be {allowed}, got {value}"),
         };
         let f = &self.filament;
+        // Bounds keep every derived quantity (tau1, lambda_max, variances) inside f64.
         for (key, v) in [
             ("filament.length", f.length),
             ("filament.bending_rigidity", f.bending_rigidity),
@@ -261,8 +326,8 @@ impl Scene {
             ("filament.drag", f.drag),
             ("filament.kt", f.kt),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(key, &v, "finite and > 0"));
+            if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
+                return Err(bad(key, &v, "in [1e-30, 1e30]"));
             }
         }
         if self.dims != 2 && self.dims != 3 {
@@ -271,8 +336,8 @@ impl Scene {
         if self.checks.is_empty() {
             return Err(bad("checks", &"[]", "a non-empty list"));
         }
-        if !(1..=2000).contains(&self.mesh.elements) {
-            return Err(bad("mesh.elements", &self.mesh.elements, "in [1, 2000]"));
+        if !(1..=1000).contains(&self.mesh.elements) {
+            return Err(bad("mesh.elements", &self.mesh.elements, "in [1, 1000]"));
         }
         let g = self.mesh.grading;
         if !(g.is_finite() && (0.01..=100.0).contains(&g)) {
@@ -282,9 +347,25 @@ impl Scene {
         if !(s.burn_in_tau1.is_finite() && s.burn_in_tau1 >= 0.0 && s.burn_in_tau1 <= 1e4) {
             return Err(bad("sampling.burn_in_tau1", &s.burn_in_tau1, "in [0, 1e4]"));
         }
+        if self.model == ModelKind::Compression {
+            return self.validate_compression(path);
+        }
+        for (i, c) in self.checks.iter().enumerate() {
+            if c.is_compression() {
+                let allowed = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time) for model \"fem\" or \"spectral\"";
+                return Err(bad(&format!("checks[{i}]"), &format!("{c:?}"), allowed));
+            }
+        }
+        if self.compression.is_some() {
+            return Err(bad(
+                "compression",
+                &"a [compression] table",
+                "absent unless model = \"compression\"",
+            ));
+        }
         let max_modes = match self.model {
             ModelKind::Fem => 2 * self.mesh.elements,
-            ModelKind::Spectral => self.mesh.elements,
+            _ => self.mesh.elements,
         };
         if s.modes < 1 || s.modes > max_modes.min(50) {
             let allowed = format!("in [1, {}]", max_modes.min(50));
@@ -305,6 +386,10 @@ impl Scene {
                     let key = format!("sampling.two_time[{i}][{j}] ({name})");
                     return Err(bad(&key, &p[j], "in [0, 1]"));
                 }
+            }
+            if !(p[3].is_finite() && p[3] > 0.0) {
+                let key = format!("sampling.two_time[{i}][3] (eta/tau1)");
+                return Err(bad(&key, &p[3], "finite and > 0"));
             }
             if !(p[2].is_finite() && p[2] > 0.0 && p[2] <= p[3]) {
                 let key = format!("sampling.two_time[{i}][2] (t/tau1)");
@@ -355,6 +440,10 @@ impl Scene {
             if self.runs[..i].iter().any(|r| r.name == run.name) {
                 return Err(bad(&key("name"), &run.name, "unique within the scene"));
             }
+            if run.integrator == IntegratorKind::MetropolisCrankNicolson {
+                let allowed = "euler-maruyama, backward-euler, crank-nicolson or exact-modal for a linear scene (metropolis-crank-nicolson is for model = \"compression\")";
+                return Err(bad(&key("integrator"), &run.integrator, allowed));
+            }
             if run.checks.as_ref().is_some_and(|c| c.is_empty()) {
                 return Err(bad(
                     &key("checks"),
@@ -397,18 +486,229 @@ impl Scene {
         Ok(())
     }
 
+    /// Validation of a compression scene (model = "compression").
+    fn validate_compression(&self, path: &Path) -> Result<()> {
+        let bad = |key: &str, value: &dyn std::fmt::Display, allowed: &str| Error::Scene {
+            file: path.to_path_buf(),
+            key: key.to_string(),
+            message: format!("must be {allowed}, got {value}"),
+        };
+        let Some(c) = &self.compression else {
+            return Err(bad(
+                "compression",
+                &"nothing",
+                "a [compression] table for model = \"compression\"",
+            ));
+        };
+        for (i, k) in self.checks.iter().enumerate() {
+            if !k.is_compression() {
+                return Err(bad(
+                    &format!("checks[{i}]"),
+                    &format!("{k:?}"),
+                    "force-strain, force-distribution or dt-halving for model = \"compression\"",
+                ));
+            }
+        }
+        if c.strain_ratios.is_empty() {
+            return Err(bad("compression.strain_ratios", &"[]", "a non-empty list"));
+        }
+        for (i, &r) in c.strain_ratios.iter().enumerate() {
+            if !(r.is_finite() && (-1e3..=1e3).contains(&r)) {
+                return Err(bad(
+                    &format!("compression.strain_ratios[{i}]"),
+                    &r,
+                    "finite, in [-1000, 1000]",
+                ));
+            }
+        }
+        for (i, r) in c.distribution_strain_ratios.iter().enumerate() {
+            if !c.strain_ratios.contains(r) {
+                return Err(bad(
+                    &format!("compression.distribution_strain_ratios[{i}]"),
+                    r,
+                    "one of compression.strain_ratios",
+                ));
+            }
+        }
+        if !(c.burn_in_tau1.is_finite() && (0.0..=1e4).contains(&c.burn_in_tau1)) {
+            return Err(bad(
+                "compression.burn_in_tau1",
+                &c.burn_in_tau1,
+                "in [0, 1e4]",
+            ));
+        }
+        if !(c.sample_every_tau1.is_finite()
+            && c.sample_every_tau1 > 0.0
+            && c.sample_every_tau1 <= 100.0)
+        {
+            return Err(bad(
+                "compression.sample_every_tau1",
+                &c.sample_every_tau1,
+                "in (0, 100]",
+            ));
+        }
+        if self.runs.is_empty() {
+            return Err(bad("runs", &"[]", "at least one [[runs]] table"));
+        }
+        for (i, run) in self.runs.iter().enumerate() {
+            let key = |k: &str| format!("runs[{i}].{k}");
+            if run.integrator == IntegratorKind::ExactModal {
+                return Err(bad(
+                    &key("integrator"),
+                    &run.integrator,
+                    "euler-maruyama, backward-euler, crank-nicolson or metropolis-crank-nicolson for model = \"compression\"",
+                ));
+            }
+            if run.integrator == IntegratorKind::MetropolisCrankNicolson
+                && run.noise != NoiseModel::Consistent
+            {
+                return Err(bad(
+                    &key("noise"),
+                    &run.noise.name(),
+                    "consistent for metropolis-crank-nicolson",
+                ));
+            }
+            if run
+                .checks
+                .as_ref()
+                .is_some_and(|cs| cs.iter().any(|k| !k.is_compression()))
+            {
+                return Err(bad(
+                    &key("checks"),
+                    &"a linear check",
+                    "compression checks only",
+                ));
+            }
+            if self.runs[..i].iter().any(|r| r.name == run.name) {
+                return Err(bad(&key("name"), &run.name, "unique within the scene"));
+            }
+            if !(run.dt_tau1.is_finite() && run.dt_tau1 > 0.0 && run.dt_tau1 <= c.sample_every_tau1)
+            {
+                let allowed = format!(
+                    "in (0, compression.sample_every_tau1 = {}]",
+                    c.sample_every_tau1
+                );
+                return Err(bad(&key("dt_tau1"), &run.dt_tau1, &allowed));
+            }
+            for budget in [Budget::Quick, Budget::Standard, Budget::Full] {
+                let e = run.ensemble(budget);
+                let b = budget.name();
+                if !(2..=100_000).contains(&e.trajectories) {
+                    return Err(bad(
+                        &key(&format!("{b}.trajectories")),
+                        &e.trajectories,
+                        "in [2, 100000] (per strain)",
+                    ));
+                }
+                let samples = e.duration_tau1 / c.sample_every_tau1;
+                if !(e.duration_tau1.is_finite() && samples >= 16.0 && e.duration_tau1 <= 1e6) {
+                    let allowed = format!(
+                        "<= 1e6 and >= 16 x sample_every_tau1 = {}",
+                        16.0 * c.sample_every_tau1
+                    );
+                    return Err(bad(
+                        &key(&format!("{b}.duration_tau1")),
+                        &e.duration_tau1,
+                        &allowed,
+                    ));
+                }
+            }
+        }
+        if let Some([a, b]) = &c.halving {
+            for (j, n) in [a, b].iter().enumerate() {
+                if !self.runs.iter().any(|r| &r.name == *n) {
+                    return Err(bad(
+                        &format!("compression.halving[{j}]"),
+                        n,
+                        "the name of a run of this scene",
+                    ));
+                }
+            }
+        } else if self.checks.contains(&CheckKind::DtHalving) {
+            return Err(bad(
+                "compression.halving",
+                &"nothing",
+                "two run names when checks has \"dt-halving\"",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Wraps an error raised while preparing or running run `run` of this scene so that
+    /// the message names the scene file and the run's key (bad input, exit 2), unless it
+    /// already names them.
+    pub fn run_error(&self, run: usize, what: &str, err: Error) -> Error {
+        let tau1 = self.filament.tau1();
+        let key = |k: &str| format!("runs[{run}].{k}");
+        match err {
+            Error::Scene { .. } | Error::Io { .. } | Error::Diverged { .. } => err,
+            Error::UnstableTimeStep {
+                integrator,
+                dt,
+                limit,
+                suggestion,
+            } => Error::Scene {
+                file: self.path.clone(),
+                key: key("dt_tau1"),
+                message: format!(
+                    "must be < {:.4e} (the stability limit 2/lambda_max of {integrator} for this mesh, in units of tau1), got {:.4e}; use a smaller dt_tau1 or a stable integrator such as {suggestion}",
+                    limit / tau1,
+                    dt / tau1
+                ),
+            },
+            other => Error::Scene {
+                file: self.path.clone(),
+                key: key(what),
+                message: format!(
+                    "cannot be run as given ({other}); for too little data raise duration_tau1 or trajectories, or lower {}",
+                    key("dt_tau1")
+                ),
+            },
+        }
+    }
+
     /// The scene files in `dir`, sorted by name.
     ///
     /// # Errors
-    /// [`Error::Io`] if the directory cannot be read.
+    /// [`Error::InvalidParameter`] (exit 2) if the directory cannot be read.
     pub fn discover(dir: &Path) -> Result<Vec<PathBuf>> {
         let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-            .map_err(|e| Error::io(dir, e))?
+            .map_err(|e| {
+                Error::invalid(
+                    "--scene-dir",
+                    dir.display(),
+                    format!("a readable directory of scene files ({e})"),
+                )
+            })?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.extension().is_some_and(|x| x == "toml"))
             .collect();
         files.sort();
         Ok(files)
+    }
+}
+
+/// The field named by a serde "missing field `x`" message.
+fn missing_field(message: &str) -> Option<&str> {
+    let rest = message.strip_prefix("missing field `")?;
+    rest.split('`').next()
+}
+
+/// The table whose header (`[t]` or `[[t]]`) is on the line of byte `offset`, or the
+/// nearest header above it; `None` at top level (before any header).
+fn table_at(text: &str, offset: usize) -> Option<String> {
+    let offset = offset.min(text.len());
+    let line_end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    let lines: Vec<&str> = text[..line_end].lines().map(str::trim).collect();
+    let at = lines.iter().rposition(|l| l.starts_with('['))?;
+    let header = lines[at];
+    let name = header.trim_matches(|c| c == '[' || c == ']').to_string();
+    if header.starts_with("[[") {
+        // An array of tables: name the element, e.g. `runs[1]`.
+        let index = lines[..at].iter().filter(|l| **l == header).count();
+        Some(format!("{name}[{index}]"))
+    } else {
+        Some(name)
     }
 }
 

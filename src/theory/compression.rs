@@ -1,0 +1,1281 @@
+//! Exact equilibrium force–strain relation of a thermally fluctuating, compressed,
+//! hinged filament (the paper's Fig. 2; `physics.md` §4).
+//!
+//! # The model (the contract shared with the simulator)
+//!
+//! A filament of length L, hinged at both ends, with transverse deflection w (2D) or two
+//! deflections (w, v) (3D) and axial displacement u, `u(0) = 0`, `u(L) = −Δ`; the imposed
+//! nominal compressive strain is `ε = Δ/L`. The energy is the paper's von Kármán energy
+//! `∫ [EA/2 (u' + ½w'²)² + EI/2 w''²] dx` (3D: `w'² → w'² + v'²`, `w''² → w''² + v''²`).
+//!
+//! **Elimination of the fast variable u.** u uses linear elements; the stretching energy
+//! of element e is evaluated with the element-mean strain `u'_e + s_e`,
+//! `s_e = (1/2h_e) ∫_e w'² dx` (i.e. `½w'²` is replaced by its element average), so the
+//! element stretching energy is `(EA h_e/2)(u'_e + s_e)²`. Axial equilibrium for fixed w
+//! (minimizing over the interior nodal u) makes the element force `EA(u'_e + s_e)` the
+//! same in every element: `N = (EA/L)(−Δ + ½∫w'² dx)`, exactly as in the continuum, where
+//! `½w'²` is pointwise and `N` is uniform. Substituting back, the energy is a function of
+//! w alone:
+//!
+//! ```text
+//! U(w) = ½ wᵀK w + (EA·L/2)(s(w) − ε)²,   s(w) = (1/2L)∫ w'² dx = wᵀG w/(2L),
+//! ```
+//!
+//! (3D: s sums over w and v), and the compressive force is `F = −N = EA(ε − s)`. K and G
+//! are the Hermite-cubic bending and geometric matrices over the free DOFs of
+//! [`crate::fem::BeamModel`]; in the continuum, `K → EI∫w''²` and `G → ∫w'²`.
+//!
+//! # The stored-length law
+//!
+//! Under the bending-only Gaussian ensemble `w ~ N(0, kT K⁻¹)`, write `K = LLᵀ`,
+//! `w = √kT L⁻ᵀ z`: then `s = Σ_i c_i χ²_{d,i}` with independent χ² variables of
+//! `d = 1` (2D) or `d = 2` (3D) degrees of freedom and weights `c_i = kT μ_i/(2L)`, `μ_i`
+//! the eigenvalues of `L⁻¹GL⁻ᵀ`, i.e. of `K⁻¹G` (the generalized eigenvalues of
+//! `(G, K)`; `1/μ_i` are the buckling loads of the discretized filament). In the
+//! continuum `μ_n = 1/(EI(nπ/L)²)`, `c_n = kT L/(2EI n²π²)`. [`StoredLengthLaw`] holds
+//! the weights and, for the continuum, the first two cumulants of the omitted modes
+//! `n > M`, which are represented by a Gaussian (see *Truncation* below).
+//!
+//! For the uniform hinged mesh the pencil `(K, G)` block-diagonalizes exactly in
+//! sine/cosine modes (a hinge is a mirror), which gives all `2N` buckling loads in closed
+//! form ([`discrete_buckling_loads`]); [`StoredLengthLaw::discrete`] uses it, and
+//! [`StoredLengthLaw::discrete_dense`] solves the dense generalized eigenproblem of the
+//! assembled [`BeamModel`] matrices as a cross-check (they agree to ≤ 10⁻¹¹ for N ≤ 32;
+//! the dense route's rounding error grows as `ε_mach·N⁴`). Two properties of the mesh,
+//! both tested: its weights converge to the continuum's as `h⁴` mode by mode, but the
+//! total stored length is only first order, exactly `⟨s⟩₀,h = ⟨s⟩₀(1 − 2h/(5L))` (the
+//! per-element clamped–clamped "bubble" fluctuations that cubics cannot represent; −4%
+//! at N = 10).
+//!
+//! Its characteristic function and cumulant generating function are
+//!
+//! ```text
+//! φ(t) = E e^{its} = Π_i (1 − 2i c_i t)^{−d/2} · e^{i t m_T − t² v_T/2},
+//! ψ(η) = ln E e^{ηs} = −(d/2) Σ_i ln(1 − 2c_i η) + η m_T + η² v_T/2,   η < 1/(2 c_max).
+//! ```
+//!
+//! # The exact average at imposed strain
+//!
+//! The Boltzmann weight of a configuration is `e^{−U/kT}`; integrating out everything but
+//! s, the stored length has density `p_ε(s) ∝ p₀(s) e^{−A(s−ε)²}`, `A = EA·L/(2kT)`, with
+//! p₀ the density of the law above, and `⟨F⟩ = EA(ε − ⟨s⟩_ε)`. No mean-field
+//! approximation is made.
+//!
+//! **Fourier route.** With `g(s) = e^{−A(s−ε)²}`, `ĝ(t) = ∫ g e^{−its} ds =
+//! √(π/A) e^{−itε − t²/(4A)}` and Parseval `∫ p₀ g ds = (1/2π)∫ φ(t) ĝ(t) dt`:
+//!
+//! ```text
+//! Z(ε)            ∝ J₀ = ∫ φ(t) E(t) dt,              E(t) = e^{−itε − t²/(4A)},
+//! ∫ s p₀ g ds     ∝ ∫ φ(t) (ε − it/(2A)) E(t) dt      (FT of s·g is i∂_t ĝ),
+//! ∫ (ε−s)² p₀ g ds ∝ ∫ φ(t) (1/(2A) − t²/(4A²)) E(t) dt.
+//! ```
+//!
+//! Hence, with `J_k = ∫ t^k φ E dt` and `EA/(2A) = kT/L`,
+//!
+//! ```text
+//! ⟨F⟩ = (kT/L) · i J₁/J₀,     ⟨F²⟩ = EA·kT/L − (kT/L)² J₂/J₀,
+//! ```
+//!
+//! which involve no cancellation between ε and ⟨s⟩.
+//!
+//! **Saddle-point contour.** The integrand is analytic in `Im t > −1/(2c_max)` (the
+//! singularities of φ lie at `t = −i/(2c_i)`), so the line of integration may be moved to
+//! `t = τ − iη` for any `η < 1/(2c_max)` without changing J_k. The code takes η = η̂,
+//! the saddle point `ψ'(η̂) + η̂/(2A) = ε` (unique: the left side increases from −∞ to +∞).
+//! With `m = ε − η̂/(2A)` the integrand becomes, up to a constant factor,
+//!
+//! ```text
+//! f(τ) = φ_η(τ) e^{−iτm} e^{−τ²/(4A)},     φ_η(τ) = φ(τ − iη̂)/φ(−iη̂),
+//! ```
+//!
+//! the characteristic function of `Y = (s_η − m) + G`, where `s_η` has the exponentially
+//! tilted density `p₀(s)e^{η̂s}/φ(−iη̂)` (mean m) and `G ~ N(0, 1/(2A))` is independent.
+//! `f(0) = 1`, so there is no exponentially small normalization (without the shift, Z(ε)
+//! is of order `e^{−ε/(2c₁)}` at large compression and `e^{−Aε²}` at large tension, and
+//! the real-line integral would cancel catastrophically). Then, with the moments
+//! `M_k = ∫τ^k f dτ / ∫ f dτ`,
+//!
+//! ```text
+//! ⟨F⟩ = (kT/L)(η̂ + i M₁),      Var F = EA·kT/L − (kT/L)² (M₂ − M₁²).
+//! ```
+//!
+//! `(kT/L)η̂` alone is the Gaussian mean-field force (self-consistent tension in the
+//! Gaussian ensemble, [`CompressionTheory::mean_field_force`]); it can never exceed the
+//! buckling load `(kT/L)/(2c_max)`, because `η̂ < 1/(2c_max)`. The term `i M₁` is the exact
+//! correction; in 2D it takes ⟨F⟩ above the buckling load.
+//!
+//! **Quadrature.** `f(−τ) = conj f(τ)`, so the full-line trapezoid rule uses τ ≥ 0 only.
+//! By Poisson summation, the trapezoid rule with step h integrates a characteristic
+//! function exactly up to the aliased density: `h Σ_j f(jh) = 2π Σ_k p_Y(2πk/h)`, so the
+//! error relative to `2π p_Y(0)` is the density of Y at distance `P = 2π/h` and beyond.
+//! The code chooses `P = max(x_L, x_R) + √(T/A)`, where `x_R`, `x_L` are Chernoff bounds
+//! `P(±(s_η − m) > x) ≤ e^{−T}` minimized over a ladder of exponents (on the right the
+//! ladder stays below the distance `δ = 1/(2c_max) − η̂` to the nearest singularity, which
+//! is the exponential rate of the right tail: this is the strip-width constraint) and
+//! `√(T/A)` covers the Gaussian part. The level is `T = 40` plus `ln(σ_Y/σ_G) + 2`, which
+//! accounts for `p_Y(0)` being smaller than the Gaussian peak; the aliasing error is then
+//! below `≈ 2e^{−40}` relative. The range is `τ ≤ √(4A(T + 10))` (Gaussian factor below
+//! `e^{−50}`), cut earlier when `|f(τ)|` (which is monotone decreasing in |τ|) times the
+//! largest remaining weight and the number of remaining nodes falls below `e^{−T}` of the
+//! running sum. [`QuadratureOptions`] scales the step and the level; the tests check that
+//! halving the step changes ⟨F⟩ by less than 10⁻¹⁰ relative.
+//!
+//! **Evaluation of φ_η.** `φ_η(τ) = Π (1 − i b_i τ)^{−d/2} e^{iτ(m_T + η̂v_T) − τ²v_T/2}`
+//! with `b_i = 2c_i/(1 − 2c_iη̂)`, evaluated as a sum of logarithms
+//! (`−¼ d ln(1 + b²τ²) + ½ d i·atan(bτ)` per mode). Modes with `b_i τ_max ≤ ¼` are
+//! summed through the power series `−ln(1 − z) = Σ z^k/k` with the power sums
+//! `Σ b_i^k`, 30 terms (remainder below `4^{−29}/31` of the first-order term), so the cost
+//! per node is independent of the number of small modes.
+//!
+//! # The distribution of F
+//!
+//! With the same tilt, `p_ε(s) ∝ q(s) e^{−A(s−m)²}`, q the tilted density. The
+//! characteristic function of `X = s − m` under `p_ε` is, by Parseval again,
+//!
+//! ```text
+//! χ(u) = ∫ φ_η(τ) e^{−iτm} e^{−(τ−u)²/(4A)} dτ / ∫ φ_η(τ) e^{−iτm} e^{−τ²/(4A)} dτ,
+//! ```
+//!
+//! evaluated with the same trapezoid nodes. The CDF of X follows from the Fourier series
+//! of its periodization over a window `[x₀, x₀ + P_s)` that holds all but `e^{−T}` of the
+//! mass (`|X| ≤ √((T + ln 1/Z)/A)`, narrowed by the Chernoff bounds of q):
+//!
+//! ```text
+//! P(X ≤ x) = (x − x₀)/P_s − (1/π) Σ_{k≥1} Im[χ(kΔ)(e^{−ikΔx} − e^{−ikΔx₀})]/k,   Δ = 2π/P_s,
+//! ```
+//!
+//! truncated at the first `K = 2^j ≥ 16` for which every `|χ(kΔ)|`, `K/2 < k ≤ K`, is
+//! below 10⁻¹⁴ (observed decay), or at the point where a rigorous bound on |χ| (from the
+//! monotonicity of |φ_η|) falls below 10⁻¹⁴, whichever comes first. The rigorous bound
+//! ignores the oscillation of `e^{−iτm}` under the Gaussian kernel, which suppresses |χ|
+//! by up to `e^{−Am²}`; at large compression it asks for hundreds of times more terms than
+//! needed. A density with a jump (a single element in 2D) gives `|χ| ∝ 1/u`; the series
+//! is then capped at 2·10⁵ terms. The CDF of `F = EA(ε − s)` is `1 − P(X ≤ (F_mf − F)/EA)`, `F_mf = (kT/L)η̂`.
+//!
+//! # Truncation of the continuum
+//!
+//! [`StoredLengthLaw::continuum`] keeps M modes explicitly and replaces the rest by a
+//! Gaussian with their exact mean `m_T = d c₁ Σ_{n>M} n⁻²` and variance
+//! `v_T = 2d c₁² Σ_{n>M} n⁻⁴` (tail sums by Euler–Maclaurin). The omitted part of
+//! `ln φ(t)` is then `(d/2) Σ_{k≥3} (2it)^k p_k/k`, `p_k = Σ_{n>M} c_n^k`, bounded by
+//! [`continuum_tail_log_char_bound`]:
+//! `(d/2)(2|t|)³ p₃ / (3(1 − 2c_{M+1}|t|))`, `p₃ ≤ c₁³/(5(M+½)⁵)`. For P = EI/(kT·L) = 100,
+//! EA·L/kT = 10⁶ and M = 10⁴ the contour reaches `|t| ≲ 2·10⁴` and the bound is below
+//! 10⁻¹⁷ (relative error of φ, hence of ⟨F⟩ − F_mf); the tests confirm that M = 10³ and
+//! M = 2·10⁴ agree to better than 10⁻¹².
+
+use crate::error::{Error, Result};
+use crate::fem::{BeamModel, Mesh};
+use crate::params::FilamentParams;
+use nalgebra::{Complex, DMatrix};
+use std::f64::consts::PI;
+
+/// Number of explicit continuum modes used by default (e.g. by the CLI).
+pub const DEFAULT_CONTINUUM_MODES: usize = 10_000;
+
+/// Largest mesh accepted by [`StoredLengthLaw::discrete`] and
+/// [`buckling_load_discrete`] (the generalized eigenproblem is solved densely, `O(N³)`).
+pub const MAX_DISCRETE_ELEMENTS: usize = 2000;
+
+/// Terms of the power series used for the small modes.
+const SERIES_TERMS: usize = 30;
+/// Modes with `b τ_max` at most this go into the power series.
+const SERIES_RADIUS: f64 = 0.25;
+/// Target of the bound on |χ(u)| at which the CDF's Fourier series is truncated.
+const CDF_TOLERANCE: f64 = 1e-14;
+/// Cap on the number of Fourier terms of a [`ForceDistribution`].
+const MAX_FOURIER_TERMS: usize = 200_000;
+/// Extra exponent for the Gaussian range of the quadrature.
+const RANGE_MARGIN: f64 = 10.0;
+
+fn numerical(routine: &str, detail: impl Into<String>) -> Error {
+    Error::Numerical {
+        routine: routine.into(),
+        detail: detail.into(),
+    }
+}
+
+/// Number of transverse directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Dims {
+    /// Planar filament: one deflection w; each mode contributes a χ²₁.
+    Two,
+    /// Filament in space: deflections w and v; each mode contributes a χ²₂.
+    Three,
+}
+
+impl Dims {
+    /// `2 → Two`, `3 → Three`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for any other value.
+    pub fn from_u32(dims: u32) -> Result<Self> {
+        match dims {
+            2 => Ok(Dims::Two),
+            3 => Ok(Dims::Three),
+            _ => Err(Error::invalid("dims", dims, "2 or 3")),
+        }
+    }
+
+    /// Number of transverse directions `d` (1 in 2D, 2 in 3D): the degrees of freedom of
+    /// each mode's χ².
+    pub fn copies(self) -> usize {
+        match self {
+            Dims::Two => 1,
+            Dims::Three => 2,
+        }
+    }
+
+    /// The spatial dimension, 2 or 3.
+    pub fn as_u32(self) -> u32 {
+        match self {
+            Dims::Two => 2,
+            Dims::Three => 3,
+        }
+    }
+}
+
+/// `Σ_{n>m} n^{−p}` for `p = 2` or `4`: the Euler–Maclaurin expansion at
+/// `K = max(m, 1000)` (to `O(K^{−p−7})`, relative error below 10⁻²⁰), plus the explicit
+/// terms `m < n ≤ K` summed from the smallest.
+fn inverse_power_tail(p: u32, m: usize) -> f64 {
+    let k = m.max(1000);
+    let x = k as f64;
+    let em = match p {
+        2 => {
+            1.0 / x - 1.0 / (2.0 * x * x) + 1.0 / (6.0 * x.powi(3)) - 1.0 / (30.0 * x.powi(5))
+                + 1.0 / (42.0 * x.powi(7))
+        }
+        4 => {
+            1.0 / (3.0 * x.powi(3)) - 1.0 / (2.0 * x.powi(4)) + 1.0 / (3.0 * x.powi(5))
+                - 1.0 / (6.0 * x.powi(7))
+                + 2.0 / (9.0 * x.powi(9))
+        }
+        _ => unreachable!("inverse_power_tail: p must be 2 or 4"),
+    };
+    (m + 1..=k)
+        .rev()
+        .fold(em, |acc, n| acc + (n as f64).powi(-(p as i32)))
+}
+
+/// The law of the stored length `s = (1/2L)∫|w'|² dx` under the bending-only Gaussian
+/// ensemble: `s = Σ_i c_i χ²_{d,i} + S_T`, with `S_T ~ N(tail_mean, tail_variance)`
+/// standing for omitted modes (zero for a discrete filament).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StoredLengthLaw {
+    /// Mode weights `c_i = kT μ_i/(2L)`, descending.
+    pub weights: Vec<f64>,
+    /// Degrees of freedom `d` of each mode's χ² (1 in 2D, 2 in 3D).
+    pub copies: usize,
+    /// Mean of the omitted modes, `d Σ_{omitted} c_n`.
+    pub tail_mean: f64,
+    /// Variance of the omitted modes, `2d Σ_{omitted} c_n²`.
+    pub tail_variance: f64,
+}
+
+impl StoredLengthLaw {
+    /// The continuum filament: `c_n = kT L/(2 EI n²π²)` for `n = 1..=n_modes`, and the
+    /// exact mean and variance of the modes `n > n_modes` as a Gaussian tail.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for invalid parameters or `n_modes = 0`.
+    pub fn continuum(params: &FilamentParams, dims: Dims, n_modes: usize) -> Result<Self> {
+        params.validate()?;
+        if n_modes == 0 {
+            return Err(Error::invalid("n_modes", n_modes, ">= 1"));
+        }
+        let c1 = continuum_first_weight(params);
+        let d = dims.copies() as f64;
+        let weights = (1..=n_modes).map(|n| c1 / (n as f64 * n as f64)).collect();
+        Ok(StoredLengthLaw {
+            weights,
+            copies: dims.copies(),
+            tail_mean: d * c1 * inverse_power_tail(2, n_modes),
+            tail_variance: 2.0 * d * c1 * c1 * inverse_power_tail(4, n_modes),
+        })
+    }
+
+    /// The filament discretized by `n_elements` uniform Hermite-cubic elements:
+    /// `c_i = kT μ_i/(2L)`, `μ_i = 1/λ_i` with `λ_i` the generalized eigenvalues of
+    /// `(K, G)` of [`BeamModel`] (the buckling loads of the mesh), from the closed form
+    /// [`discrete_buckling_loads`]; no tail. The closed form equals the dense generalized
+    /// eigenproblem ([`Self::discrete_dense`]) to rounding (≤ 10⁻¹² relative for N ≤ 32,
+    /// `tests/compression_theory.rs`), but stays exact for large N, where the dense
+    /// route loses accuracy in the largest μ as `≈ ε_mach·N⁴` (3·10⁻⁷ at N = 512) and costs
+    /// `O(N³)`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for invalid parameters or `n_elements` outside
+    /// `[1, MAX_DISCRETE_ELEMENTS]`.
+    pub fn discrete(params: &FilamentParams, dims: Dims, n_elements: usize) -> Result<Self> {
+        let loads = discrete_buckling_loads(params, n_elements)?;
+        let f = params.kt / (2.0 * params.length);
+        Ok(StoredLengthLaw {
+            weights: loads.iter().map(|l| f / l).collect(),
+            copies: dims.copies(),
+            tail_mean: 0.0,
+            tail_variance: 0.0,
+        })
+    }
+
+    /// As [`Self::discrete`], but from the dense generalized eigenproblem of the assembled
+    /// [`BeamModel`] matrices: `K = LLᵀ` (banded Cholesky), `μ_i` the eigenvalues of
+    /// `L⁻¹GL⁻ᵀ` (`O(N³)`). A cross-check of the closed form; inaccurate for large N (see
+    /// [`Self::discrete`]).
+    ///
+    /// # Errors
+    /// As [`Self::discrete`]; [`Error::Numerical`] if `K` is not positive definite or an
+    /// eigenvalue is not positive.
+    pub fn discrete_dense(params: &FilamentParams, dims: Dims, n_elements: usize) -> Result<Self> {
+        let mu = discrete_compliances_dense(params, n_elements)?;
+        let f = params.kt / (2.0 * params.length);
+        Ok(StoredLengthLaw {
+            weights: mu.iter().map(|m| f * m).collect(),
+            copies: dims.copies(),
+            tail_mean: 0.0,
+            tail_variance: 0.0,
+        })
+    }
+
+    /// Checks the law is well formed: `copies ≥ 1`, weights finite and `≥ 0`, tail
+    /// cumulants finite and `≥ 0`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the offending field.
+    pub fn validate(&self) -> Result<()> {
+        if self.copies == 0 {
+            return Err(Error::invalid("copies", self.copies, ">= 1"));
+        }
+        if let Some(c) = self.weights.iter().find(|c| !(c.is_finite() && **c >= 0.0)) {
+            return Err(Error::invalid("weights", c, "finite and >= 0"));
+        }
+        if !(self.tail_mean.is_finite() && self.tail_mean >= 0.0) {
+            return Err(Error::invalid(
+                "tail_mean",
+                self.tail_mean,
+                "finite and >= 0",
+            ));
+        }
+        if !(self.tail_variance.is_finite() && self.tail_variance >= 0.0) {
+            return Err(Error::invalid(
+                "tail_variance",
+                self.tail_variance,
+                "finite and >= 0",
+            ));
+        }
+        Ok(())
+    }
+
+    /// `E s = d Σ c_i + tail_mean` (the stored length of the free filament, ⟨s⟩₀).
+    pub fn mean(&self) -> f64 {
+        let d = self.copies as f64;
+        d * self.weights.iter().rev().sum::<f64>() + self.tail_mean
+    }
+
+    /// `Var s = 2d Σ c_i² + tail_variance`.
+    pub fn variance(&self) -> f64 {
+        let d = self.copies as f64;
+        2.0 * d * self.weights.iter().rev().map(|c| c * c).sum::<f64>() + self.tail_variance
+    }
+
+    /// The largest weight (0 for an empty list).
+    pub fn max_weight(&self) -> f64 {
+        self.weights.iter().fold(0.0_f64, |a, &c| a.max(c))
+    }
+
+    /// The characteristic function `φ(t) = E e^{its} = Π(1 − 2ic_it)^{−d/2} ·
+    /// e^{it·tail_mean − t²·tail_variance/2}`, evaluated as a sum of logarithms.
+    pub fn char_fn(&self, t: f64) -> Complex<f64> {
+        let half_d = 0.5 * self.copies as f64;
+        let (mut re, mut im) = (0.0, 0.0);
+        for &c in self.weights.iter().rev() {
+            let x = 2.0 * c * t;
+            re -= 0.5 * half_d * (x * x).ln_1p();
+            im += half_d * x.atan();
+        }
+        re -= 0.5 * self.tail_variance * t * t;
+        im += t * self.tail_mean;
+        Complex::from_polar(re.exp(), im)
+    }
+
+    /// The cumulant generating function `ψ(η) = ln E e^{ηs}`, finite for
+    /// `η < 1/(2 max c_i)`; `+∞` beyond.
+    pub fn cumulant_generating_fn(&self, eta: f64) -> f64 {
+        let half_d = 0.5 * self.copies as f64;
+        let mut acc = 0.0;
+        for &c in self.weights.iter().rev() {
+            let a = -2.0 * c * eta;
+            if a <= -1.0 {
+                return f64::INFINITY;
+            }
+            acc -= half_d * a.ln_1p();
+        }
+        acc + eta * self.tail_mean + 0.5 * eta * eta * self.tail_variance
+    }
+}
+
+/// `c₁ = kT L/(2EIπ²)` of the continuum.
+fn continuum_first_weight(params: &FilamentParams) -> f64 {
+    params.kt * params.length / (2.0 * params.bending_rigidity * PI * PI)
+}
+
+/// Rigorous bound on `|ln φ_exact(t) − ln φ_law(t)|` for
+/// [`StoredLengthLaw::continuum`]`(params, dims, n_modes)`: the error of representing the
+/// modes `n > n_modes` by a Gaussian with their exact mean and variance, at a complex
+/// argument of modulus `t_abs`. `(d/2)(2|t|)³ p₃/(3(1 − 2c_{M+1}|t|))` with
+/// `p₃ = Σ_{n>M} c_n³ ≤ c₁³/(5(M+½)⁵)` (midpoint bound of a convex sum); `+∞` if
+/// `2c_{M+1}|t| ≥ 1`.
+pub fn continuum_tail_log_char_bound(
+    params: &FilamentParams,
+    dims: Dims,
+    n_modes: usize,
+    t_abs: f64,
+) -> f64 {
+    let c1 = continuum_first_weight(params);
+    let m1 = n_modes as f64 + 1.0;
+    let r = 2.0 * c1 / (m1 * m1) * t_abs;
+    if r >= 1.0 {
+        return f64::INFINITY;
+    }
+    let p3 = c1.powi(3) / (5.0 * (n_modes as f64 + 0.5).powi(5));
+    0.5 * dims.copies() as f64 * (2.0 * t_abs).powi(3) * p3 / (3.0 * (1.0 - r))
+}
+
+/// Lower-triangular banded forward substitution `L y = b` in place.
+fn forward_solve(lband: &[f64], bw: usize, b: &mut [f64]) {
+    let w = bw + 1;
+    for i in 0..b.len() {
+        let mut s = b[i];
+        for k in i.saturating_sub(bw)..i {
+            s -= lband[i * w + (i - k)] * b[k];
+        }
+        b[i] = s / lband[i * w];
+    }
+}
+
+fn check_elements(n_elements: usize) -> Result<()> {
+    if n_elements == 0 || n_elements > MAX_DISCRETE_ELEMENTS {
+        return Err(Error::invalid(
+            "n_elements",
+            n_elements,
+            format!("in [1, {MAX_DISCRETE_ELEMENTS}]"),
+        ));
+    }
+    Ok(())
+}
+
+/// All `2N` buckling loads of the hinged filament discretized by `n_elements = N`
+/// uniform Hermite-cubic elements — the generalized eigenvalues `λ` of `K v = λ G v` over
+/// the free DOFs of [`BeamModel`] — ascending, in closed form.
+///
+/// **Derivation.** A hinge is a mirror for the element equations (w odd, θ = w' even),
+/// so with `h = L/N` and `k = nπ/L` the vectors `w_i = W sin(kx_i)`, `θ_i = Θ cos(kx_i)`
+/// span an invariant subspace of the pencil: the constrained `w_0 = w_N = 0` hold, and the
+/// boundary rows of `θ_0`, `θ_N` are exactly half the interior rows. On it, summing the
+/// element matrices over the two elements at a node (`σ = sin(kh/2)`):
+///
+/// ```text
+/// K₂ = (EI/h³) [[48σ², −12h sin kh], [−12h sin kh, (12 − 8σ²)h²]],
+/// G₂ = (1/30h) [[144σ², −6h sin kh], [−6h sin kh, (6 + 4σ²)h²]],
+/// ```
+///
+/// with `det K₂ = 192 (EI)² σ⁴/h⁴` and `det G₂ = 0.8 σ²(1 + σ²)`. With `λ = x·EI/h²` the
+/// characteristic equation is `(1 + σ²)x² − (60 − 16σ²)x + 240σ² = 0`: for
+/// `n = 1..N−1` both roots (the acoustic root `x₋ = 480σ²/(b + √D)`, `b = 60 − 16σ²`,
+/// `D = b² − 960σ²(1 + σ²) > 0`, computed without cancellation; `x₋ → (kh)²`, i.e.
+/// `λ → EIk²`), plus the rotation-only modes `n = 0` (`x = 60`, θ constant) and `n = N`
+/// (`x = 12`, θ alternating). The lowest load, `n = 1` acoustic, is
+/// [`buckling_load_discrete`]; it converges to `F_c0` as `h⁴`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for invalid parameters or `n_elements` outside
+/// `[1, MAX_DISCRETE_ELEMENTS]`.
+pub fn discrete_buckling_loads(params: &FilamentParams, n_elements: usize) -> Result<Vec<f64>> {
+    params.validate()?;
+    check_elements(n_elements)?;
+    let h = params.length / n_elements as f64;
+    let scale = params.bending_rigidity / (h * h);
+    let mut loads = Vec::with_capacity(2 * n_elements);
+    loads.push(60.0 * scale);
+    loads.push(12.0 * scale);
+    for n in 1..n_elements {
+        let sigma = (n as f64 * PI / (2.0 * n_elements as f64)).sin();
+        let s2 = sigma * sigma;
+        let b = 60.0 - 16.0 * s2;
+        let root = (b * b - 960.0 * s2 * (1.0 + s2)).sqrt();
+        loads.push(480.0 * s2 / (b + root) * scale);
+        loads.push((b + root) / (2.0 * (1.0 + s2)) * scale);
+    }
+    loads.sort_by(|a, b| a.total_cmp(b));
+    Ok(loads)
+}
+
+/// Eigenvalues μ of `K⁻¹G` (the compliances `1/buckling load` of the discrete modes),
+/// descending, from the dense generalized eigenproblem.
+fn discrete_compliances_dense(params: &FilamentParams, n_elements: usize) -> Result<Vec<f64>> {
+    params.validate()?;
+    check_elements(n_elements)?;
+    let beam = BeamModel::new(*params, Mesh::uniform(params.length, n_elements)?)?;
+    let chol = beam.stiffness().cholesky()?;
+    let g = beam.geometric();
+    let n = beam.n_dofs();
+    let bw = chol.bandwidth();
+    let mut lband = vec![0.0; n * (bw + 1)];
+    for i in 0..n {
+        for k in i.saturating_sub(bw)..=i {
+            lband[i * (bw + 1) + (i - k)] = chol.get(i, k);
+        }
+    }
+    // Z = L⁻¹ G (column by column), then B = L⁻¹ Zᵀ = L⁻¹ G L⁻ᵀ.
+    let gb = g.bandwidth();
+    let mut z = DMatrix::<f64>::zeros(n, n);
+    for j in 0..n {
+        let mut col = z.column_mut(j);
+        let col = col.as_mut_slice();
+        let rows = j.saturating_sub(gb)..(j + gb + 1).min(n);
+        for (i, v) in rows.clone().zip(&mut col[rows]) {
+            *v = g.get(i, j);
+        }
+        forward_solve(&lband, bw, col);
+    }
+    z.transpose_mut();
+    for j in 0..n {
+        let mut col = z.column_mut(j);
+        forward_solve(&lband, bw, col.as_mut_slice());
+    }
+    let b = (&z + z.transpose()) * 0.5;
+    drop(z);
+    let mut mu: Vec<f64> = b.symmetric_eigenvalues().iter().copied().collect();
+    if let Some(v) = mu.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        return Err(numerical(
+            "discrete stored-length weights",
+            format!("eigenvalue {v:e} of K^-1 G, expected finite and > 0"),
+        ));
+    }
+    mu.sort_by(|a, b| b.total_cmp(a));
+    Ok(mu)
+}
+
+/// Euler buckling load of the filament discretized by `n_elements` uniform Hermite-cubic
+/// elements: `1/μ_max`, the smallest generalized eigenvalue of `(K, G)` (closed form, see
+/// [`discrete_buckling_loads`]). It converges to `F_c0 = π²EI/L²` from above as `h⁴`
+/// (the discretization is stiffer).
+///
+/// # Errors
+/// As [`StoredLengthLaw::discrete`].
+pub fn buckling_load_discrete(params: &FilamentParams, n_elements: usize) -> Result<f64> {
+    Ok(discrete_buckling_loads(params, n_elements)?[0])
+}
+
+/// Accuracy knobs of the quadrature (defaults: step scale 1, level 40).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadratureOptions {
+    /// Multiplies the trapezoid step chosen from the aliasing bound (`< 1` refines).
+    pub step_scale: f64,
+    /// The level T: tails, aliasing and range are cut at `e^{−T}`.
+    pub decay_exponent: f64,
+}
+
+impl Default for QuadratureOptions {
+    fn default() -> Self {
+        QuadratureOptions {
+            step_scale: 1.0,
+            decay_exponent: 40.0,
+        }
+    }
+}
+
+/// The exact equilibrium force–strain theory for one filament (parameters + stored-length
+/// law). See the module documentation for the method.
+#[derive(Debug, Clone)]
+pub struct CompressionTheory {
+    params: FilamentParams,
+    law: StoredLengthLaw,
+    options: QuadratureOptions,
+    /// Positive weights only, descending.
+    weights: Vec<f64>,
+    half_d: f64,
+    /// A = EA·L/(2kT).
+    a: f64,
+    /// kT/L.
+    force_unit: f64,
+}
+
+/// Contour parameters at one strain.
+#[derive(Debug, Clone, Copy)]
+struct Setup {
+    eta: f64,
+    m: f64,
+    h: f64,
+    tau_max: f64,
+    level: f64,
+}
+
+/// The tilted characteristic function on a contour, split into explicit and series modes.
+struct Contour {
+    half_d: f64,
+    m: f64,
+    inv4a: f64,
+    explicit: Vec<f64>,
+    series: Vec<f64>,
+    tail_lin: f64,
+    tail_half_var: f64,
+}
+
+impl Contour {
+    /// `ln φ_η(τ)`.
+    fn log_phi(&self, tau: f64) -> Complex<f64> {
+        let (mut re, mut im) = (0.0, 0.0);
+        for &b in &self.explicit {
+            let x = b * tau;
+            re -= 0.5 * self.half_d * (x * x).ln_1p();
+            im += self.half_d * x.atan();
+        }
+        let mut acc = Complex::new(0.0, 0.0);
+        if !self.series.is_empty() {
+            let z = Complex::new(0.0, tau);
+            for &a in self.series.iter().rev() {
+                acc = acc * z + a;
+            }
+            acc *= z;
+        }
+        Complex::new(
+            re + acc.re - self.tail_half_var * tau * tau,
+            im + acc.im + tau * self.tail_lin,
+        )
+    }
+
+    /// `φ_η(τ) e^{−iτm}`.
+    fn shifted(&self, tau: f64) -> Complex<f64> {
+        let l = self.log_phi(tau);
+        Complex::from_polar(l.re.exp(), l.im - tau * self.m)
+    }
+
+    /// `f(τ) = φ_η(τ) e^{−iτm} e^{−τ²/(4A)}`.
+    fn integrand(&self, tau: f64) -> Complex<f64> {
+        let l = self.log_phi(tau);
+        Complex::from_polar((l.re - tau * tau * self.inv4a).exp(), l.im - tau * self.m)
+    }
+}
+
+/// Trapezoid sums `s0 = Σf`, `s1 = Σ τ f / i`, `s2 = Σ τ² f` over the full line.
+#[derive(Debug, Clone, Copy)]
+struct Moments {
+    s0: f64,
+    s1: f64,
+    s2: f64,
+}
+
+impl CompressionTheory {
+    /// Builds the theory for `params` (uses EA, kT, L) and a stored-length law computed
+    /// for the same parameters.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for invalid parameters or an ill-formed law.
+    pub fn new(params: &FilamentParams, law: StoredLengthLaw) -> Result<Self> {
+        params.validate()?;
+        law.validate()?;
+        let mut weights: Vec<f64> = law.weights.iter().copied().filter(|&c| c > 0.0).collect();
+        weights.sort_by(|a, b| b.total_cmp(a));
+        Ok(CompressionTheory {
+            params: *params,
+            half_d: 0.5 * law.copies as f64,
+            law,
+            options: QuadratureOptions::default(),
+            weights,
+            a: params.stretch_rigidity * params.length / (2.0 * params.kt),
+            force_unit: params.kt / params.length,
+        })
+    }
+
+    /// The same theory with other quadrature settings.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless `0 < step_scale ≤ 1` and
+    /// `10 ≤ decay_exponent ≤ 200`.
+    pub fn with_options(mut self, options: QuadratureOptions) -> Result<Self> {
+        if !(options.step_scale > 0.0 && options.step_scale <= 1.0) {
+            return Err(Error::invalid(
+                "step_scale",
+                options.step_scale,
+                "in (0, 1]",
+            ));
+        }
+        if !(options.decay_exponent >= 10.0 && options.decay_exponent <= 200.0) {
+            return Err(Error::invalid(
+                "decay_exponent",
+                options.decay_exponent,
+                "in [10, 200]",
+            ));
+        }
+        self.options = options;
+        Ok(self)
+    }
+
+    /// The physical parameters.
+    pub fn params(&self) -> &FilamentParams {
+        &self.params
+    }
+
+    /// The stored-length law.
+    pub fn law(&self) -> &StoredLengthLaw {
+        &self.law
+    }
+
+    /// The quadrature settings.
+    pub fn options(&self) -> QuadratureOptions {
+        self.options
+    }
+
+    /// `(kT/L)/(2 c_max)`: the buckling load of the law's stiffest-to-buckle mode (F_c0 for
+    /// the continuum, [`buckling_load_discrete`] for a mesh); `+∞` without weights.
+    pub fn buckling_load(&self) -> f64 {
+        match self.weights.first() {
+            Some(&c) => self.force_unit / (2.0 * c),
+            None => f64::INFINITY,
+        }
+    }
+
+    fn eta_max(&self) -> f64 {
+        match self.weights.first() {
+            Some(&c) => 1.0 / (2.0 * c),
+            None => f64::INFINITY,
+        }
+    }
+
+    fn psi(&self, eta: f64) -> f64 {
+        self.law.cumulant_generating_fn(eta)
+    }
+
+    fn psi1(&self, eta: f64) -> f64 {
+        let d = 2.0 * self.half_d;
+        let mut acc = 0.0;
+        for &c in self.weights.iter().rev() {
+            acc += d * c / (1.0 - 2.0 * c * eta);
+        }
+        acc + self.law.tail_mean + eta * self.law.tail_variance
+    }
+
+    fn psi2(&self, eta: f64) -> f64 {
+        let d = 2.0 * self.half_d;
+        let mut acc = 0.0;
+        for &c in self.weights.iter().rev() {
+            let q = c / (1.0 - 2.0 * c * eta);
+            acc += 2.0 * d * q * q;
+        }
+        acc + self.law.tail_variance
+    }
+
+    /// The saddle point η̂: `ψ'(η) + η/(2A) = ε`, by safeguarded Newton on a bracket.
+    fn saddle(&self, strain: f64) -> Result<f64> {
+        let inv2a = 0.5 / self.a;
+        let g = |eta: f64| self.psi1(eta) + eta * inv2a - strain;
+        let mean = self.law.mean();
+        let mut lo = (2.0 * self.a * (strain - mean)).min(0.0) - 1.0;
+        let emax = self.eta_max();
+        let mut hi = if emax.is_finite() {
+            let mut r = 0.5_f64;
+            loop {
+                let cand = emax * (1.0 - r);
+                if cand > lo && g(cand) > 0.0 {
+                    break cand;
+                }
+                r *= 0.25;
+                if r < 1e-15 {
+                    return Err(numerical(
+                        "compression saddle point",
+                        format!(
+                            "strain {strain:e} too far beyond buckling for a double-precision \
+                             contour (distance to the singularity below 1e-15 relative)"
+                        ),
+                    ));
+                }
+            }
+        } else {
+            (2.0 * self.a * strain).max(0.0) + 1.0
+        };
+        // g is increasing and convex: Newton from the right converges monotonically; the
+        // bracket guards against rounding.
+        let mut eta = hi;
+        for _ in 0..300 {
+            let gv = g(eta);
+            let g_scale = strain.abs() + mean + eta.abs() * inv2a;
+            if gv.abs() <= 1e-15 * g_scale {
+                return Ok(eta);
+            }
+            if gv > 0.0 {
+                hi = eta;
+            } else {
+                lo = eta;
+            }
+            let slope = self.psi2(eta) + inv2a;
+            let mut next = eta - gv / slope;
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if (next - eta).abs() <= 1e-15 * eta.abs() || hi - lo <= 1e-15 * hi.abs().max(lo.abs())
+            {
+                return Ok(next);
+            }
+            eta = next;
+        }
+        Ok(eta)
+    }
+
+    /// Chernoff bounds `P(s_η − m > x_R) ≤ e^{−level}`, `P(s_η − m < −x_L) ≤ e^{−level}`
+    /// for the tilted law s_η (density ∝ p₀(s)e^{ηs}), minimized over a ladder of
+    /// exponents θ (right: θ below the singularity distance δ).
+    fn chernoff(&self, eta: f64, m: f64, level: f64) -> (f64, f64) {
+        let var = self.psi2(eta);
+        if var <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let p0 = self.psi(eta);
+        let delta = self.eta_max() - eta;
+        let theta0 = (2.0 * level / var).sqrt();
+        let mut ladder: Vec<f64> = (-24..=24)
+            .map(|k| theta0 * 2f64.powf(k as f64 / 2.0))
+            .collect();
+        let (mut x_l, mut x_r) = (f64::INFINITY, f64::INFINITY);
+        for &th in &ladder {
+            let v = (level + self.psi(eta - th) - p0 + th * m) / th;
+            if v.is_finite() {
+                x_l = x_l.min(v);
+            }
+        }
+        if delta.is_finite() {
+            ladder.retain(|&th| th < delta * 0.999);
+            ladder.extend((1..=24).map(|k| delta * (1.0 - 2f64.powi(-k))));
+        }
+        for &th in &ladder {
+            let v = (level + self.psi(eta + th) - p0 - th * m) / th;
+            if v.is_finite() {
+                x_r = x_r.min(v);
+            }
+        }
+        (x_l.max(0.0), x_r.max(0.0))
+    }
+
+    fn setup(&self, strain: f64) -> Result<Setup> {
+        if !strain.is_finite() {
+            return Err(Error::invalid("strain", strain, "finite"));
+        }
+        let eta = self.saddle(strain)?;
+        let m = strain - eta * 0.5 / self.a;
+        let var_g = 0.5 / self.a;
+        let sigma_y = (self.psi2(eta) + var_g).sqrt();
+        let t = self.options.decay_exponent;
+        let level = t + (sigma_y / var_g.sqrt()).ln().max(0.0) + 2.0;
+        let (x_l, x_r) = self.chernoff(eta, m, level);
+        let period = x_l.max(x_r) + (level / self.a).sqrt();
+        let h = 2.0 * PI / period * self.options.step_scale;
+        let tau_max = (4.0 * self.a * (level + RANGE_MARGIN)).sqrt();
+        if !(h.is_finite() && h > 0.0 && tau_max.is_finite()) {
+            return Err(numerical(
+                "compression quadrature",
+                format!("bad step {h:e} or range {tau_max:e} at strain {strain:e}"),
+            ));
+        }
+        Ok(Setup {
+            eta,
+            m,
+            h,
+            tau_max,
+            level,
+        })
+    }
+
+    fn contour(&self, s: &Setup, tau_range: f64) -> Contour {
+        let mut explicit = Vec::new();
+        let mut power = vec![0.0; SERIES_TERMS];
+        for &c in &self.weights {
+            let b = 2.0 * c / (1.0 - 2.0 * c * s.eta);
+            if b * tau_range > SERIES_RADIUS {
+                explicit.push(b);
+            } else {
+                let mut bk = b;
+                for p in power.iter_mut() {
+                    *p += bk;
+                    bk *= b;
+                    if bk == 0.0 {
+                        break;
+                    }
+                }
+            }
+        }
+        let series = if power[0] > 0.0 {
+            power
+                .iter()
+                .enumerate()
+                .map(|(k, p)| self.half_d * p / (k + 1) as f64)
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Contour {
+            half_d: self.half_d,
+            m: s.m,
+            inv4a: 0.25 / self.a,
+            explicit,
+            series,
+            tail_lin: self.law.tail_mean + s.eta * self.law.tail_variance,
+            tail_half_var: 0.5 * self.law.tail_variance,
+        }
+    }
+
+    /// `|φ_η(τ)|` over all modes (monotone decreasing in |τ|).
+    fn abs_phi(&self, eta: f64, tau: f64) -> f64 {
+        let mut re = 0.0;
+        for &c in self.weights.iter().rev() {
+            let x = 2.0 * c / (1.0 - 2.0 * c * eta) * tau;
+            re -= 0.5 * self.half_d * (x * x).ln_1p();
+        }
+        (re - 0.5 * self.law.tail_variance * tau * tau).exp()
+    }
+
+    fn moments(&self, s: &Setup, c: &Contour) -> Moments {
+        let (mut s0, mut s1, mut s2) = (1.0, 0.0, 0.0);
+        let cutoff = (-s.level).exp();
+        let weight_max = 1.0 + s.tau_max * s.tau_max;
+        let mut j = 1usize;
+        loop {
+            let tau = j as f64 * s.h;
+            if tau > s.tau_max {
+                break;
+            }
+            let f = c.integrand(tau);
+            s0 += 2.0 * f.re;
+            s1 += 2.0 * tau * f.im;
+            s2 += 2.0 * tau * tau * f.re;
+            let remaining = (s.tau_max - tau) / s.h + 1.0;
+            if f.norm() * weight_max * remaining < cutoff * s0.abs() {
+                break;
+            }
+            j += 1;
+        }
+        Moments { s0, s1, s2 }
+    }
+
+    fn evaluate(&self, strain: f64) -> Result<(Setup, Moments)> {
+        let s = self.setup(strain)?;
+        let c = self.contour(&s, s.tau_max);
+        let mo = self.moments(&s, &c);
+        if !(mo.s0.is_finite() && mo.s0 > 0.0 && mo.s1.is_finite() && mo.s2.is_finite()) {
+            return Err(numerical(
+                "compression quadrature",
+                format!(
+                    "non-positive or non-finite normalization {:e} at strain {strain:e}",
+                    mo.s0
+                ),
+            ));
+        }
+        Ok((s, mo))
+    }
+
+    fn mean_from(&self, s: &Setup, mo: &Moments) -> f64 {
+        self.force_unit * (s.eta - mo.s1 / mo.s0)
+    }
+
+    fn variance_from(&self, mo: &Moments) -> f64 {
+        let r1 = mo.s1 / mo.s0;
+        let ea = self.params.stretch_rigidity;
+        (ea * self.force_unit - self.force_unit * self.force_unit * (mo.s2 / mo.s0 + r1 * r1))
+            .max(0.0)
+    }
+
+    /// The exact equilibrium mean compressive force ⟨F⟩ at imposed nominal strain ε
+    /// (physical units; negative = tension).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a non-finite strain; [`Error::Numerical`] if the
+    /// quadrature fails (e.g. a strain so large that the contour cannot be resolved in
+    /// double precision).
+    pub fn mean_force(&self, strain: f64) -> Result<f64> {
+        let (s, mo) = self.evaluate(strain)?;
+        Ok(self.mean_from(&s, &mo))
+    }
+
+    /// `⟨F⟩/F_c0` at `ε = strain_ratio·ε_c0`, with the continuum `F_c0 = π²EI/L²` and
+    /// `ε_c0 = π²EI/(EA·L²)` ([`FilamentParams::euler_load`], `euler_strain`), also for a
+    /// discrete law.
+    ///
+    /// # Errors
+    /// As [`Self::mean_force`].
+    pub fn force_ratio(&self, strain_ratio: f64) -> Result<f64> {
+        if !strain_ratio.is_finite() {
+            return Err(Error::invalid("strain_ratio", strain_ratio, "finite"));
+        }
+        Ok(self.mean_force(strain_ratio * self.params.euler_strain())? / self.params.euler_load())
+    }
+
+    /// The exact equilibrium variance of F at strain ε.
+    ///
+    /// # Errors
+    /// As [`Self::mean_force`].
+    pub fn force_variance(&self, strain: f64) -> Result<f64> {
+        let (_, mo) = self.evaluate(strain)?;
+        Ok(self.variance_from(&mo))
+    }
+
+    /// The Gaussian mean-field (saddle-point) force `(kT/L)η̂`: the tension that makes the
+    /// mean stored length of the Gaussian ensemble under that tension, plus the elastic
+    /// strain F/EA, equal to ε. Not exact; it never exceeds [`Self::buckling_load`]. For
+    /// comparison only.
+    ///
+    /// # Errors
+    /// As [`Self::mean_force`].
+    pub fn mean_field_force(&self, strain: f64) -> Result<f64> {
+        if !strain.is_finite() {
+            return Err(Error::invalid("strain", strain, "finite"));
+        }
+        Ok(self.force_unit * self.saddle(strain)?)
+    }
+
+    /// The exact equilibrium distribution of `F = EA(ε − s)` at strain ε.
+    ///
+    /// # Errors
+    /// As [`Self::mean_force`].
+    pub fn force_distribution(&self, strain: f64) -> Result<ForceDistribution> {
+        let (s, mo) = self.evaluate(strain)?;
+        let mean = self.mean_from(&s, &mo);
+        let std_dev = self.variance_from(&mo).sqrt();
+        let a = self.a;
+        // Z = E_q[e^{−A(s−m)²}] = √(π/A)/(2π) · h · s0
+        let z = (PI / a).sqrt() / (2.0 * PI) * s.h * mo.s0;
+        let level = self.options.decay_exponent + (-z.ln()).max(0.0);
+        let w = (level / a).sqrt();
+        let (x_l, x_r) = self.chernoff(s.eta, s.m, level);
+        let lo = -(w.min(x_l));
+        let hi = w.min(x_r);
+        let width = (hi - lo).max(1e-300);
+        let x0 = lo - 0.02 * width;
+        let period = 1.04 * width;
+        let du = 2.0 * PI / period;
+        let rho_exp = self.options.decay_exponent + RANGE_MARGIN;
+        let rho = (4.0 * a * rho_exp).sqrt();
+        let kernel_mass = (4.0 * PI * a).sqrt() / s.h + 1.0;
+        let bound = |u: f64| {
+            (self.abs_phi(s.eta, (u - rho).max(0.0)) * kernel_mass
+                + (2.0 * u / s.h + 1.0) * (-rho_exp).exp())
+                / mo.s0
+        };
+        // smallest K with bound(KΔ) ≤ tolerance (bound is monotone up to the tiny
+        // linear term), capped
+        let mut k_hi = 1usize;
+        while bound(k_hi as f64 * du) > CDF_TOLERANCE && k_hi < MAX_FOURIER_TERMS {
+            k_hi = (2 * k_hi).min(MAX_FOURIER_TERMS);
+        }
+        let mut k_lo = k_hi / 2;
+        while k_hi - k_lo > 1 {
+            let mid = (k_lo + k_hi) / 2;
+            if bound(mid as f64 * du) > CDF_TOLERANCE {
+                k_lo = mid;
+            } else {
+                k_hi = mid;
+            }
+        }
+        let k_cap = k_hi;
+        let rigorous_bound = bound(k_cap as f64 * du);
+        let c = self.contour(&s, k_cap as f64 * du + rho);
+        let inv4a = 0.25 / a;
+        // φ_η(τ_j) e^{−iτ_j m} at τ_j = j h, j ≥ 0, extended on demand
+        let mut vals: Vec<Complex<f64>> = Vec::new();
+        let mut kernel_sum = |u: f64| -> Complex<f64> {
+            let jlo = ((u - rho) / s.h).ceil() as i64;
+            let jhi = ((u + rho) / s.h).floor() as i64;
+            while (vals.len() as i64) <= jhi.max(-jlo) {
+                let tau = vals.len() as f64 * s.h;
+                vals.push(c.shifted(tau));
+            }
+            let mut acc = Complex::new(0.0, 0.0);
+            for j in jlo..=jhi {
+                let v = if j >= 0 {
+                    vals[j as usize]
+                } else {
+                    vals[(-j) as usize].conj()
+                };
+                let d = j as f64 * s.h - u;
+                acc += v * (-d * d * inv4a).exp();
+            }
+            acc
+        };
+        let norm = kernel_sum(0.0).re;
+        if !(norm.is_finite() && norm > 0.0) {
+            return Err(numerical(
+                "compression force distribution",
+                format!("non-positive normalization {norm:e} at strain {strain:e}"),
+            ));
+        }
+        // Terms k = 1..K; stop at K = 2^j ≥ 16 once every |χ(kΔ)|, K/2 < k ≤ K, is below
+        // the tolerance (observed decay), or at the rigorous cap.
+        let mut coeffs: Vec<Complex<f64>> = Vec::new();
+        let mut block_max = 0.0_f64;
+        let mut truncation_bound = rigorous_bound;
+        for k in 1..=k_cap {
+            let chi = kernel_sum(k as f64 * du) / norm;
+            block_max = block_max.max(chi.norm());
+            coeffs.push(chi / k as f64);
+            if k.is_power_of_two() {
+                if k >= 16 && block_max < CDF_TOLERANCE {
+                    truncation_bound = block_max;
+                    break;
+                }
+                block_max = 0.0;
+            }
+        }
+        let mut dist = ForceDistribution {
+            strain,
+            ea: self.params.stretch_rigidity,
+            mean_field_force: self.force_unit * s.eta,
+            x0,
+            period,
+            du,
+            coeffs,
+            c0: 0.0,
+            mean,
+            std_dev,
+            truncation_bound,
+        };
+        dist.c0 = dist.series_im(x0);
+        Ok(dist)
+    }
+}
+
+/// The exact equilibrium distribution of the compressive force `F = EA(ε − s)` at one
+/// strain, from a Fourier series of the stored length's tilted law (module docs).
+#[derive(Debug, Clone)]
+pub struct ForceDistribution {
+    strain: f64,
+    ea: f64,
+    mean_field_force: f64,
+    /// Window start of X = s − m.
+    x0: f64,
+    period: f64,
+    du: f64,
+    /// χ(kΔ)/k, k = 1..
+    coeffs: Vec<Complex<f64>>,
+    c0: f64,
+    mean: f64,
+    std_dev: f64,
+    truncation_bound: f64,
+}
+
+impl ForceDistribution {
+    /// `Σ_k Im[χ(kΔ) e^{−ikΔx}]/k`.
+    fn series_im(&self, x: f64) -> f64 {
+        let mut acc = 0.0;
+        let mut z = Complex::new(1.0, 0.0);
+        let r = Complex::from_polar(1.0, -self.du * x);
+        for (i, g) in self.coeffs.iter().enumerate() {
+            let k = i + 1;
+            if k % 64 == 0 {
+                z = Complex::from_polar(1.0, -(k as f64) * self.du * x);
+            } else {
+                z *= r;
+            }
+            acc += (g * z).im;
+        }
+        acc
+    }
+
+    /// CDF of X = s − m.
+    fn cdf_x(&self, x: f64) -> f64 {
+        if x <= self.x0 {
+            0.0
+        } else if x >= self.x0 + self.period {
+            1.0
+        } else {
+            ((x - self.x0) / self.period - (self.series_im(x) - self.c0) / PI).clamp(0.0, 1.0)
+        }
+    }
+
+    /// `P(F ≤ f)`.
+    pub fn cdf(&self, f: f64) -> f64 {
+        if f.is_nan() {
+            return f64::NAN;
+        }
+        1.0 - self.cdf_x((self.mean_field_force - f) / self.ea)
+    }
+
+    /// ⟨F⟩ (the same value as [`CompressionTheory::mean_force`]).
+    pub fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// Standard deviation of F (square root of [`CompressionTheory::force_variance`]).
+    pub fn std_dev(&self) -> f64 {
+        self.std_dev
+    }
+
+    /// The imposed strain ε.
+    pub fn strain(&self) -> f64 {
+        self.strain
+    }
+
+    /// Interval of F outside which the CDF is 0 or 1 (it holds all but `≈ e^{−40}` of the
+    /// probability).
+    pub fn support(&self) -> (f64, f64) {
+        (
+            self.mean_field_force - self.ea * (self.x0 + self.period),
+            self.mean_field_force - self.ea * self.x0,
+        )
+    }
+
+    /// Number of Fourier terms of the series.
+    pub fn fourier_terms(&self) -> usize {
+        self.coeffs.len()
+    }
+
+    /// Size of the omitted Fourier coefficients: the largest |χ(kΔ)| over the last half of
+    /// the retained terms when the series stopped on observed decay (below 10⁻¹⁴), else the
+    /// rigorous bound on |χ| at the first omitted term (10⁻¹⁴, or larger if the cap of
+    /// 2·10⁵ terms was reached).
+    pub fn truncation_bound(&self) -> f64 {
+        self.truncation_bound
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_power_tails_are_consistent() {
+        let zeta = [PI * PI / 6.0, PI.powi(4) / 90.0];
+        for (i, &p) in [2u32, 4].iter().enumerate() {
+            assert!(
+                (inverse_power_tail(p, 0) / zeta[i] - 1.0).abs() < 1e-15,
+                "p = {p}"
+            );
+            let head: f64 = (1..=5).map(|n| (n as f64).powi(-(p as i32))).sum();
+            let t5 = inverse_power_tail(p, 5);
+            assert!(((t5 + head) / zeta[i] - 1.0).abs() < 1e-15, "p = {p}");
+            // Euler–Maclaurin at 1000 against Euler–Maclaurin at 5000 plus explicit terms
+            let partial: f64 = (1001..=5000)
+                .rev()
+                .map(|n| (n as f64).powi(-(p as i32)))
+                .sum();
+            let em = inverse_power_tail(p, 5000) + partial;
+            assert!(
+                (inverse_power_tail(p, 1000) / em - 1.0).abs() < 1e-14,
+                "p = {p}"
+            );
+        }
+    }
+
+    #[test]
+    fn char_fn_of_law_matches_cumulants() {
+        let law = StoredLengthLaw {
+            weights: vec![0.3, 0.1],
+            copies: 2,
+            tail_mean: 0.05,
+            tail_variance: 0.01,
+        };
+        let t = 1e-4;
+        let phi = law.char_fn(t);
+        // ln φ ≈ i t κ1 − t² κ2/2
+        let approx = Complex::new(-0.5 * t * t * law.variance(), t * law.mean()).exp();
+        assert!((phi - approx).norm() < 1e-11);
+        assert!((law.cumulant_generating_fn(1e-6) - 1e-6 * law.mean()).abs() < 1e-11);
+    }
+}

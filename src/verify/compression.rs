@@ -1,0 +1,394 @@
+//! Compression scenes: the force–strain curve of the paper's Fig. 2, simulated with the
+//! finite-deflection filament ([`crate::dynamics::nonlinear`]) and judged against the exact
+//! equilibrium theory of the same discretization ([`crate::theory::compression`]), with
+//! the continuum theory beside it.
+
+use crate::dynamics::nonlinear::{CompressedFilament, NonlinearIntegrator};
+use crate::error::{Error, Result};
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::rng::TrajectoryRng;
+use crate::stats;
+use crate::theory::compression::{CompressionTheory, Dims, ForceDistribution, StoredLengthLaw};
+use crate::verify::scene::{CheckKind, CompressionSpec, RunSpec, Scene};
+use crate::verify::summary::CheckResult;
+
+/// Modes of the continuum theory (plus the exact tail cumulants).
+const CONTINUUM_MODES: usize = 10_000;
+/// Thinning of F samples for the KS test, in integrated autocorrelation times.
+const KS_THINNING_TAU: f64 = 10.0;
+
+/// Theory of one compression scene, shared by its runs.
+pub struct CompressionTheoryTable {
+    /// Imposed strains ε/ε_c0.
+    pub strain_ratios: Vec<f64>,
+    /// Exact ⟨F⟩/F_c0 of the discretized filament (same elements and energy as the
+    /// simulation).
+    pub discrete: Vec<f64>,
+    /// Exact ⟨F⟩/F_c0 of the continuum.
+    pub continuum: Vec<f64>,
+    /// Exact law of F at the distribution strains (None elsewhere).
+    pub distributions: Vec<Option<ForceDistribution>>,
+}
+
+impl CompressionTheoryTable {
+    /// Computes the theory for `scene`.
+    ///
+    /// # Errors
+    /// Numerical failures of the theory.
+    pub fn new(scene: &Scene, spec: &CompressionSpec) -> Result<Self> {
+        let p = scene.filament;
+        let dims = Dims::from_u32(scene.dims as u32)?;
+        let disc = CompressionTheory::new(
+            &p,
+            StoredLengthLaw::discrete(&p, dims, scene.mesh.elements)?,
+        )?;
+        let cont =
+            CompressionTheory::new(&p, StoredLengthLaw::continuum(&p, dims, CONTINUUM_MODES)?)?;
+        let mut discrete = Vec::new();
+        let mut continuum = Vec::new();
+        let mut distributions = Vec::new();
+        for &r in &spec.strain_ratios {
+            discrete.push(disc.force_ratio(r)?);
+            continuum.push(cont.force_ratio(r)?);
+            distributions.push(if spec.distribution_strain_ratios.contains(&r) {
+                Some(disc.force_distribution(r * p.euler_strain())?)
+            } else {
+                None
+            });
+        }
+        Ok(CompressionTheoryTable {
+            strain_ratios: spec.strain_ratios.clone(),
+            discrete,
+            continuum,
+            distributions,
+        })
+    }
+}
+
+/// One run (integrator and time step) of a compression scene.
+pub struct CompressionRun {
+    /// The run specification.
+    pub spec: RunSpec,
+    /// Time step.
+    pub dt: f64,
+    /// Burn-in steps at each strain.
+    pub burn_in_steps: u64,
+    /// Steps between samples of F.
+    pub sample_every: u64,
+    models: Vec<CompressedFilament>,
+    euler_load: f64,
+}
+
+/// What one trajectory at one strain recorded.
+#[derive(Debug, Clone, Default)]
+pub struct ForceRecord {
+    /// F/F_c0 every `sample_every` steps after burn-in.
+    pub force_ratio: Vec<f64>,
+    /// Metropolis proposals and acceptances (0 for θ-schemes).
+    pub proposed: u64,
+    /// Accepted proposals.
+    pub accepted: u64,
+}
+
+impl CompressionRun {
+    /// Prepares run `spec` of compression scene `scene`.
+    ///
+    /// # Errors
+    /// Invalid integrator or a time step above an explicit stability limit (exit 2).
+    pub fn prepare(scene: &Scene, comp: &CompressionSpec, spec: &RunSpec) -> Result<Self> {
+        let p = scene.filament;
+        let tau1 = p.tau1();
+        let dt = spec.dt_tau1 * tau1;
+        let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
+        let models: Vec<CompressedFilament> = comp
+            .strain_ratios
+            .iter()
+            .map(|r| CompressedFilament::new(beam.clone(), scene.dims, r * p.euler_strain()))
+            .collect::<Result<_>>()?;
+        // Fails early (exit 2) for a bad integrator or time step.
+        NonlinearIntegrator::new(&models[0], spec.integrator, spec.noise, dt)?;
+        Ok(CompressionRun {
+            spec: spec.clone(),
+            dt,
+            burn_in_steps: (comp.burn_in_tau1 * tau1 / dt).round() as u64,
+            sample_every: ((comp.sample_every_tau1 * tau1 / dt).round() as u64).max(1),
+            models,
+            euler_load: p.euler_load(),
+        })
+    }
+
+    /// Number of steps for a sampled duration (physical time).
+    pub fn sampled_steps(&self, duration: f64) -> u64 {
+        let n = (duration / self.dt).round() as u64;
+        (n / self.sample_every).max(1) * self.sample_every
+    }
+
+    /// Simulates one trajectory at strain index `point` from rest.
+    ///
+    /// # Errors
+    /// [`Error::Diverged`] naming the step, time and strain if the state becomes
+    /// non-finite.
+    pub fn simulate(
+        &self,
+        point: usize,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<ForceRecord> {
+        let model = &self.models[point];
+        let mut integ =
+            NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
+        let n = model.beam().n_dofs();
+        let mut w = vec![vec![0.0; n]; model.components()];
+        let total = self.burn_in_steps + sampled_steps;
+        let mut rec = ForceRecord {
+            force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+            ..Default::default()
+        };
+        for step in 1..=total {
+            integ.step(model, &mut w, rng);
+            if !w.iter().flatten().all(|v| v.is_finite()) {
+                return Err(Error::Diverged {
+                    step,
+                    time: step as f64 * self.dt,
+                    detail: format!(
+                        "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
+                        self.spec.integrator,
+                        model.strain(),
+                        self.spec.dt_tau1
+                    ),
+                });
+            }
+            if step > self.burn_in_steps
+                && (step - self.burn_in_steps).is_multiple_of(self.sample_every)
+            {
+                let f = model.compressive_force(model.stored_length(&w));
+                rec.force_ratio.push(f / self.euler_load);
+            }
+        }
+        rec.proposed = integ.proposed;
+        rec.accepted = integ.accepted;
+        Ok(rec)
+    }
+
+    /// The strains of this run (ε/ε_c0 is in the theory table).
+    pub fn points(&self) -> usize {
+        self.models.len()
+    }
+}
+
+/// Per-strain estimates of one run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ForceEstimates {
+    /// (⟨F⟩/F_c0, standard error) per strain.
+    pub force: Vec<(f64, f64)>,
+    /// Metropolis acceptance rate over the run (1 for θ-schemes).
+    pub acceptance: f64,
+    /// Largest integrated autocorrelation time of F (in samples) over the strains.
+    pub max_tau_int: f64,
+}
+
+/// ⟨F⟩/F_c0 per strain: per trajectory the time average with an autocorrelation-aware
+/// error (integrated autocorrelation time); trajectories are independent, so errors add
+/// in quadrature.
+///
+/// # Errors
+/// Estimator errors (too few samples).
+pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
+    let mut out = ForceEstimates::default();
+    let (mut prop, mut acc) = (0u64, 0u64);
+    for point in records {
+        let mut means = Vec::new();
+        let mut var = 0.0;
+        for r in point {
+            let m = stats::mean_with_error(&r.force_ratio)?;
+            out.max_tau_int = out.max_tau_int.max(m.tau_int);
+            means.push(m.mean);
+            var += m.std_error * m.std_error;
+            prop += r.proposed;
+            acc += r.accepted;
+        }
+        let n = means.len() as f64;
+        out.force
+            .push((means.iter().sum::<f64>() / n, var.sqrt() / n));
+    }
+    out.acceptance = if prop == 0 {
+        1.0
+    } else {
+        acc as f64 / prop as f64
+    };
+    Ok(out)
+}
+
+fn result(
+    name: String,
+    kind: &str,
+    values: (f64, f64, f64),
+    continuum: Option<f64>,
+    p_value: f64,
+    detail: String,
+) -> CheckResult {
+    let finite = |v: f64| v.is_finite().then_some(v);
+    CheckResult {
+        name,
+        kind: kind.to_string(),
+        passed: true,
+        p_value: Some(p_value),
+        p_adjusted: None,
+        estimate: finite(values.0),
+        reference: finite(values.1),
+        std_error: finite(values.2),
+        continuum,
+        reference_kind: "discrete".to_string(),
+        detail,
+    }
+}
+
+/// The force–strain and force-distribution checks of one run.
+///
+/// # Errors
+/// Estimator errors.
+pub fn compression_checks(
+    run: &CompressionRun,
+    checks: &[CheckKind],
+    theory: &CompressionTheoryTable,
+    records: &[Vec<ForceRecord>],
+    est: &ForceEstimates,
+) -> Result<Vec<CheckResult>> {
+    let name = &run.spec.name;
+    let mut out = Vec::new();
+    if checks.contains(&CheckKind::ForceStrain) {
+        let mut z = Vec::new();
+        for (i, &(f, se)) in est.force.iter().enumerate() {
+            let o = stats::z_test(f, theory.discrete[i], se)?;
+            z.push(o.statistic);
+            out.push(result(
+                format!("{name}/force/strain_ratio={}", theory.strain_ratios[i]),
+                "z-test",
+                (f, theory.discrete[i], se),
+                Some(theory.continuum[i]),
+                o.p_value,
+                format!(
+                    "<F>/F_c0 over {} trajectories (IAT errors)",
+                    records[i].len()
+                ),
+            ));
+        }
+        let o = stats::chi2_sum_test(&z)?;
+        out.push(result(
+            format!("{name}/force-strain-chi2"),
+            "chi2-sum",
+            (o.statistic, z.len() as f64, f64::NAN),
+            None,
+            o.p_value,
+            format!(
+                "sum of squared z over {} strains against chi2({})",
+                z.len(),
+                z.len()
+            ),
+        ));
+    }
+    if checks.contains(&CheckKind::ForceDistribution) {
+        for (i, dist) in theory.distributions.iter().enumerate() {
+            let Some(dist) = dist else { continue };
+            // Thin each trajectory's series to effectively independent samples.
+            let mut samples = Vec::new();
+            let mut stride = 1;
+            for r in &records[i] {
+                let tau = stats::integrated_autocorrelation_time(&r.force_ratio)?.tau_int;
+                stride = stride.max((KS_THINNING_TAU * tau).ceil() as usize);
+            }
+            for r in &records[i] {
+                samples.extend(r.force_ratio.iter().step_by(stride).copied());
+            }
+            let fc0 = run.euler_load;
+            let o = stats::ks_test(&samples, |f| dist.cdf(f * fc0))?;
+            out.push(result(
+                format!("{name}/force-ks/strain_ratio={}", theory.strain_ratios[i]),
+                "ks",
+                (o.statistic, f64::NAN, f64::NAN),
+                None,
+                o.p_value,
+                format!(
+                    "{} samples thinned every {stride} (>= {KS_THINNING_TAU} IAT)",
+                    samples.len()
+                ),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// The Δt-halving check: per strain z = (F_Δt − F_Δt/2)/sqrt(se² + se²), combined as
+/// Σz² against χ²(points); estimate = mean difference over strains with its error.
+///
+/// # Errors
+/// Estimator errors.
+pub fn halving_check(
+    names: [&str; 2],
+    a: &ForceEstimates,
+    b: &ForceEstimates,
+) -> Result<(CheckResult, String)> {
+    let z: Vec<f64> = a
+        .force
+        .iter()
+        .zip(&b.force)
+        .map(|(x, y)| (x.0 - y.0) / (x.1 * x.1 + y.1 * y.1).sqrt())
+        .collect();
+    let n = z.len() as f64;
+    let mean_diff = a
+        .force
+        .iter()
+        .zip(&b.force)
+        .map(|(x, y)| x.0 - y.0)
+        .sum::<f64>()
+        / n;
+    let se = a
+        .force
+        .iter()
+        .zip(&b.force)
+        .map(|(x, y)| x.1 * x.1 + y.1 * y.1)
+        .sum::<f64>()
+        .sqrt()
+        / n;
+    let max_diff = a
+        .force
+        .iter()
+        .zip(&b.force)
+        .map(|(x, y)| (x.0 - y.0).abs())
+        .fold(0.0, f64::max);
+    let max_se = a.force.iter().map(|x| x.1).fold(0.0, f64::max);
+    let o = stats::chi2_sum_test(&z)?;
+    let note = format!(
+        "dt-halving ({} vs {}): mean <F>/F_c0 difference {:.2e} ± {:.2e} over {} strains (95% bound on |bias| {:.2e}), largest |difference| {:.2e}; largest point standard error of {} {:.2e}: the time-step bias {} below the standard error",
+        names[0],
+        names[1],
+        mean_diff,
+        se,
+        z.len(),
+        mean_diff.abs() + 2.0 * se,
+        max_diff,
+        names[0],
+        max_se,
+        if mean_diff.abs() + 2.0 * se < max_se {
+            "is shown"
+        } else {
+            "is NOT shown"
+        }
+    );
+    Ok((
+        result(
+            format!("dt-halving/{}-vs-{}", names[0], names[1]),
+            "chi2-sum",
+            (mean_diff, 0.0, se),
+            None,
+            o.p_value,
+            format!(
+                "per-strain z of the difference, sum of z^2 = {:.2} against chi2({})",
+                o.statistic,
+                z.len()
+            ),
+        ),
+        note,
+    ))
+}
