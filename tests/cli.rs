@@ -1339,3 +1339,49 @@ fn same_seed_reproduces_and_new_seed_changes_estimates() {
         "changing the seed changed no estimate: {ea:?}"
     );
 }
+
+/// What: a run that goes unstable stops with an error naming the step and the time, exit
+/// code 3, and writes no summary (no NaN output).
+/// Set-up: the paper's explicit Euler–Maruyama on the compressed filament, just below its
+/// linear stability limit (7.73e-6 tau1 for 10 elements), with EA·L/kT = 1e13: the
+/// stretching stiffness (EA/L)(Gw)(Gw)ᵀ, which the linear limit does not see, blows the
+/// explicit scheme up within a few steps.
+/// Reference: `src/error.rs` (`Diverged`: step and time), the brief's "a run that goes
+/// unstable stops with an error naming the step".
+/// Tolerance: exact substrings.
+#[test]
+fn diverging_run_stops_with_the_step() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/compression-2d.toml"),
+    )
+    .unwrap();
+    let text = replaced(
+        &text,
+        "stretch_rigidity = 1.0e6",
+        "stretch_rigidity = 1.0e13",
+    );
+    let text = text.replace(
+        "integrator = \"metropolis-crank-nicolson\"",
+        "integrator = \"euler-maruyama\"",
+    );
+    let text = text
+        .replace("dt_tau1 = 0.02\n", "dt_tau1 = 7.0e-6\n")
+        .replace("dt_tau1 = 0.01\n", "dt_tau1 = 3.0e-6\n")
+        .replace(
+            "checks = [\"force-strain\", \"force-distribution\", \"dt-halving\"]",
+            "checks = [\"force-strain\"]",
+        );
+    let dir = TempDir::new("diverge");
+    let scene = write_scene(&dir, "diverge", text.as_bytes());
+    let (scene_s, out_s) = (scene.display().to_string(), dir.join_str("out"));
+    let args = ["verify", "--scene", &scene_s, "--out", &out_s];
+    let o = run(&args);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(3), "{}", describe(&args, &o));
+    assert!(
+        err.contains("unstable at step") && err.contains("t = "),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!Path::new(&out_s).join("summary.json").exists());
+}

@@ -49,9 +49,7 @@ pub struct LinearEstimates {
     pub skipped: Vec<String>,
 }
 
-/// A check result before the family-wise correction; `values` is (estimate, reference,
-/// standard error), a non-finite entry meaning "not applicable" (e.g. the reference of a
-/// KS distance).
+/// A check result before the family-wise correction (see [`CheckResult::statistical`]).
 fn check(
     name: String,
     kind: &str,
@@ -60,20 +58,7 @@ fn check(
     continuum: Option<f64>,
     detail: String,
 ) -> CheckResult {
-    let finite = |v: f64| v.is_finite().then_some(v);
-    CheckResult {
-        name,
-        kind: kind.to_string(),
-        passed: true,
-        p_value: Some(outcome.p_value),
-        p_adjusted: None,
-        estimate: finite(values.0),
-        reference: finite(values.1),
-        std_error: finite(values.2),
-        reference_kind: "discrete".to_string(),
-        continuum,
-        detail,
-    }
+    CheckResult::statistical(name, kind, values, continuum, outcome.p_value, detail)
 }
 
 /// Thinned, effectively independent samples of series pooled over trajectories:

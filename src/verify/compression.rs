@@ -29,7 +29,12 @@ pub struct CompressionTheoryTable {
     pub continuum: Vec<f64>,
     /// Exact law of F at the distribution strains (None elsewhere).
     pub distributions: Vec<Option<ForceDistribution>>,
+    /// The exact curves on a fine grid for figures: (ε/ε_c0, discrete, continuum).
+    pub curve: Vec<(f64, f64, f64)>,
 }
+
+/// Points of the fine theory curve drawn in the figures.
+const CURVE_POINTS: usize = 81;
 
 impl CompressionTheoryTable {
     /// Computes the theory for `scene`.
@@ -57,11 +62,28 @@ impl CompressionTheoryTable {
                 None
             });
         }
+        let lo = spec
+            .strain_ratios
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let hi = spec
+            .strain_ratios
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let curve = (0..CURVE_POINTS)
+            .map(|k| {
+                let r = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
+                Ok((r, disc.force_ratio(r)?, cont.force_ratio(r)?))
+            })
+            .collect::<Result<_>>()?;
         Ok(CompressionTheoryTable {
             strain_ratios: spec.strain_ratios.clone(),
             discrete,
             continuum,
             distributions,
+            curve,
         })
     }
 }
@@ -220,30 +242,6 @@ pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
     Ok(out)
 }
 
-fn result(
-    name: String,
-    kind: &str,
-    values: (f64, f64, f64),
-    continuum: Option<f64>,
-    p_value: f64,
-    detail: String,
-) -> CheckResult {
-    let finite = |v: f64| v.is_finite().then_some(v);
-    CheckResult {
-        name,
-        kind: kind.to_string(),
-        passed: true,
-        p_value: Some(p_value),
-        p_adjusted: None,
-        estimate: finite(values.0),
-        reference: finite(values.1),
-        std_error: finite(values.2),
-        continuum,
-        reference_kind: "discrete".to_string(),
-        detail,
-    }
-}
-
 /// The force–strain and force-distribution checks of one run.
 ///
 /// # Errors
@@ -262,7 +260,7 @@ pub fn compression_checks(
         for (i, &(f, se)) in est.force.iter().enumerate() {
             let o = stats::z_test(f, theory.discrete[i], se)?;
             z.push(o.statistic);
-            out.push(result(
+            out.push(CheckResult::statistical(
                 format!("{name}/force/strain_ratio={}", theory.strain_ratios[i]),
                 "z-test",
                 (f, theory.discrete[i], se),
@@ -275,7 +273,7 @@ pub fn compression_checks(
             ));
         }
         let o = stats::chi2_sum_test(&z)?;
-        out.push(result(
+        out.push(CheckResult::statistical(
             format!("{name}/force-strain-chi2"),
             "chi2-sum",
             (o.statistic, z.len() as f64, f64::NAN),
@@ -303,7 +301,7 @@ pub fn compression_checks(
             }
             let fc0 = run.euler_load;
             let o = stats::ks_test(&samples, |f| dist.cdf(f * fc0))?;
-            out.push(result(
+            out.push(CheckResult::statistical(
                 format!("{name}/force-ks/strain_ratio={}", theory.strain_ratios[i]),
                 "ks",
                 (o.statistic, f64::NAN, f64::NAN),
@@ -377,7 +375,7 @@ pub fn halving_check(
         }
     );
     Ok((
-        result(
+        CheckResult::statistical(
             format!("dt-halving/{}-vs-{}", names[0], names[1]),
             "chi2-sum",
             (mean_diff, 0.0, se),

@@ -178,22 +178,12 @@ fn run_compression_scene(
     )
     .series(Series::line(
         "exact, discretized filament",
-        theory
-            .strain_ratios
-            .iter()
-            .copied()
-            .zip(theory.discrete.iter().copied())
-            .collect(),
+        theory.curve.iter().map(|c| (c.0, c.1)).collect(),
     ))
     .series(
         Series::line(
             "exact, continuum",
-            theory
-                .strain_ratios
-                .iter()
-                .copied()
-                .zip(theory.continuum.iter().copied())
-                .collect(),
+            theory.curve.iter().map(|c| (c.0, c.2)).collect(),
         )
         .dashed(),
     )
@@ -260,7 +250,7 @@ fn run_compression_scene(
             curves.retain(|c| c.dims != scene.dims);
             curves.push(Curve {
                 dims: scene.dims,
-                theory: rows.iter().map(|r| (r[0], r[3], r[4])).collect(),
+                theory: theory.curve.clone(),
                 simulated: rows.iter().map(|r| (r[0], r[1], r[2])).collect(),
             });
         }
@@ -289,7 +279,7 @@ fn run_compression_scene(
 /// solid, continuum: dashed) and simulated points with error bars.
 fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
     let mut fig = Figure::new(
-        "Fig. 2: compressive force of a thermally fluctuating hinged filament (EI/kTL = 100, EA L/kT = 1e6, 10 elements)",
+        "Fig. 2: thermally fluctuating hinged filament under imposed compression",
         "strain / Euler strain",
         "<F> / Euler load",
     )
@@ -418,30 +408,7 @@ fn run_scene(
             notes.push(noise_study(scene, &dir, &mut figures, &mut tables)?);
         }
     }
-    let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
-    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, opts.alpha)) {
-        c.p_adjusted = Some(adj);
-        c.passed = !reject;
-    }
-    let rel = |v: Vec<PathBuf>| -> Vec<String> {
-        v.iter()
-            .map(|p| {
-                p.strip_prefix(&opts.out)
-                    .unwrap_or(p)
-                    .to_string_lossy()
-                    .into_owned()
-            })
-            .collect()
-    };
-    Ok(SceneSummary {
-        name: scene.name.clone(),
-        passed: checks.iter().all(|c| c.passed),
-        wall_seconds: start.elapsed().as_secs_f64(),
-        figures: rel(figures),
-        tables: rel(tables),
-        notes,
-        checks,
-    })
+    finish_scene(scene, checks, figures, tables, notes, start, opts)
 }
 
 fn write_run_outputs(

@@ -31,6 +31,36 @@ pub struct CheckResult {
     pub detail: String,
 }
 
+impl CheckResult {
+    /// A statistical check before the family-wise correction (`passed` is set by the
+    /// runner's Holm step). `values` is (estimate, reference, standard error) against the
+    /// exact discrete reference; a non-finite entry means "not applicable" (e.g. the
+    /// reference of a KS distance) and is stored as `None`.
+    pub fn statistical(
+        name: String,
+        kind: &str,
+        values: (f64, f64, f64),
+        continuum: Option<f64>,
+        p_value: f64,
+        detail: String,
+    ) -> Self {
+        let finite = |v: f64| v.is_finite().then_some(v);
+        CheckResult {
+            name,
+            kind: kind.to_string(),
+            passed: true,
+            p_value: Some(p_value),
+            p_adjusted: None,
+            estimate: finite(values.0),
+            reference: finite(values.1),
+            std_error: finite(values.2),
+            continuum,
+            reference_kind: "discrete".to_string(),
+            detail,
+        }
+    }
+}
+
 /// The result of one scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SceneSummary {

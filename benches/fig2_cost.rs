@@ -1,0 +1,81 @@
+//! What the paper's explicit scheme would need for the Fig. 2 accuracy, measured on a
+//! short run and extrapolated (labelled as such in the README).
+//!
+//! For each compression scene, the cost of one step is measured for the paper's explicit
+//! Euler–Maruyama (with the axial solve of step i, at half its stability limit) and for the
+//! Metropolis-adjusted Crank–Nicolson used by the scene, on the same filament at
+//! ε = 3 ε_c0. The simulated time the scene needs at the full budget (all strains,
+//! trajectories, burn-in and sampling of its primary run) is then converted into the number
+//! of explicit steps and an extrapolated wall time. The extrapolation assumes the explicit
+//! scheme needs the same simulated time for the same error bar (its correlation times are
+//! the physical ones), which flatters it: it is a lower bound.
+//!
+//! Run: `cargo bench --bench fig2_cost`.
+
+use langevin_fem::dynamics::IntegratorKind;
+use langevin_fem::dynamics::nonlinear::{CompressedFilament, NonlinearIntegrator};
+use langevin_fem::fem::beam::BeamModel;
+use langevin_fem::fem::mesh::Mesh;
+use langevin_fem::fem::noise::NoiseModel;
+use langevin_fem::rng::trajectory_rng;
+use langevin_fem::verify::Scene;
+use langevin_fem::verify::scene::Budget;
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+fn ns_per_step(model: &CompressedFilament, kind: IntegratorKind, dt: f64, steps: u64) -> f64 {
+    let mut integ =
+        NonlinearIntegrator::new(model, kind, NoiseModel::Consistent, dt).expect("integrator");
+    let mut w = vec![vec![0.0; model.beam().n_dofs()]; model.components()];
+    let mut rng = trajectory_rng(1, 0);
+    // Warm up into the fluctuating state, then time.
+    for _ in 0..steps / 4 {
+        integ.step(model, &mut w, &mut rng);
+    }
+    let t = Instant::now();
+    for _ in 0..steps {
+        integ.step(model, &mut w, &mut rng);
+    }
+    black_box(&w);
+    t.elapsed().as_nanos() as f64 / steps as f64
+}
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification");
+    println!(
+        "| scene | explicit dt / tau1 | explicit ns/step | scene dt / tau1 | scene ns/step | simulated tau1 (full budget) | scene steps | explicit steps | explicit wall (extrapolated, 1 core) |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for name in ["compression-2d", "compression-3d"] {
+        let scene = Scene::load(&root.join(format!("{name}.toml"))).expect("scene");
+        let comp = scene.compression.as_ref().expect("compression scene");
+        let p = scene.filament;
+        let tau1 = p.tau1();
+        let beam = BeamModel::new(
+            p,
+            Mesh::uniform(p.length, scene.mesh.elements).expect("mesh"),
+        )
+        .expect("beam");
+        let limit = 2.0 / beam.max_rate().expect("max rate");
+        let model =
+            CompressedFilament::new(beam, scene.dims, 3.0 * p.euler_strain()).expect("model");
+        let run = &scene.runs[0];
+        let e = run.ensemble(Budget::Full);
+        let simulated = comp.strain_ratios.len() as f64
+            * e.trajectories as f64
+            * (e.duration_tau1 + comp.burn_in_tau1);
+        let dt_explicit = 0.5 * limit;
+        let explicit = ns_per_step(&model, IntegratorKind::EulerMaruyama, dt_explicit, 400_000);
+        let scene_cost = ns_per_step(&model, run.integrator, run.dt_tau1 * tau1, 100_000);
+        let scene_steps = simulated / run.dt_tau1;
+        let explicit_steps = simulated * tau1 / dt_explicit;
+        let wall = explicit_steps * explicit * 1e-9;
+        println!(
+            "| {name} | {:.2e} | {explicit:.0} | {:.2e} | {scene_cost:.0} | {simulated:.3e} | {scene_steps:.2e} | {explicit_steps:.2e} | {:.1} h |",
+            dt_explicit / tau1,
+            run.dt_tau1,
+            wall / 3600.0
+        );
+    }
+}
