@@ -1,5 +1,6 @@
 //! Argument parsing (clap) and dispatch.
 
+mod converge;
 mod theory;
 mod verify;
 
@@ -21,6 +22,8 @@ enum Command {
     Theory(theory::TheoryArgs),
     /// Run verification scenes and write reports.
     Verify(verify::VerifyArgs),
+    /// Convergence study of a linear scene over the element count or the time step.
+    Converge(converge::ConvergeArgs),
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
@@ -29,5 +32,6 @@ pub fn run() -> Result<i32> {
     match cli.command {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => verify::run(args),
+        Command::Converge(args) => converge::run(args),
     }
 }

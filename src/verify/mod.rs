@@ -9,6 +9,7 @@
 
 pub mod checks;
 pub mod compression;
+pub mod converge;
 pub mod linear;
 pub mod runner;
 pub mod scene;

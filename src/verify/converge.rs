@@ -1,0 +1,956 @@
+//! Convergence studies of the linear scenes (`langevin-fem converge`).
+//!
+//! For each value of the refined parameter (the element count, or the time step Δt/τ1)
+//! the scene is rebuilt with that value, the run is prepared ([`LinearRun::prepare`]) and
+//! its ensemble simulated (rayon over trajectories, one PCG stream per trajectory, so the
+//! result does not depend on the thread count). The observables are ⟨w²(L/2)⟩ and the
+//! stationary variances of discrete modes 1–3. For each one and each value:
+//!
+//! - the ensemble estimate and its standard error (per trajectory and component:
+//!   autocorrelation-aware errors from [`stats::variance_with_error`] /
+//!   [`stats::mean_with_error`], added in quadrature, as in [`crate::verify::checks`]);
+//! - the exact discrete reference (this mesh, noise model, integrator and Δt);
+//! - the *limit* reference the refinement converges to: the continuum (eq. 2) for
+//!   `--over elements`; for `--over dt` the Δt → 0 limit of the same mesh and noise model
+//!   (the semi-discrete stationary covariance `S_ij = 2kT Σ_q,ij/(λ_i + λ_j)`), because the
+//!   spatial error does not depend on Δt;
+//! - the total error |estimate − limit| with the estimate's standard error, and the exact
+//!   discretization/integrator error |discrete − limit| (no sampling).
+//!
+//! The observed order p of error ∝ h^p (h = L/elements or Δt/τ1) is fitted by weighted
+//! least squares on ln error against ln h ([`fit_order`]), using only points whose total
+//! error exceeds [`FLOOR_SIGMAS`] standard errors; the others are flagged "sampling floor".
+//! The order of the exact error is fitted on all points whose exact error is above
+//! round-off ([`ROUNDING_FACTOR`]). Confidence intervals use Student's t with n − 2 degrees of
+//! freedom (residual scale), so at least three points are needed for an interval.
+
+use crate::dynamics::IntegratorKind;
+use crate::error::{Error, Result};
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::fem::modal::{
+    continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
+};
+use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::rng::{derive_seed, trajectory_rng};
+use crate::stats;
+use crate::verify::linear::{LinearRun, TrajectoryRecord};
+use crate::verify::scene::{Budget, ModelKind, RunSpec, Scene};
+use nalgebra::DVector;
+use rayon::prelude::*;
+use serde::Serialize;
+use statrs::distribution::{ContinuousCDF, StudentsT};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A total error is resolved (not at the sampling floor) if it exceeds this many
+/// standard errors.
+pub const FLOOR_SIGMAS: f64 = 3.0;
+/// An exact error below `ROUNDING_FACTOR · ε · λ_max/λ_1` of the limit reference is
+/// round-off of the references themselves (a dense generalized eigen-decomposition,
+/// whose relative accuracy on the slow modes is about ε·λ_max/λ_1): the discretization
+/// is exact for that observable there and the point is left out of the fit.
+pub const ROUNDING_FACTOR: f64 = 4.0;
+/// Confidence level of the fitted-order intervals.
+pub const CONFIDENCE: f64 = 0.95;
+/// Number of modes reported (modes 1..=3).
+pub const N_MODES: usize = 3;
+/// Default element counts of `--over elements`.
+pub const DEFAULT_ELEMENTS: [usize; 4] = [5, 10, 20, 40];
+/// Default Δt/τ1 of `--over dt` for the unconditionally stable integrators.
+pub const DEFAULT_DT_TAU1: [f64; 4] = [4e-3, 2e-3, 1e-3, 5e-4];
+/// Default fractions of the stability limit of `--over dt` for euler-maruyama.
+pub const DEFAULT_EM_FRACTIONS: [f64; 4] = [0.9, 0.5, 0.25, 0.125];
+/// Allowed element counts (the references use a dense eigen-decomposition).
+pub const ELEMENTS_RANGE: (usize, usize) = (2, 200);
+
+/// The refined parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Over {
+    /// Element count; h = L/elements.
+    Elements,
+    /// Time step; h = Δt/τ1.
+    Dt,
+}
+
+impl Over {
+    /// The name used on the command line and in file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Over::Elements => "elements",
+            Over::Dt => "dt",
+        }
+    }
+}
+
+/// A least-squares fit of ln error = ln C + p ln h.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OrderFit {
+    /// The fitted order p.
+    pub order: f64,
+    /// Its standard error (residual scale, n − 2 degrees of freedom); `None` with two
+    /// points.
+    pub std_error: Option<f64>,
+    /// The [`CONFIDENCE`] interval (Student's t, n − 2 degrees of freedom); `None` with
+    /// two points.
+    pub ci: Option<(f64, f64)>,
+    /// The fitted prefactor C.
+    pub prefactor: f64,
+    /// Number of points used.
+    pub points: usize,
+}
+
+/// Fits the order p of `err ∝ h^p` by (weighted) least squares on ln err against ln h.
+/// With `std_errors`, the weight of a point is (err/se)² (the inverse variance of ln err);
+/// without, all weights are 1. Points with a non-positive or non-finite h, error or
+/// standard error are ignored. Returns `None` with fewer than two usable points or a
+/// single distinct h.
+pub fn fit_order(h: &[f64], err: &[f64], std_errors: Option<&[f64]>) -> Option<OrderFit> {
+    let mut pts = Vec::new();
+    for i in 0..h.len().min(err.len()) {
+        let w = match std_errors {
+            Some(se) => {
+                let s = *se.get(i)?;
+                if !(s.is_finite() && s > 0.0) {
+                    continue;
+                }
+                (err[i] / s).powi(2)
+            }
+            None => 1.0,
+        };
+        if h[i].is_finite() && h[i] > 0.0 && err[i].is_finite() && err[i] > 0.0 {
+            pts.push((h[i].ln(), err[i].ln(), w));
+        }
+    }
+    let n = pts.len();
+    if n < 2 {
+        return None;
+    }
+    let sw: f64 = pts.iter().map(|p| p.2).sum();
+    let xm = pts.iter().map(|p| p.2 * p.0).sum::<f64>() / sw;
+    let ym = pts.iter().map(|p| p.2 * p.1).sum::<f64>() / sw;
+    let sxx: f64 = pts.iter().map(|p| p.2 * (p.0 - xm).powi(2)).sum();
+    if not_above(sxx, 0.0) {
+        return None;
+    }
+    let sxy: f64 = pts.iter().map(|p| p.2 * (p.0 - xm) * (p.1 - ym)).sum();
+    let order = sxy / sxx;
+    let intercept = ym - order * xm;
+    let (std_error, ci) = if n > 2 {
+        let dof = (n - 2) as f64;
+        let rss: f64 = pts
+            .iter()
+            .map(|p| p.2 * (p.1 - intercept - order * p.0).powi(2))
+            .sum();
+        let se = (rss / dof / sxx).sqrt();
+        let t = StudentsT::new(0.0, 1.0, dof)
+            .map(|d| d.inverse_cdf(0.5 + CONFIDENCE / 2.0))
+            .unwrap_or(f64::NAN);
+        (Some(se), Some((order - t * se, order + t * se)))
+    } else {
+        (None, None)
+    };
+    Some(OrderFit {
+        order,
+        std_error,
+        ci,
+        prefactor: intercept.exp(),
+        points: n,
+    })
+}
+
+/// `a` is not above `b` (also when either is NaN).
+fn not_above(a: f64, b: f64) -> bool {
+    a.partial_cmp(&b) != Some(std::cmp::Ordering::Greater)
+}
+
+/// Whether each total error is at the sampling floor: not above [`FLOOR_SIGMAS`]
+/// standard errors.
+pub fn sampling_floor(err: &[f64], std_errors: &[f64]) -> Vec<bool> {
+    err.iter()
+        .zip(std_errors)
+        .map(|(e, s)| not_above(*e, FLOOR_SIGMAS * s))
+        .collect()
+}
+
+/// The observables: `0` is ⟨w²(L/2)⟩, `1..=3` the variances of modes 1–3.
+pub fn observable_names() -> Vec<String> {
+    std::iter::once("w2(L/2)".to_string())
+        .chain((1..=N_MODES).map(|n| format!("mode{n}")))
+        .collect()
+}
+
+/// The exact references of one value of the refined parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointReference {
+    /// The value (element count or Δt/τ1).
+    pub value: f64,
+    /// h: L/elements, or Δt/τ1.
+    pub h: f64,
+    /// Exact discrete value per observable (order of [`observable_names`]).
+    pub discrete: Vec<f64>,
+    /// Limit reference per observable (continuum, or the Δt → 0 limit of this mesh).
+    pub limit: Vec<f64>,
+    /// Relative round-off level of the references, [`ROUNDING_FACTOR`]·ε·λ_max/λ_1.
+    pub rounding_rel: f64,
+}
+
+/// The expected order of the error of one observable, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Expected {
+    /// The order, if the theory predicts a power law; `None` if the discretization is
+    /// exact for this observable or no single order applies.
+    pub order: Option<f64>,
+    /// Whether the error is exactly zero (up to round-off).
+    pub exact: bool,
+    /// The reason.
+    pub why: String,
+}
+
+/// The expected order of the error of observable `obs` (index into
+/// [`observable_names`]) when refining `over` with this run's integrator and noise.
+/// `node_at_mid` tells whether x = L/2 is a mesh node for every value studied.
+pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool) -> Expected {
+    let exact_stationary = matches!(
+        spec.integrator,
+        IntegratorKind::CrankNicolson | IntegratorKind::ExactModal
+    );
+    let e = |order: Option<f64>, exact: bool, why: &str| Expected {
+        order,
+        exact,
+        why: why.to_string(),
+    };
+    match over {
+        Over::Elements => {
+            if !exact_stationary {
+                return e(
+                    None,
+                    false,
+                    "the integrator's stationary bias at fixed dt (O(lambda dt) per mode) does not vanish as h -> 0, and grows with lambda_max for sums over modes: no order in h",
+                );
+            }
+            match (spec.noise, obs) {
+                (NoiseModel::Consistent, 0) if node_at_mid => e(
+                    None,
+                    true,
+                    "consistent noise with an exact-stationary integrator gives the covariance kT K^-1, whose nodal values are exact for Hermite cubics (the beam's Green's function is piecewise cubic): zero error, no order",
+                ),
+                (NoiseModel::Consistent, 0) => e(
+                    None,
+                    false,
+                    "kT K^-1 is exact at nodes (zero error there); where x = L/2 lies inside an element (odd element counts) the interpolated variance falls below the continuum by the energy-norm error of the point-load response, about h^3: no single order over these meshes",
+                ),
+                (NoiseModel::Consistent, _) => e(
+                    Some(4.0),
+                    false,
+                    "the variance is kT/lambda_i^h; Hermite-cubic generalized eigenvalues converge as h^4 (2(k+1-m), k = 3, m = 2)",
+                ),
+                (NoiseModel::ElementUniform, 0) => e(
+                    Some(2.0),
+                    false,
+                    "the element-uniform noise (eq. 5) under-excites every mode by about (i pi h/L)^2/12; the profile sums these h^2 deficits (plus the h^4 eigenvalue error)",
+                ),
+                (NoiseModel::ElementUniform, _) => e(
+                    Some(2.0),
+                    false,
+                    "element-uniform noise (eq. 5): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (i pi h/L)^2/12, order h^2 (dominates the h^4 eigenvalue error)",
+                ),
+            }
+        }
+        Over::Dt => match spec.integrator {
+            IntegratorKind::CrankNicolson => e(
+                None,
+                true,
+                "Crank-Nicolson: m = (1-a/2)/(1+a/2), g^2 = 2kT dt/(1+a/2)^2 give S_ij = 2kT Sigma_q,ij/(lambda_i+lambda_j) exactly for any dt, any noise model: zero error, no order",
+            ),
+            IntegratorKind::ExactModal if spec.noise == NoiseModel::Consistent || obs > 0 => e(
+                None,
+                true,
+                "exact OU update per mode: the stationary variance of every mode is kT Sigma_q,ii/lambda_i at any dt: zero error, no order",
+            ),
+            IntegratorKind::ExactModal => e(
+                None,
+                false,
+                "exact OU update with element-uniform noise: the modal variances are exact, but the cross-covariances of modes (correlated by eq. 5 noise) are not, by O((lambda dt)^2) for resolved modes: no single order",
+            ),
+            IntegratorKind::EulerMaruyama if obs == 0 => e(
+                Some(1.0),
+                false,
+                "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the profile error is dt kT/2 sum_i phi_i(L/2)^2 + O(dt^2): order 1",
+            ),
+            IntegratorKind::EulerMaruyama => e(
+                Some(1.0),
+                false,
+                "Euler-Maruyama stationary variance ratio 1/(1 - lambda dt/2): bias O(lambda dt), order 1",
+            ),
+            IntegratorKind::BackwardEuler if obs == 0 => e(
+                Some(1.0),
+                false,
+                "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the continuum-like sum gives about dt^(3/4), so the observed order lies between 3/4 and 1",
+            ),
+            IntegratorKind::BackwardEuler => e(
+                Some(1.0),
+                false,
+                "backward Euler stationary variance ratio 1/(1 + lambda dt/2): bias O(lambda dt), order 1",
+            ),
+            IntegratorKind::MetropolisCrankNicolson => e(
+                None,
+                true,
+                "on the linear problem every Crank-Nicolson proposal is accepted: exact",
+            ),
+        },
+    }
+}
+
+/// Rebuilds `scene` for one value of the study: sets the element count (or the run's
+/// Δt/τ1), samples modes 1–3 and the profile at x/L = 0.5, and drops the two-time points
+/// (not reported here).
+pub fn rebuild(scene: &Scene, run: usize, over: Over, value: f64) -> Scene {
+    let mut s = scene.clone();
+    match over {
+        Over::Elements => s.mesh.elements = value.round() as usize,
+        Over::Dt => s.runs[run].dt_tau1 = value,
+    }
+    s.sampling.modes = N_MODES;
+    s.sampling.profile_points = vec![0.5];
+    s.sampling.two_time.clear();
+    s
+}
+
+/// The probe vector a_x = Φᵀ p_x, with w(x) = p_xᵀ w.
+fn modal_probe(beam: &BeamModel, vectors: &nalgebra::DMatrix<f64>, x: f64) -> DVector<f64> {
+    let n = beam.n_dofs();
+    let mut e = vec![0.0; n];
+    let mut v = DVector::zeros(n);
+    for k in 0..n {
+        e[k] = 1.0;
+        v[k] = beam.deflection_at(&e, x);
+        e[k] = 0.0;
+    }
+    vectors.transpose() * v
+}
+
+/// The Δt → 0 limit of this scene's mesh and the run's noise model: ⟨w²(L/2)⟩ and the
+/// variances of modes 1–3 from the semi-discrete stationary covariance.
+fn semi_discrete_limit(scene: &Scene, spec: &RunSpec) -> Result<Vec<f64>> {
+    let p = scene.filament;
+    let mesh = if scene.mesh.grading == 1.0 {
+        Mesh::uniform(p.length, scene.mesh.elements)?
+    } else {
+        Mesh::graded(p.length, scene.mesh.elements, scene.mesh.grading)?
+    };
+    let beam = BeamModel::new(p, mesh)?;
+    let gm = generalized_modes(&beam)?;
+    let sq = modal_noise_covariance(&gm, &NoiseGenerator::new(spec.noise, &beam)?.covariance());
+    let s = continuous_stationary_covariance(&sq, &gm.rates, p.kt);
+    let a = modal_probe(&beam, &gm.vectors, 0.5 * p.length);
+    let mut out = vec![(a.transpose() * &s * &a)[(0, 0)]];
+    out.extend((0..N_MODES).map(|i| s[(i, i)]));
+    Ok(out)
+}
+
+/// h of a value: L/elements, or Δt/τ1.
+fn h_of(scene: &Scene, over: Over, value: f64) -> f64 {
+    match over {
+        Over::Elements => scene.filament.length / value,
+        Over::Dt => value,
+    }
+}
+
+/// Prepares run `run` of `scene` rebuilt for `value`, mapping an unstable time step to a
+/// message naming `--values`.
+fn prepare(scene: &Scene, run: usize, over: Over, value: f64) -> Result<(Scene, LinearRun)> {
+    let s = rebuild(scene, run, over, value);
+    let spec = s.runs[run].clone();
+    let lr = LinearRun::prepare(&s, &spec).map_err(|e| match e {
+        Error::UnstableTimeStep { limit, .. } => {
+            let limit_tau1 = limit / s.filament.tau1();
+            match over {
+                Over::Dt => Error::invalid(
+                    "--values",
+                    value,
+                    format!(
+                        "< {limit_tau1:.4e} (dt_tau1: the stability limit 2/lambda_max of {} with {} elements)",
+                        spec.integrator, s.mesh.elements
+                    ),
+                ),
+                Over::Elements => Error::invalid(
+                    "--values",
+                    value,
+                    format!(
+                        "an element count whose stability limit of {} exceeds the run's dt_tau1 = {:e} (with {} elements the limit is {limit_tau1:.4e}); use fewer elements or a stable integrator such as crank-nicolson",
+                        spec.integrator, spec.dt_tau1, value
+                    ),
+                ),
+            }
+        }
+        other => other,
+    })?;
+    Ok((s, lr))
+}
+
+/// The exact references (no simulation) of every value of the study.
+///
+/// # Errors
+/// As [`LinearRun::prepare`]; an unstable Δt is reported against `--values`.
+pub fn exact_study(
+    scene: &Scene,
+    run: usize,
+    over: Over,
+    values: &[f64],
+) -> Result<Vec<PointReference>> {
+    let limit_dt = match over {
+        Over::Dt => Some(semi_discrete_limit(scene, &scene.runs[run])?),
+        Over::Elements => None,
+    };
+    values
+        .iter()
+        .map(|&v| {
+            let (_, lr) = prepare(scene, run, over, v)?;
+            Ok(reference_point(scene, &lr, over, v, limit_dt.as_deref()))
+        })
+        .collect()
+}
+
+fn reference_point(
+    scene: &Scene,
+    lr: &LinearRun,
+    over: Over,
+    value: f64,
+    limit_dt: Option<&[f64]>,
+) -> PointReference {
+    let r = &lr.reference;
+    let mut discrete = vec![r.profile_discrete[0]];
+    discrete.extend(r.modes.iter().take(N_MODES).map(|m| m.variance_discrete));
+    let limit = match limit_dt {
+        Some(l) => l.to_vec(),
+        None => {
+            let mut c = vec![r.profile_continuum[0]];
+            c.extend(r.modes.iter().take(N_MODES).map(|m| m.variance_continuum));
+            c
+        }
+    };
+    let rate1 = lr.reference.modes[0]
+        .rate_discrete
+        .unwrap_or(lr.reference.modes[0].rate_continuum);
+    PointReference {
+        value,
+        h: h_of(scene, over, value),
+        discrete,
+        limit,
+        rounding_rel: ROUNDING_FACTOR * f64::EPSILON * lr.reference.max_rate / rate1,
+    }
+}
+
+/// Default values of the study for run `run` of `scene`.
+///
+/// # Errors
+/// From the stability-limit computation (euler-maruyama over dt).
+pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>> {
+    Ok(match over {
+        Over::Elements => DEFAULT_ELEMENTS.iter().map(|&n| n as f64).collect(),
+        Over::Dt => match scene.runs[run].integrator.theta() {
+            Some(theta) if theta < 0.5 => {
+                let p = scene.filament;
+                let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
+                let limit = scene.runs[run]
+                    .integrator
+                    .stability_limit(beam.max_rate()?)
+                    .unwrap_or(f64::INFINITY)
+                    / p.tau1();
+                DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect()
+            }
+            _ => DEFAULT_DT_TAU1.to_vec(),
+        },
+    })
+}
+
+/// Validates the values of a study: at least two, distinct, in range.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--values`.
+pub fn validate_values(over: Over, values: &[f64]) -> Result<()> {
+    if values.len() < 2 {
+        return Err(Error::invalid(
+            "--values",
+            format!("{} value(s)", values.len()),
+            "at least 2 distinct values (3 or more for a confidence interval)",
+        ));
+    }
+    for &v in values {
+        match over {
+            Over::Elements => {
+                let (lo, hi) = ELEMENTS_RANGE;
+                if !(v.fract() == 0.0 && v >= lo as f64 && v <= hi as f64) {
+                    return Err(Error::invalid(
+                        "--values",
+                        v,
+                        format!("integer element counts in [{lo}, {hi}]"),
+                    ));
+                }
+            }
+            Over::Dt => {
+                if !(v.is_finite() && v > 0.0 && v <= 100.0) {
+                    return Err(Error::invalid("--values", v, "dt_tau1 values in (0, 100]"));
+                }
+            }
+        }
+    }
+    for (i, v) in values.iter().enumerate() {
+        if values[..i].contains(v) {
+            return Err(Error::invalid(
+                "--values",
+                v,
+                "distinct values (this one is repeated)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Options of a convergence study.
+#[derive(Debug, Clone)]
+pub struct ConvergeOptions {
+    /// The scene (linear, model = "fem").
+    pub scene: Scene,
+    /// The run's name (default: the scene's first run).
+    pub run: Option<String>,
+    /// What is refined.
+    pub over: Over,
+    /// The values (default: [`default_values`]).
+    pub values: Option<Vec<f64>>,
+    /// Ensemble budget.
+    pub budget: Budget,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Progress lines on stderr.
+    pub progress: bool,
+}
+
+/// One row of the table: one value and one observable.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// The value (element count or Δt/τ1).
+    pub value: f64,
+    /// h.
+    pub h: f64,
+    /// Observable name.
+    pub observable: String,
+    /// Ensemble estimate.
+    pub estimate: f64,
+    /// Its standard error.
+    pub std_error: f64,
+    /// Exact discrete reference.
+    pub discrete: f64,
+    /// Limit reference (continuum, or Δt → 0 of this mesh).
+    pub limit: f64,
+    /// |estimate − limit|.
+    pub total_error: f64,
+    /// Its standard error (that of the estimate).
+    pub total_error_se: f64,
+    /// |discrete − limit|.
+    pub exact_error: f64,
+    /// Whether the total error is at the sampling floor (≤ 3 standard errors).
+    pub sampling_floor: bool,
+    /// Whether the exact error is at the round-off level of the references (the
+    /// discretization is exact for this observable here).
+    pub exact_at_rounding: bool,
+}
+
+/// The fitted and expected orders of one observable.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObservableSummary {
+    /// Observable name.
+    pub observable: String,
+    /// Expected order and why.
+    pub expected: Expected,
+    /// Order of the total error fitted on the resolved points (`None` if fewer than two).
+    pub observed: Option<OrderFit>,
+    /// Values at the sampling floor (left out of the fit).
+    pub floor_values: Vec<f64>,
+    /// Order of the exact error, fitted on the points above round-off.
+    pub exact: Option<OrderFit>,
+    /// Values whose exact error is at round-off (the discretization is exact there).
+    pub exact_at_rounding: Vec<f64>,
+    /// Why no observed order was fitted, if none was.
+    pub note: String,
+}
+
+/// The JSON summary of a study.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConvergeSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Run name.
+    pub run: String,
+    /// Integrator.
+    pub integrator: String,
+    /// Noise model.
+    pub noise: String,
+    /// What is refined.
+    pub over: Over,
+    /// What h is.
+    pub h: String,
+    /// What the errors are measured against.
+    pub limit_reference: String,
+    /// Budget.
+    pub budget: String,
+    /// Trajectories × duration per value.
+    pub trajectories: usize,
+    /// Sampled duration per trajectory (τ1).
+    pub duration_tau1: f64,
+    /// Fixed parameters of the study (the other of elements / dt).
+    pub fixed: String,
+    /// Values studied, in the order of h descending.
+    pub values: Vec<f64>,
+    /// Per observable.
+    pub observables: Vec<ObservableSummary>,
+    /// All rows.
+    pub rows: Vec<Row>,
+    /// Files written (relative to the output directory).
+    pub files: Vec<String>,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+}
+
+/// Estimates of the observables from the records: (estimate, standard error).
+fn estimates(lr: &LinearRun, records: &[TrajectoryRecord]) -> Result<Vec<(f64, f64)>> {
+    let c = lr.components;
+    let nm = lr.reference.modes.len();
+    let np = lr.reference.profile_x.len();
+    let combine = |parts: Vec<stats::MeanEstimate>| {
+        let n = parts.len() as f64;
+        let mean = parts.iter().map(|p| p.mean).sum::<f64>() / n;
+        let se = parts
+            .iter()
+            .map(|p| p.std_error.powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / n;
+        (mean, se)
+    };
+    let mut out = Vec::new();
+    let mut parts = Vec::new();
+    for t in records {
+        for k in 0..c {
+            let sq: Vec<f64> = t.profile[k * np].iter().map(|w| w * w).collect();
+            parts.push(stats::mean_with_error(&sq)?);
+        }
+    }
+    out.push(combine(parts));
+    for i in 0..N_MODES {
+        let mut parts = Vec::new();
+        for t in records {
+            for k in 0..c {
+                parts.push(stats::variance_with_error(&t.modes[k * nm + i], Some(0.0))?);
+            }
+        }
+        out.push(combine(parts));
+    }
+    Ok(out)
+}
+
+/// Finds run `name` (default: the first) of a linear fem scene.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--scene` (compression or spectral scene) or
+/// `--run` (unknown run).
+pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
+    match scene.model {
+        ModelKind::Compression => {
+            return Err(Error::invalid(
+                "--scene",
+                &scene.name,
+                "a linear finite-element scene (e.g. hinged-linear-2d, hinged-linear-3d): compression scenes are not supported by converge yet",
+            ));
+        }
+        ModelKind::Spectral => {
+            return Err(Error::invalid(
+                "--scene",
+                &scene.name,
+                "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d, hinged-linear-3d): the spectral model has no discretization to refine",
+            ));
+        }
+        ModelKind::Fem => {}
+    }
+    match name {
+        None => Ok(0),
+        Some(n) => scene.runs.iter().position(|r| r.name == n).ok_or_else(|| {
+            let names: Vec<&str> = scene.runs.iter().map(|r| r.name.as_str()).collect();
+            Error::invalid("--run", n, format!("one of: {}", names.join(", ")))
+        }),
+    }
+}
+
+/// Runs a convergence study and writes `<scene>-<run>-<over>.{csv,svg,json}` in `out`.
+///
+/// # Errors
+/// Bad input (exit 2) naming the flag; run failures (exit 3).
+pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
+    let start = Instant::now();
+    let scene = &opts.scene;
+    let run = select_run(scene, opts.run.as_deref())?;
+    let spec = scene.runs[run].clone();
+    let over = opts.over;
+    let mut values = match &opts.values {
+        Some(v) => v.clone(),
+        None => default_values(scene, run, over)?,
+    };
+    validate_values(over, &values)?;
+    // Largest h first.
+    values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
+    let names = observable_names();
+    let ensemble = spec.ensemble(opts.budget);
+    let limit_dt = match over {
+        Over::Dt => Some(semi_discrete_limit(scene, &spec)?),
+        Over::Elements => None,
+    };
+    // Prepare everything first, so that bad input fails before any simulation.
+    let prepared = values
+        .iter()
+        .map(|&v| prepare(scene, run, over, v))
+        .collect::<Result<Vec<_>>>()?;
+    let mut rows = Vec::new();
+    for ((s, lr), &v) in prepared.iter().zip(&values) {
+        let t0 = Instant::now();
+        let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
+        let seed = derive_seed(
+            s.seed,
+            &format!("{}/converge/{}={v}", spec.name, over.name()),
+        );
+        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+        let records = (0..ensemble.trajectories as u64)
+            .into_par_iter()
+            .map(|j| lr.simulate(&mut trajectory_rng(seed, j), steps))
+            .collect::<Result<Vec<_>>>()?;
+        let est = estimates(lr, &records)?;
+        for (k, name) in names.iter().enumerate() {
+            let (e, se) = est[k];
+            let total = (e - refp.limit[k]).abs();
+            rows.push(Row {
+                value: v,
+                h: refp.h,
+                observable: name.clone(),
+                estimate: e,
+                std_error: se,
+                discrete: refp.discrete[k],
+                limit: refp.limit[k],
+                total_error: total,
+                total_error_se: se,
+                exact_error: (refp.discrete[k] - refp.limit[k]).abs(),
+                sampling_floor: not_above(total, FLOOR_SIGMAS * se),
+                exact_at_rounding: not_above(
+                    (refp.discrete[k] - refp.limit[k]).abs(),
+                    refp.rounding_rel * refp.limit[k].abs(),
+                ),
+            });
+        }
+        if opts.progress {
+            eprintln!(
+                "converge {} {}: {}={v}: {} trajectories x {} tau1, {:.1} s",
+                scene.name,
+                spec.name,
+                over.name(),
+                ensemble.trajectories,
+                ensemble.duration_tau1,
+                t0.elapsed().as_secs_f64()
+            );
+        }
+    }
+    let node_at_mid = match over {
+        Over::Elements => values
+            .iter()
+            .all(|v| (v.round() as usize).is_multiple_of(2)),
+        Over::Dt => scene.mesh.elements.is_multiple_of(2),
+    };
+    let observables = summarize(&names, &rows, over, &spec, node_at_mid);
+
+    let stem = format!("{}-{}-{}", scene.name, spec.name, over.name());
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let csv = opts.out.join(format!("{stem}.csv"));
+    write_rows_csv(&csv, &rows)?;
+    let svg = opts.out.join(format!("{stem}.svg"));
+    figure(scene, &spec, over, &names, &rows).write_svg(&svg)?;
+    let json = opts.out.join(format!("{stem}.json"));
+    let summary = ConvergeSummary {
+        scene: scene.name.clone(),
+        run: spec.name.clone(),
+        integrator: spec.integrator.name().to_string(),
+        noise: spec.noise.name().to_string(),
+        over,
+        h: match over {
+            Over::Elements => "L/elements".to_string(),
+            Over::Dt => "dt/tau1".to_string(),
+        },
+        limit_reference: match over {
+            Over::Elements => "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)".to_string(),
+            Over::Dt => format!(
+                "dt -> 0 limit of this mesh ({} elements) and noise model: S_ij = 2kT Sigma_q,ij/(lambda_i + lambda_j)",
+                scene.mesh.elements
+            ),
+        },
+        budget: opts.budget.name().to_string(),
+        trajectories: ensemble.trajectories,
+        duration_tau1: ensemble.duration_tau1,
+        fixed: match over {
+            Over::Elements => format!("dt_tau1 = {:e}", spec.dt_tau1),
+            Over::Dt => format!("elements = {}", scene.mesh.elements),
+        },
+        values,
+        observables,
+        rows,
+        files: [&csv, &svg, &json]
+            .iter()
+            .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+            .collect(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    write_json(&json, &summary)?;
+    Ok(summary)
+}
+
+/// Fits the observed and exact orders per observable.
+fn summarize(
+    names: &[String],
+    rows: &[Row],
+    over: Over,
+    spec: &RunSpec,
+    node_at_mid: bool,
+) -> Vec<ObservableSummary> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
+            let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+            let all_exact = rs.iter().all(|r| r.exact_at_rounding);
+            let within = rs.iter().filter(|r| r.sampling_floor).count();
+            let note = if all_exact {
+                format!(
+                    "the discretization is exact for this observable (exact error at round-off at every value): the total error is sampling noise only, no order is fitted; {within} of {} estimates within {FLOOR_SIGMAS} standard errors of the reference",
+                    rs.len()
+                )
+            } else if resolved.len() < 2 {
+                format!(
+                    "{} of {} points at the sampling floor: too few resolved points for an observed order (a larger --budget resolves more)",
+                    rs.len() - resolved.len(),
+                    rs.len()
+                )
+            } else {
+                String::new()
+            };
+            let observed = if all_exact { None } else { fit_order(
+                &resolved.iter().map(|r| r.h).collect::<Vec<_>>(),
+                &resolved.iter().map(|r| r.total_error).collect::<Vec<_>>(),
+                Some(&resolved.iter().map(|r| r.total_error_se).collect::<Vec<_>>()),
+            ) };
+            let above: Vec<&&Row> = rs
+                .iter()
+                .filter(|r| !r.exact_at_rounding)
+                .collect();
+            let exact = fit_order(
+                &above.iter().map(|r| r.h).collect::<Vec<_>>(),
+                &above.iter().map(|r| r.exact_error).collect::<Vec<_>>(),
+                None,
+            );
+            ObservableSummary {
+                observable: name.clone(),
+                expected: expected_order(over, spec, k, node_at_mid),
+                observed,
+                floor_values: rs.iter().filter(|r| r.sampling_floor).map(|r| r.value).collect(),
+                exact,
+                exact_at_rounding: rs
+                    .iter()
+                    .filter(|r| r.exact_at_rounding)
+                    .map(|r| r.value)
+                    .collect(),
+                note,
+            }
+        })
+        .collect()
+}
+
+fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
+    let mut text = String::from(
+        "value,h,observable,estimate,std_error,discrete,limit,total_error,total_error_se,exact_error,status\n",
+    );
+    for r in rows {
+        text.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            r.value,
+            r.h,
+            r.observable,
+            r.estimate,
+            r.std_error,
+            r.discrete,
+            r.limit,
+            r.total_error,
+            r.total_error_se,
+            r.exact_error,
+            if r.sampling_floor {
+                "sampling floor"
+            } else {
+                "resolved"
+            }
+        ));
+    }
+    write_atomic(path, text.as_bytes())
+}
+
+fn figure(scene: &Scene, spec: &RunSpec, over: Over, names: &[String], rows: &[Row]) -> Figure {
+    let x_label = match over {
+        Over::Elements => "h = L/elements",
+        Over::Dt => "h = dt/tau1",
+    };
+    let mut fig = Figure::new(
+        format!(
+            "{} {} ({} noise): |error| vs {}",
+            scene.name,
+            spec.name,
+            spec.noise.name(),
+            over.name()
+        ),
+        x_label,
+        "|estimate - limit| (markers), |discrete - limit| (lines)",
+    )
+    .log_x()
+    .log_y();
+    for name in names {
+        let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
+        let res: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+        let floor: Vec<&&Row> = rs.iter().filter(|r| r.sampling_floor).collect();
+        if !res.is_empty() {
+            fig = fig.series(
+                Series::markers(
+                    name.clone(),
+                    res.iter().map(|r| (r.h, r.total_error)).collect(),
+                )
+                .with_errors(res.iter().map(|r| r.total_error_se).collect()),
+            );
+        }
+        if !floor.is_empty() {
+            // At the floor the error is not resolved: drawn at 3 standard errors (an
+            // upper bound), without error bars.
+            fig = fig.series(Series::markers(
+                format!("{name} sampling floor (3 s.e.)"),
+                floor
+                    .iter()
+                    .map(|r| (r.h, FLOOR_SIGMAS * r.total_error_se))
+                    .collect(),
+            ));
+        }
+        let exact: Vec<(f64, f64)> = rs
+            .iter()
+            .filter(|r| !r.exact_at_rounding)
+            .map(|r| (r.h, r.exact_error))
+            .collect();
+        if !exact.is_empty() {
+            fig = fig.series(
+                Series::line(format!("{name} exact"), exact).with_style(SeriesStyle::LineMarkers),
+            );
+        }
+    }
+    fig
+}
