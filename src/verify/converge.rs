@@ -27,7 +27,7 @@
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
-use crate::fem::mesh::Mesh;
+
 use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
@@ -35,9 +35,8 @@ use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::stats;
-use crate::verify::linear::{LinearRun, TrajectoryRecord};
+use crate::verify::linear::{LinearRun, TrajectoryRecord, modal_probe};
 use crate::verify::scene::{Budget, ModelKind, RunSpec, Scene};
-use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
@@ -319,29 +318,11 @@ pub fn rebuild(scene: &Scene, run: usize, over: Over, value: f64) -> Scene {
     s
 }
 
-/// The probe vector a_x = Φᵀ p_x, with w(x) = p_xᵀ w.
-fn modal_probe(beam: &BeamModel, vectors: &nalgebra::DMatrix<f64>, x: f64) -> DVector<f64> {
-    let n = beam.n_dofs();
-    let mut e = vec![0.0; n];
-    let mut v = DVector::zeros(n);
-    for k in 0..n {
-        e[k] = 1.0;
-        v[k] = beam.deflection_at(&e, x);
-        e[k] = 0.0;
-    }
-    vectors.transpose() * v
-}
-
 /// The Δt → 0 limit of this scene's mesh and the run's noise model: ⟨w²(L/2)⟩ and the
 /// variances of modes 1–3 from the semi-discrete stationary covariance.
 fn semi_discrete_limit(scene: &Scene, spec: &RunSpec) -> Result<Vec<f64>> {
     let p = scene.filament;
-    let mesh = if scene.mesh.grading == 1.0 {
-        Mesh::uniform(p.length, scene.mesh.elements)?
-    } else {
-        Mesh::graded(p.length, scene.mesh.elements, scene.mesh.grading)?
-    };
-    let beam = BeamModel::new(p, mesh)?;
+    let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
     let gm = generalized_modes(&beam)?;
     let sq = modal_noise_covariance(&gm, &NoiseGenerator::new(spec.noise, &beam)?.covariance());
     let s = continuous_stationary_covariance(&sq, &gm.rates, p.kt);
@@ -454,7 +435,7 @@ pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>>
         Over::Dt => match scene.runs[run].integrator.theta() {
             Some(theta) if theta < 0.5 => {
                 let p = scene.filament;
-                let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
+                let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
                 let limit = scene.runs[run]
                     .integrator
                     .stability_limit(beam.max_rate()?)

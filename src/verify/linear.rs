@@ -13,7 +13,6 @@
 use crate::dynamics::{Integrator, IntegratorKind, build_integrator};
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
-use crate::fem::mesh::Mesh;
 use crate::fem::modal::{
     GeneralizedModes, discrete_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
@@ -84,6 +83,21 @@ pub struct LinearReference {
     pub dt: f64,
     /// Largest rate of the discrete system (λ_max).
     pub max_rate: f64,
+}
+
+/// The probe vector `a_x = Φᵀ p_x` of the deflection at `x`, where `w(x) = p_xᵀ w`
+/// (Hermite interpolation) and Φ are the generalized modes: `⟨w(x)w(y)⟩ = a_yᵀ S a_x` for a
+/// modal covariance S.
+pub fn modal_probe(beam: &BeamModel, vectors: &DMatrix<f64>, x: f64) -> DVector<f64> {
+    let n = beam.n_dofs();
+    let mut e = vec![0.0; n];
+    let mut v = DVector::zeros(n);
+    for k in 0..n {
+        e[k] = 1.0;
+        v[k] = beam.deflection_at(&e, x);
+        e[k] = 0.0;
+    }
+    vectors.transpose() * v
 }
 
 /// A filament being simulated: advances all its transverse components by one step and
@@ -306,12 +320,7 @@ impl LinearRun {
                 )
             }
             ModelKind::Fem => {
-                let mesh = if scene.mesh.grading == 1.0 {
-                    Mesh::uniform(p.length, scene.mesh.elements)?
-                } else {
-                    Mesh::graded(p.length, scene.mesh.elements, scene.mesh.grading)?
-                };
-                let beam = BeamModel::new(p, mesh)?;
+                let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
                 let gm = generalized_modes(&beam)?;
                 let max_rate = gm.rates[gm.rates.len() - 1];
                 // Fails early with the stability limit if the step is too large.
@@ -339,16 +348,7 @@ impl LinearRun {
                     });
                 }
                 // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
-                let probe = |x: f64| -> DVector<f64> {
-                    let mut e = vec![0.0; beam.n_dofs()];
-                    let mut v = DVector::zeros(beam.n_dofs());
-                    for k in 0..beam.n_dofs() {
-                        e[k] = 1.0;
-                        v[k] = beam.deflection_at(&e, x);
-                        e[k] = 0.0;
-                    }
-                    gm.vectors.transpose() * v
-                };
+                let probe = |x: f64| modal_probe(&beam, &gm.vectors, x);
                 let profile_discrete = profile_x
                     .iter()
                     .map(|&x| {

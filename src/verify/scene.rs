@@ -33,6 +33,7 @@
 
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
+use crate::fem::mesh::Mesh;
 use crate::fem::noise::NoiseModel;
 use crate::params::FilamentParams;
 use serde::{Deserialize, Serialize};
@@ -156,6 +157,20 @@ pub struct MeshSpec {
 
 fn one() -> f64 {
     1.0
+}
+
+impl MeshSpec {
+    /// The mesh of a filament of length `length`: uniform, or geometrically graded.
+    ///
+    /// # Errors
+    /// Invalid element count or grading (see [`Mesh::uniform`], [`Mesh::graded`]).
+    pub fn build(&self, length: f64) -> Result<Mesh> {
+        if self.grading == 1.0 {
+            Mesh::uniform(length, self.elements)
+        } else {
+            Mesh::graded(length, self.elements, self.grading)
+        }
+    }
 }
 
 /// What is sampled and where.
@@ -511,6 +526,14 @@ impl Scene {
         }
         if c.strain_ratios.is_empty() {
             return Err(bad("compression.strain_ratios", &"[]", "a non-empty list"));
+        }
+        if self.mesh.grading != 1.0 {
+            // The exact discrete theory uses the closed-form spectrum of a uniform mesh.
+            return Err(bad(
+                "mesh.grading",
+                &self.mesh.grading,
+                "1 (uniform) for model = \"compression\"",
+            ));
         }
         for (i, &r) in c.strain_ratios.iter().enumerate() {
             if !(r.is_finite() && (-1e3..=1e3).contains(&r)) {
