@@ -89,6 +89,15 @@ impl Error {
         }
     }
 
+    /// [`Error::Diverged`] at step `step` of a run with time step `dt` (time = step·dt).
+    pub fn diverged(step: u64, dt: f64, detail: impl Into<String>) -> Self {
+        Error::Diverged {
+            step,
+            time: step as f64 * dt,
+            detail: detail.into(),
+        }
+    }
+
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {

@@ -170,16 +170,16 @@ impl CompressionRun {
         for step in 1..=total {
             integ.step(model, &mut w, rng);
             if !w.iter().flatten().all(|v| v.is_finite()) {
-                return Err(Error::Diverged {
+                return Err(Error::diverged(
                     step,
-                    time: step as f64 * self.dt,
-                    detail: format!(
+                    self.dt,
+                    format!(
                         "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
                         self.spec.integrator,
                         model.strain(),
                         self.spec.dt_tau1
                     ),
-                });
+                ));
             }
             if step > self.burn_in_steps
                 && (step - self.burn_in_steps).is_multiple_of(self.sample_every)

@@ -496,11 +496,11 @@ impl LinearRun {
         for step in 1..=steps {
             sampler.step(rng);
             if !sampler.is_finite() {
-                return Err(Error::Diverged {
+                return Err(Error::diverged(
                     step,
-                    time: step as f64 * r.dt,
-                    detail: format!("non-finite deflection with {}", self.spec.integrator),
-                });
+                    r.dt,
+                    format!("non-finite deflection with {}", self.spec.integrator),
+                ));
             }
             if step % every.max(1) == 0 {
                 sampler.modes(&mut m);
@@ -551,16 +551,16 @@ impl LinearRun {
         for step in 1..=total {
             sampler.step(rng);
             if !sampler.is_finite() {
-                return Err(Error::Diverged {
+                return Err(Error::diverged(
                     step,
-                    time: step as f64 * r.dt,
-                    detail: format!(
+                    r.dt,
+                    format!(
                         "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
                         self.spec.integrator,
                         r.dt,
                         r.max_rate * r.dt
                     ),
-                });
+                ));
             }
             for (j, q) in tt.iter().enumerate() {
                 if step == q.t_step {
