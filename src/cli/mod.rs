@@ -1,11 +1,17 @@
 //! Argument parsing (clap) and dispatch.
 
 mod converge;
+mod stability;
 mod theory;
 mod verify;
+mod work_precision;
 
 use clap::{Parser, Subcommand};
 use langevin_fem::Result;
+use langevin_fem::error::Error;
+use langevin_fem::verify::{Scene, resolve_scenes};
+use std::path::Path;
+use std::str::FromStr;
 
 /// Finite-element Langevin dynamics of thermally fluctuating filaments, with exact
 /// references and statistical verification.
@@ -24,6 +30,12 @@ enum Command {
     Verify(verify::VerifyArgs),
     /// Convergence study of a linear scene over the element count or the time step.
     Converge(converge::ConvergeArgs),
+    /// Stability map (integrator x dt*lambda_max x elements) and per-mode stationary
+    /// bias against each integrator's exact discrete-time formula.
+    Stability(stability::StabilityArgs),
+    /// Work-precision study: error in <w2(L/2)> against wall time for every integrator
+    /// and noise model, and the projected cost of reaching a tolerance.
+    WorkPrecision(work_precision::WorkPrecisionArgs),
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
@@ -33,5 +45,28 @@ pub fn run() -> Result<i32> {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => verify::run(args),
         Command::Converge(args) => converge::run(args),
+        Command::Stability(args) => stability::run(args),
+        Command::WorkPrecision(args) => work_precision::run(args),
     }
+}
+
+/// Parses a comma-separated list for `flag`; a bad item exits with code 2 naming the
+/// flag, the item and `allowed`.
+fn parse_list<T: FromStr>(flag: &str, text: &str, allowed: &str) -> Result<Vec<T>> {
+    text.split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<T>()
+                .map_err(|_| Error::invalid(flag, s.trim(), allowed))
+        })
+        .collect()
+}
+
+/// Loads one scene given by name (in `scene_dir`) or path.
+fn resolve_scene(name: &str, scene_dir: &Path) -> Result<Scene> {
+    let path = resolve_scenes(&[name.to_string()], scene_dir)?
+        .into_iter()
+        .next()
+        .ok_or_else(|| Error::invalid("--scene", name, "a scene name or .toml path"))?;
+    Scene::load(&path)
 }

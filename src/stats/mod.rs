@@ -46,8 +46,8 @@ pub use hypothesis::{
     t_test, z_test,
 };
 pub use moments::{
-    IatEstimate, MeanEstimate, blocking_std_error, ensemble_mean, integrated_autocorrelation_time,
-    mean_with_error, variance_with_error,
+    IatEstimate, MeanEstimate, blocking_std_error, combine_independent, ensemble_mean,
+    integrated_autocorrelation_time, mean_with_error, variance_with_error,
 };
 pub use spectrum::{
     Psd, ar1_density, welch, welch_expectation, welch_expectation_ar1, welch_pooled,

@@ -176,6 +176,22 @@ pub fn variance_with_error(x: &[f64], known_mean: Option<f64>) -> Result<MeanEst
     })
 }
 
+/// Average of independent estimates of the same quantity (e.g. one time average per
+/// independent trajectory, each with its own autocorrelation-aware error): the plain
+/// mean of the estimates, with standard error `sqrt(Σ se_i²)/n`. Returns
+/// `(mean, standard error)`; `(NaN, NaN)` for no parts.
+pub fn combine_independent(parts: &[MeanEstimate]) -> (f64, f64) {
+    let n = parts.len() as f64;
+    let mean = parts.iter().map(|p| p.mean).sum::<f64>() / n;
+    let se = parts
+        .iter()
+        .map(|p| p.std_error.powi(2))
+        .sum::<f64>()
+        .sqrt()
+        / n;
+    (mean, se)
+}
+
 /// Mean of independent samples (e.g. one value per independent trajectory):
 /// x̄ with SE = s/√n, s² = Σ (x_i − x̄)²/(n − 1); `tau_int` = 0.5 and `n_eff` = n.
 ///

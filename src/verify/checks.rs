@@ -103,19 +103,15 @@ pub fn linear_checks(
         for j in 0..np {
             // Per series: mean of w² with an autocorrelation-aware error (integrated
             // autocorrelation time); series are independent, so errors add in quadrature.
-            let mut means = Vec::new();
-            let mut var_sum = 0.0;
+            let mut parts = Vec::new();
             for t in records {
                 for k in 0..c {
                     let sq: Vec<f64> = t.profile[k * np + j].iter().map(|w| w * w).collect();
-                    let m = stats::mean_with_error(&sq)?;
-                    means.push(m.mean);
-                    var_sum += m.std_error * m.std_error;
+                    parts.push(stats::mean_with_error(&sq)?);
                 }
             }
-            let n = means.len() as f64;
-            let mean = means.iter().sum::<f64>() / n;
-            let se = var_sum.sqrt() / n;
+            let (mean, se) = stats::combine_independent(&parts);
+            let means: Vec<f64> = parts.iter().map(|m| m.mean).collect();
             let between = stats::ensemble_mean(&means)?;
             let o = stats::z_test(mean, r.profile_discrete[j], se)?;
             let x = r.profile_x[j];
@@ -153,16 +149,11 @@ pub fn linear_checks(
         let thinned = thin(&series, stride);
 
         if checks.contains(&CheckKind::ModeVariance) {
-            let mut means = Vec::new();
-            let mut var_sum = 0.0;
-            for s in &series {
-                let v = stats::variance_with_error(s, Some(0.0))?;
-                means.push(v.mean);
-                var_sum += v.std_error * v.std_error;
-            }
-            let n = means.len() as f64;
-            let mean = means.iter().sum::<f64>() / n;
-            let se = var_sum.sqrt() / n;
+            let parts = series
+                .iter()
+                .map(|s| stats::variance_with_error(s, Some(0.0)))
+                .collect::<Result<Vec<_>>>()?;
+            let (mean, se) = stats::combine_independent(&parts);
             me.variance = (mean, se);
             let o = stats::z_test(mean, mr.variance_discrete, se)?;
             out.push(check(

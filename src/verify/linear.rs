@@ -20,6 +20,7 @@ use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::rng::TrajectoryRng;
 use crate::spectral::HingedBeam;
 use crate::spectral::simulator::ModalSimulator;
+use crate::stats;
 use crate::verify::scene::{ModelKind, RunSpec, Scene};
 use nalgebra::{DMatrix, DVector};
 
@@ -443,6 +444,29 @@ impl LinearRun {
     /// Time between samples of mode `i` (0-based).
     pub fn mode_dt(&self, i: usize) -> f64 {
         self.mode_every[i] as f64 * self.reference.dt
+    }
+
+    /// ⟨w²(x_j)⟩ at profile point `point` over an ensemble: per trajectory and component
+    /// the time average of w² with an autocorrelation-aware standard error
+    /// ([`stats::mean_with_error`]); the independent parts are averaged and their errors
+    /// added in quadrature. Returns (estimate, standard error).
+    ///
+    /// # Errors
+    /// Estimator errors (too few samples).
+    pub fn profile_square_estimate(
+        &self,
+        records: &[TrajectoryRecord],
+        point: usize,
+    ) -> Result<(f64, f64)> {
+        let np = self.reference.profile_x.len();
+        let mut parts = Vec::new();
+        for t in records {
+            for k in 0..self.components {
+                let sq: Vec<f64> = t.profile[k * np + point].iter().map(|w| w * w).collect();
+                parts.push(stats::mean_with_error(&sq)?);
+            }
+        }
+        Ok(stats::combine_independent(&parts))
     }
 
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {

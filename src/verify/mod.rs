@@ -13,7 +13,9 @@ pub mod converge;
 pub mod linear;
 pub mod runner;
 pub mod scene;
+pub mod stability;
 pub mod summary;
+pub mod work_precision;
 
 pub use runner::{VerifyOptions, resolve_scenes, run_verification};
 pub use scene::{Budget, Scene};

@@ -1,0 +1,716 @@
+//! Stability map and per-mode stationary bias of the linear integrators
+//! (`langevin-fem stability`).
+//!
+//! For each integrator, element count and normalized step a = Δt·λ_max (λ_max the fastest
+//! generalized rate of (K, C) on that mesh) the linear filament is simulated from rest
+//! with consistent noise, and the cell is classified:
+//!
+//! - **unstable**: the amplification factor of some mode has |m| ≥ 1. The tool refuses
+//!   such a run before simulating ([`build_integrator`] returns
+//!   [`Error::UnstableTimeStep`]); to show that the refusal is not over-cautious the
+//!   θ-scheme is then run anyway, bypassing the check, and the step at which the state
+//!   overflowed is recorded;
+//! - **biased**: stable, but the measured stationary variance of at least one checked
+//!   mode differs from the Δt → 0 value kT/λ_i beyond its statistical error (two-sided
+//!   z-tests, Holm over every checked mode of the map at level α, so that a map of
+//!   unbiased cells shows no "biased" cell with probability ≥ 1 − α);
+//! - **stable**: no bias resolved at this sample size (the formula's predicted bias is
+//!   listed beside it, so "stable" reads as "unbiased within the error bar").
+//!
+//! Every checked mode's measured ratio var/(kT/λ_i) is also compared with the
+//! integrator's exact discrete-time formula [`IntegratorKind::stationary_variance_ratio`]
+//! (θ-schemes: 1/(1 + (θ − ½)λΔt); exact OU update: 1), z-tests with Holm over the whole
+//! map: the formula must be accepted everywhere.
+//!
+//! Checked modes: the fastest mode and modes spaced by √10 in rate below it, as long as
+//! the run resolves them: with |m_i| the mode's one-step multiplier and
+//! d_i = −ln|m_i| its decay per step, the burn-in must cover [`BURN_IN_DECAYS`] decays
+//! (the transient variance deficit |m_i|^{2B} ≤ e^{−14}) and the sampled part
+//! [`MIN_SAMPLED_DECAYS`]. Crank–Nicolson's stiffest modes have m → −1 as λΔt → ∞ and
+//! barely decay: they are left out and counted, since their variance is exact but cannot
+//! be measured in such a run (and their dynamics is wrong).
+//!
+//! Each cell has its own seed (derived from the scene seed and the cell's label) and its
+//! trajectories their own streams, so results do not depend on the thread count.
+
+use crate::dynamics::{Integrator, IntegratorKind, ThetaScheme, build_integrator};
+use crate::error::{Error, Result};
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::fem::modal::generalized_modes;
+use crate::fem::noise::NoiseModel;
+use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::rng::{derive_seed, trajectory_rng};
+use crate::stats;
+use crate::verify::scene::{ModelKind, Scene};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Default element counts of the map.
+pub const DEFAULT_ELEMENTS: [usize; 4] = [5, 10, 20, 40];
+/// Default normalized steps a = Δt·λ_max: well inside, at and beyond the explicit limit
+/// (a = 2), and far beyond it.
+pub const DEFAULT_DT_LAMBDA_MAX: [f64; 7] = [0.1, 1.0, 1.9, 2.1, 10.0, 1.0e3, 1.0e5];
+/// Default integrators: every linear one.
+pub const DEFAULT_INTEGRATORS: [IntegratorKind; 4] = IntegratorKind::ALL;
+/// Burn-in length in decays of the slowest checked mode (−ln|m| per step).
+pub const BURN_IN_DECAYS: f64 = 7.0;
+/// Sampled length in decays of the slowest checked mode.
+pub const MIN_SAMPLED_DECAYS: f64 = 100.0;
+/// At most this many modes are checked per cell.
+pub const MAX_CHECKED_MODES: usize = 6;
+/// Allowed element counts (dense generalized eigen-decomposition per cell).
+pub const ELEMENTS_RANGE: (usize, usize) = (2, 200);
+
+/// Options of a stability study.
+#[derive(Debug, Clone)]
+pub struct StabilityOptions {
+    /// A linear finite-element scene: filament parameters and seed.
+    pub scene: Scene,
+    /// Integrators (rows of the map).
+    pub integrators: Vec<IntegratorKind>,
+    /// Element counts.
+    pub elements: Vec<usize>,
+    /// Normalized steps a = Δt·λ_max.
+    pub dt_lambda_max: Vec<f64>,
+    /// Independent trajectories per cell.
+    pub trajectories: usize,
+    /// Sampled steps per trajectory (after the burn-in).
+    pub sampled_steps: u64,
+    /// Burn-in steps per trajectory.
+    pub burn_in_steps: u64,
+    /// Family-wise level of the bias and formula tests.
+    pub alpha: f64,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Print one line per cell on stderr.
+    pub progress: bool,
+}
+
+/// The classification of a cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Status {
+    /// Stable; no stationary bias resolved.
+    Stable,
+    /// Stable, but the stationary variance is biased beyond its statistical error.
+    Biased,
+    /// |m| ≥ 1 for some mode: refused before running; diverges when forced.
+    Unstable,
+}
+
+impl Status {
+    /// Name used in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Stable => "stable",
+            Status::Biased => "biased",
+            Status::Unstable => "unstable",
+        }
+    }
+}
+
+/// The measured stationary variance of one mode against the exact formula.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeBias {
+    /// Mode number (1-based, ascending rate).
+    pub mode: usize,
+    /// λ_i Δt.
+    pub lambda_dt: f64,
+    /// One-step multiplier m_i of the mode.
+    pub multiplier: f64,
+    /// Measured variance / (kT/λ_i).
+    pub measured_ratio: f64,
+    /// Its standard error (autocorrelation-aware, trajectories in quadrature).
+    pub std_error: f64,
+    /// The exact discrete-time ratio of the integrator.
+    pub formula_ratio: f64,
+    /// z of measured against the formula.
+    pub z_formula: f64,
+    /// Two-sided p-value of that z.
+    pub p_formula: f64,
+    /// z of measured against 1 (no bias).
+    pub z_bias: f64,
+    /// Two-sided p-value of that z.
+    pub p_bias: f64,
+    /// Whether Holm over the whole map rejects the formula for this mode.
+    pub formula_rejected: bool,
+}
+
+/// One cell of the map.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Cell {
+    /// Integrator.
+    pub integrator: String,
+    /// Element count.
+    pub elements: usize,
+    /// a = Δt·λ_max.
+    pub dt_lambda_max: f64,
+    /// Δt/τ1.
+    pub dt_tau1: f64,
+    /// Multiplier of the fastest mode.
+    pub max_multiplier: f64,
+    /// Classification.
+    pub status: Status,
+    /// Human-readable detail.
+    pub detail: String,
+    /// The tool's refusal message for an unstable step.
+    pub refused: Option<String>,
+    /// The step at which the forced run overflowed (unstable cells).
+    pub diverged_at: Option<u64>,
+    /// Modes not checked because the run cannot resolve them.
+    pub unresolved_modes: usize,
+    /// Largest |measured − formula| bias predicted among the checked modes, |ratio − 1|.
+    pub predicted_max_bias: f64,
+    /// The checked modes.
+    pub modes: Vec<ModeBias>,
+}
+
+/// The JSON summary of a stability study.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilitySummary {
+    /// Scene name.
+    pub scene: String,
+    /// Noise model (consistent).
+    pub noise: String,
+    /// Family-wise level.
+    pub alpha: f64,
+    /// Trajectories per cell.
+    pub trajectories: usize,
+    /// Burn-in steps per trajectory.
+    pub burn_in_steps: u64,
+    /// Sampled steps per trajectory.
+    pub sampled_steps: u64,
+    /// All cells, integrator-major, then elements, then a.
+    pub cells: Vec<Cell>,
+    /// Number of per-mode formula comparisons (the Holm family).
+    pub formula_tests: usize,
+    /// Number rejected by Holm at α.
+    pub formula_rejections: usize,
+    /// Whether the predicted stability agreed with every run (refused cells diverge
+    /// when forced, accepted cells do not).
+    pub stability_as_predicted: bool,
+    /// Files written (relative to the output directory).
+    pub files: Vec<String>,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+}
+
+/// Validates the options (exit code 2 on bad input, naming the flag).
+fn validate(opts: &StabilityOptions) -> Result<()> {
+    if opts.scene.model != ModelKind::Fem {
+        return Err(Error::invalid(
+            "--scene",
+            &opts.scene.name,
+            "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d)",
+        ));
+    }
+    for &e in &opts.elements {
+        if !(ELEMENTS_RANGE.0..=ELEMENTS_RANGE.1).contains(&e) {
+            return Err(Error::invalid(
+                "--elements",
+                e,
+                format!("integers in [{}, {}]", ELEMENTS_RANGE.0, ELEMENTS_RANGE.1),
+            ));
+        }
+    }
+    for &a in &opts.dt_lambda_max {
+        if !(a.is_finite() && a > 0.0 && a <= 1e12) {
+            return Err(Error::invalid("--dt-lambda-max", a, "numbers in (0, 1e12]"));
+        }
+    }
+    for &k in &opts.integrators {
+        if k == IntegratorKind::MetropolisCrankNicolson {
+            return Err(Error::invalid(
+                "--integrators",
+                k,
+                "euler-maruyama, backward-euler, crank-nicolson or exact-modal (on the linear filament metropolis-crank-nicolson is crank-nicolson)",
+            ));
+        }
+    }
+    if opts.integrators.is_empty() || opts.elements.is_empty() || opts.dt_lambda_max.is_empty() {
+        return Err(Error::invalid(
+            "--integrators/--elements/--dt-lambda-max",
+            "(empty)",
+            "at least one value each",
+        ));
+    }
+    if !(2..=1024).contains(&opts.trajectories) {
+        return Err(Error::invalid(
+            "--trajectories",
+            opts.trajectories,
+            "an integer in [2, 1024]",
+        ));
+    }
+    if !(1000..=100_000_000).contains(&opts.sampled_steps) {
+        return Err(Error::invalid(
+            "--steps",
+            opts.sampled_steps,
+            "an integer in [1000, 1e8]",
+        ));
+    }
+    crate::error::require_in_range("--alpha", opts.alpha, 1e-6, 0.5)?;
+    Ok(())
+}
+
+/// Decay per step of a mode with multiplier `m` (infinite for m = 0).
+fn decay(m: f64) -> f64 {
+    -m.abs().ln()
+}
+
+/// Chooses the checked modes: the fastest, then modes spaced by √10 in rate, each
+/// resolved by the run (burn-in and sampled length in decays).
+fn checked_modes(rates: &[f64], mult: &[f64], burn_in: u64, sampled: u64) -> Vec<usize> {
+    let n = rates.len();
+    let resolved = |i: usize| {
+        decay(mult[i]) * burn_in as f64 >= BURN_IN_DECAYS
+            && decay(mult[i]) * sampled as f64 >= MIN_SAMPLED_DECAYS
+    };
+    let mut out: Vec<usize> = Vec::new();
+    let mut k = 0;
+    loop {
+        let target = rates[n - 1] * 10f64.powf(-0.5 * k as f64);
+        if target < rates[0] * 0.5 || out.len() >= MAX_CHECKED_MODES {
+            break;
+        }
+        let i = (0..n)
+            .min_by(|&a, &b| {
+                (rates[a].ln() - target.ln())
+                    .abs()
+                    .total_cmp(&(rates[b].ln() - target.ln()).abs())
+            })
+            .unwrap_or(0);
+        if resolved(i) && !out.contains(&i) {
+            out.push(i);
+        }
+        k += 1;
+    }
+    out.sort_unstable();
+    out
+}
+
+/// Runs one cell.
+fn run_cell(
+    opts: &StabilityOptions,
+    kind: IntegratorKind,
+    elements: usize,
+    a: f64,
+) -> Result<Cell> {
+    let scene = &opts.scene;
+    let p = scene.filament;
+    let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
+    let gm = generalized_modes(&beam)?;
+    let rates: Vec<f64> = gm.rates.iter().copied().collect();
+    let n = rates.len();
+    let lmax = rates[n - 1];
+    let dt = a / lmax;
+    let kt = p.kt;
+    let mult: Vec<f64> = rates
+        .iter()
+        .map(|&r| kind.modal_form(r, dt, kt).0)
+        .collect();
+    let seed = derive_seed(
+        scene.seed,
+        &format!("stability/{}/{elements}/{a:e}", kind.name()),
+    );
+    let mut cell = Cell {
+        integrator: kind.name().to_string(),
+        elements,
+        dt_lambda_max: a,
+        dt_tau1: dt / p.tau1(),
+        max_multiplier: mult[n - 1],
+        status: Status::Stable,
+        detail: String::new(),
+        refused: None,
+        diverged_at: None,
+        unresolved_modes: 0,
+        predicted_max_bias: 0.0,
+        modes: Vec::new(),
+    };
+    let total = opts.burn_in_steps + opts.sampled_steps;
+    let worst = mult.iter().fold(0.0f64, |w, m| w.max(m.abs()));
+    let integrator = match build_integrator(
+        kind,
+        &beam,
+        NoiseModel::Consistent,
+        dt,
+        lmax,
+        Some(&gm),
+    ) {
+        Ok(i) => i,
+        Err(e @ Error::UnstableTimeStep { .. }) => {
+            cell.status = Status::Unstable;
+            cell.refused = Some(e.to_string());
+            // Forced run, bypassing the check, to show the refusal is warranted.
+            let theta = kind.theta().ok_or_else(|| Error::Numerical {
+                routine: "stability map".into(),
+                detail: format!("{kind} refused a step but is not a theta-scheme"),
+            })?;
+            let mut forced = ThetaScheme::new(&beam, NoiseModel::Consistent, theta, dt)?;
+            let mut rng = trajectory_rng(seed, 0);
+            let mut w = vec![0.0; n];
+            for step in 1..=total {
+                forced.step(&mut w, &mut rng);
+                if !w.iter().all(|v| v.is_finite()) {
+                    cell.diverged_at = Some(step);
+                    break;
+                }
+            }
+            cell.detail = match cell.diverged_at {
+                Some(s) => format!(
+                    "|m| = {worst:.3} >= 1: refused before running; forced, the state overflowed at step {s}"
+                ),
+                None => format!(
+                    "|m| = {worst:.3} >= 1: refused before running; forced, still finite after {total} steps (growth too slow to overflow)"
+                ),
+            };
+            return Ok(cell);
+        }
+        Err(e) => return Err(e),
+    };
+    drop(integrator);
+    let modes = checked_modes(&rates, &mult, opts.burn_in_steps, opts.sampled_steps);
+    let n_resolvable = (0..n)
+        .filter(|&i| {
+            decay(mult[i]) * opts.burn_in_steps as f64 >= BURN_IN_DECAYS
+                && decay(mult[i]) * opts.sampled_steps as f64 >= MIN_SAMPLED_DECAYS
+        })
+        .count();
+    cell.unresolved_modes = n - n_resolvable;
+    let projector = gm.projector(&beam, n);
+    let rows: Vec<Vec<f64>> = modes
+        .iter()
+        .map(|&i| projector.row(i).iter().copied().collect())
+        .collect();
+    // Per trajectory: the sampled series of each checked mode.
+    let series = (0..opts.trajectories as u64)
+        .map(|j| -> Result<Vec<Vec<f64>>> {
+            let mut integ =
+                build_integrator(kind, &beam, NoiseModel::Consistent, dt, lmax, Some(&gm))?;
+            let mut rng = trajectory_rng(seed, j);
+            let mut w = vec![0.0; n];
+            let mut out = vec![Vec::with_capacity(opts.sampled_steps as usize); rows.len()];
+            for step in 1..=total {
+                integ.step(&mut w, &mut rng);
+                if !w.iter().all(|v| v.is_finite()) {
+                    return Err(Error::diverged(
+                        step,
+                        dt,
+                        format!("{kind} at dt*lambda_max = {a:e} with {elements} elements"),
+                    ));
+                }
+                if step > opts.burn_in_steps {
+                    for (s, r) in out.iter_mut().zip(&rows) {
+                        s.push(r.iter().zip(&w).map(|(x, y)| x * y).sum());
+                    }
+                }
+            }
+            Ok(out)
+        })
+        .collect::<Vec<_>>();
+    let mut per_traj = Vec::new();
+    for s in series {
+        match s {
+            Ok(s) => per_traj.push(s),
+            Err(e @ Error::Diverged { .. }) => {
+                cell.status = Status::Unstable;
+                cell.detail = format!("predicted stable (|m| = {worst:.3}) but diverged: {e}");
+                return Ok(cell);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    for (k, &i) in modes.iter().enumerate() {
+        let parts = per_traj
+            .iter()
+            .map(|t| stats::variance_with_error(&t[k], Some(0.0)))
+            .collect::<Result<Vec<_>>>()?;
+        let (var, var_se) = stats::combine_independent(&parts);
+        let scale = rates[i] / kt;
+        let ratio = var * scale;
+        let se = var_se * scale;
+        let formula = kind
+            .stationary_variance_ratio(rates[i], dt)
+            .ok_or_else(|| Error::Numerical {
+                routine: "stability map".into(),
+                detail: format!("no stationary variance for a stable mode of {kind}"),
+            })?;
+        let zf = stats::z_test(ratio, formula, se)?;
+        let zb = stats::z_test(ratio, 1.0, se)?;
+        cell.predicted_max_bias = cell.predicted_max_bias.max((formula - 1.0).abs());
+        cell.modes.push(ModeBias {
+            mode: i + 1,
+            lambda_dt: rates[i] * dt,
+            multiplier: mult[i],
+            measured_ratio: ratio,
+            std_error: se,
+            formula_ratio: formula,
+            z_formula: zf.statistic,
+            p_formula: zf.p_value,
+            z_bias: zb.statistic,
+            p_bias: zb.p_value,
+            formula_rejected: false,
+        });
+    }
+    cell.detail = undamped_note(&cell, &mult, total);
+    Ok(cell)
+}
+
+/// Why some modes were not checked.
+fn undamped_note(cell: &Cell, mult: &[f64], total: u64) -> String {
+    let n = mult.len();
+    if cell.unresolved_modes > 0 {
+        format!(
+            "; {} of {n} modes relax too slowly to be measured in {total} steps (|m| close to 1{})",
+            cell.unresolved_modes,
+            if mult[n - 1] < -0.9 {
+                ": the stiff modes oscillate undamped, m -> -1"
+            } else {
+                ""
+            }
+        )
+    } else {
+        String::new()
+    }
+}
+
+/// Classifies a simulated (not unstable) cell from the map-wide Holm decisions on its
+/// bias tests, and writes its detail line.
+fn classify(cell: &mut Cell, biased: bool) {
+    let worst_mode = cell
+        .modes
+        .iter()
+        .max_by(|x, y| x.z_bias.abs().total_cmp(&y.z_bias.abs()));
+    cell.status = if biased {
+        Status::Biased
+    } else {
+        Status::Stable
+    };
+    let undamped = std::mem::take(&mut cell.detail);
+    let predicted = if cell.predicted_max_bias < 1e-12 {
+        "0 (exact)".to_string()
+    } else {
+        format!("{:.2e}", cell.predicted_max_bias)
+    };
+    cell.detail = match worst_mode {
+        None => format!("no mode resolved in this run{undamped}"),
+        Some(m) if biased => format!(
+            "mode {} variance ratio {:.4e} +- {:.1e} (formula {:.4e}), z = {:.1} against no bias{undamped}",
+            m.mode, m.measured_ratio, m.std_error, m.formula_ratio, m.z_bias
+        ),
+        Some(m) => format!(
+            "no bias resolved: largest |z| = {:.1} (mode {}, ratio {:.4} +- {:.4}); predicted largest bias {predicted}{undamped}",
+            m.z_bias.abs(),
+            m.mode,
+            m.measured_ratio,
+            m.std_error,
+        ),
+    };
+}
+
+/// Runs the stability study and writes `stability-cells.csv`, `stationary-bias.csv`,
+/// `stability.json`, `stability-map-<integrator>.svg` and `stationary-bias.svg` in
+/// `opts.out`.
+///
+/// # Errors
+/// Bad options (exit 2, naming the flag); numerical or I/O failures.
+pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
+    let start = Instant::now();
+    validate(opts)?;
+    let mut jobs = Vec::new();
+    for &k in &opts.integrators {
+        for &e in &opts.elements {
+            for &a in &opts.dt_lambda_max {
+                jobs.push((k, e, a));
+            }
+        }
+    }
+    let mut cells = jobs
+        .par_iter()
+        .map(|&(k, e, a)| {
+            let t0 = Instant::now();
+            let c = run_cell(opts, k, e, a);
+            if opts.progress
+                && let Ok(c) = &c
+            {
+                eprintln!(
+                    "stability {k} {e} elements dt*lambda_max={a:e}: {} modes checked ({:.1} s)",
+                    c.modes.len(),
+                    t0.elapsed().as_secs_f64()
+                );
+            }
+            c
+        })
+        .collect::<Result<Vec<_>>>()?;
+    // Holm over every bias test of the map: a cell is biased if any of its modes is
+    // rejected.
+    let p_bias: Vec<f64> = cells
+        .iter()
+        .filter(|c| c.status != Status::Unstable)
+        .flat_map(|c| c.modes.iter().map(|m| m.p_bias))
+        .collect();
+    let bias_decisions = stats::holm(&p_bias, opts.alpha);
+    let mut it = bias_decisions.iter();
+    for c in cells.iter_mut().filter(|c| c.status != Status::Unstable) {
+        let mut biased = false;
+        for _ in &c.modes {
+            biased |= it.next().is_some_and(|d| d.1);
+        }
+        classify(c, biased);
+    }
+    // Holm over every formula comparison of the map.
+    let p: Vec<f64> = cells
+        .iter()
+        .flat_map(|c| c.modes.iter().map(|m| m.p_formula))
+        .collect();
+    let decisions = stats::holm(&p, opts.alpha);
+    let mut it = decisions.iter();
+    for c in &mut cells {
+        for m in &mut c.modes {
+            m.formula_rejected = it.next().is_some_and(|d| d.1);
+        }
+    }
+    let formula_rejections = decisions.iter().filter(|d| d.1).count();
+    let stability_as_predicted = cells.iter().all(|c| match c.status {
+        Status::Unstable => c.refused.is_some() && c.diverged_at.is_some(),
+        _ => c.refused.is_none(),
+    });
+
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let mut files = Vec::new();
+    let mut csv = String::from(
+        "integrator,elements,dt_lambda_max,dt_tau1,max_multiplier,status,checked_modes,unresolved_modes,predicted_max_bias,diverged_at,detail\n",
+    );
+    for c in &cells {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
+            c.integrator,
+            c.elements,
+            c.dt_lambda_max,
+            c.dt_tau1,
+            c.max_multiplier,
+            c.status.name(),
+            c.modes.len(),
+            c.unresolved_modes,
+            c.predicted_max_bias,
+            c.diverged_at.map(|s| s.to_string()).unwrap_or_default(),
+            c.detail.replace('"', "'")
+        ));
+    }
+    write_atomic(&opts.out.join("stability-cells.csv"), csv.as_bytes())?;
+    files.push("stability-cells.csv".to_string());
+    let mut csv = String::from(
+        "integrator,elements,dt_lambda_max,mode,lambda_dt,multiplier,measured_ratio,std_error,formula_ratio,z_formula,p_formula,formula_rejected,z_bias,p_bias\n",
+    );
+    for c in &cells {
+        for m in &c.modes {
+            csv.push_str(&format!(
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                c.integrator,
+                c.elements,
+                c.dt_lambda_max,
+                m.mode,
+                m.lambda_dt,
+                m.multiplier,
+                m.measured_ratio,
+                m.std_error,
+                m.formula_ratio,
+                m.z_formula,
+                m.p_formula,
+                m.formula_rejected,
+                m.z_bias,
+                m.p_bias
+            ));
+        }
+    }
+    write_atomic(&opts.out.join("stationary-bias.csv"), csv.as_bytes())?;
+    files.push("stationary-bias.csv".to_string());
+    for &k in &opts.integrators {
+        let name = format!("stability-map-{}.svg", k.name());
+        map_figure(&opts.scene.name, k, &cells).write_svg(&opts.out.join(&name))?;
+        files.push(name);
+    }
+    bias_figure(&opts.scene.name, &opts.integrators, &cells)
+        .write_svg(&opts.out.join("stationary-bias.svg"))?;
+    files.push("stationary-bias.svg".to_string());
+    files.push("stability.json".to_string());
+    let summary = StabilitySummary {
+        scene: opts.scene.name.clone(),
+        noise: NoiseModel::Consistent.name().to_string(),
+        alpha: opts.alpha,
+        trajectories: opts.trajectories,
+        burn_in_steps: opts.burn_in_steps,
+        sampled_steps: opts.sampled_steps,
+        formula_tests: p.len(),
+        formula_rejections,
+        stability_as_predicted,
+        cells,
+        files,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    write_json(&opts.out.join("stability.json"), &summary)?;
+    Ok(summary)
+}
+
+fn map_figure(scene: &str, kind: IntegratorKind, cells: &[Cell]) -> Figure {
+    let mut fig = Figure::new(
+        format!("{scene}: stability map of {kind} (consistent noise)"),
+        "dt * lambda_max",
+        "elements",
+    )
+    .log_x()
+    .log_y();
+    for status in [Status::Stable, Status::Biased, Status::Unstable] {
+        let pts: Vec<(f64, f64)> = cells
+            .iter()
+            .filter(|c| c.integrator == kind.name() && c.status == status)
+            .map(|c| (c.dt_lambda_max, c.elements as f64))
+            .collect();
+        // Every status gets a series, even an empty one, so colours mean the same in
+        // every map.
+        fig = fig.series(Series::markers(status.name(), pts));
+    }
+    fig
+}
+
+fn bias_figure(scene: &str, kinds: &[IntegratorKind], cells: &[Cell]) -> Figure {
+    let mut fig = Figure::new(
+        format!("{scene}: stationary variance per mode / (kT/lambda)"),
+        "lambda * dt",
+        "variance ratio: measured (markers), exact formula (lines)",
+    )
+    .log_x()
+    .log_y();
+    for &k in kinds {
+        let modes: Vec<&ModeBias> = cells
+            .iter()
+            .filter(|c| c.integrator == k.name())
+            .flat_map(|c| &c.modes)
+            .collect();
+        if modes.is_empty() {
+            continue;
+        }
+        let (lo, hi) = modes.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
+            (lo.min(m.lambda_dt), hi.max(m.lambda_dt))
+        });
+        let curve: Vec<(f64, f64)> = (0..=200)
+            .map(|j| lo * (hi / lo).powf(j as f64 / 200.0))
+            .filter_map(|x| k.stationary_variance_ratio(x, 1.0).map(|r| (x, r)))
+            .collect();
+        fig = fig
+            .series(
+                Series::markers(
+                    format!("{k} measured"),
+                    modes
+                        .iter()
+                        .map(|m| (m.lambda_dt, m.measured_ratio))
+                        .collect(),
+                )
+                .with_errors(modes.iter().map(|m| m.std_error).collect()),
+            )
+            .series(Series::line(format!("{k} formula"), curve).with_style(SeriesStyle::Line));
+    }
+    fig
+}

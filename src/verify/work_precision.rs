@@ -1,0 +1,504 @@
+//! Work–precision study (`langevin-fem work-precision`): the error in ⟨w²(L/2)⟩ against
+//! wall time for every integrator and noise model on the same scene.
+//!
+//! Each method (integrator × noise model) is run at several time steps, each point with
+//! the same ensemble (trajectories × sampled duration; euler-maruyama, whose step is
+//! bounded by its stability limit, with a shorter duration of its own), so the points of
+//! a method have about the same sampling error and cost wall time ∝ (steps per τ1) ×
+//! (cost per step). For each point:
+//!
+//! - the measured relative error |estimate − continuum|/continuum (the continuum profile
+//!   variance kT x²(L − x)²/(3EIL) of eq. 2), with its standard error
+//!   (autocorrelation-aware, trajectories in quadrature, as in the verification checks);
+//! - the exact relative bias b = |discrete − continuum|/continuum of this mesh, noise
+//!   model, integrator and Δt (no sampling): the error the method keeps with unlimited
+//!   samples (spatial error of the noise model plus the integrator's stationary bias);
+//! - z of the estimate against the exact discrete value (the run is right if |z| is small);
+//! - the projected wall time to reach a relative error ε with 95 % confidence: the
+//!   sampling error of a time average falls as T^{-1/2}, so with the measured relative
+//!   standard error s₀ at wall time t₀, b + 2s ≤ ε needs t(ε) = t₀ (2s₀/(ε − b))² (∞ if
+//!   ε ≤ b). The burn-in is scaled with the samples, so t(ε) slightly overstates long
+//!   runs. Per method the best time step is the one minimizing t(ε).
+//!
+//! Wall times are measured on this machine with the rayon pool over trajectories (the
+//! thread count is recorded); they are not reproducible bit for bit, the estimates are.
+
+use crate::dynamics::IntegratorKind;
+use crate::error::{Error, Result};
+use crate::fem::noise::NoiseModel;
+use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::rng::{derive_seed, trajectory_rng};
+use crate::verify::linear::LinearRun;
+use crate::verify::scene::{Ensemble, ModelKind, RunSpec, Scene};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Default methods: the paper's explicit scheme with both noise models, backward Euler,
+/// Crank–Nicolson with both noise models, and the exact modal update.
+pub const DEFAULT_METHODS: [(IntegratorKind, NoiseModel); 6] = [
+    (IntegratorKind::EulerMaruyama, NoiseModel::ElementUniform),
+    (IntegratorKind::EulerMaruyama, NoiseModel::Consistent),
+    (IntegratorKind::BackwardEuler, NoiseModel::Consistent),
+    (IntegratorKind::CrankNicolson, NoiseModel::ElementUniform),
+    (IntegratorKind::CrankNicolson, NoiseModel::Consistent),
+    (IntegratorKind::ExactModal, NoiseModel::Consistent),
+];
+/// Default Δt/τ1 of the unconditionally stable integrators.
+pub const DEFAULT_DT_TAU1: [f64; 4] = [1e-2, 3e-3, 1e-3, 3e-4];
+/// Default fractions of the stability limit for euler-maruyama.
+pub const DEFAULT_EM_FRACTIONS: [f64; 2] = [0.9, 0.45];
+/// Tolerances of the projected curves (relative error).
+const CURVE_TOLERANCES: usize = 61;
+
+/// Options of a work–precision study.
+#[derive(Debug, Clone)]
+pub struct WorkPrecisionOptions {
+    /// A linear finite-element scene (filament, mesh, seed, burn-in).
+    pub scene: Scene,
+    /// Methods (integrator, noise model).
+    pub methods: Vec<(IntegratorKind, NoiseModel)>,
+    /// Δt/τ1 of the unconditionally stable integrators.
+    pub dt_tau1: Vec<f64>,
+    /// Fractions of the stability limit for euler-maruyama.
+    pub em_fractions: Vec<f64>,
+    /// Trajectories per point.
+    pub trajectories: usize,
+    /// Sampled duration per trajectory (τ1).
+    pub duration_tau1: f64,
+    /// Sampled duration per trajectory (τ1) of euler-maruyama.
+    pub em_duration_tau1: f64,
+    /// The tolerance whose projected cost is tabulated (relative error, e.g. 0.01).
+    pub tolerance: f64,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Print one line per point on stderr.
+    pub progress: bool,
+}
+
+/// One method at one time step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WpPoint {
+    /// Integrator.
+    pub integrator: String,
+    /// Noise model.
+    pub noise: String,
+    /// Δt/τ1.
+    pub dt_tau1: f64,
+    /// Trajectories.
+    pub trajectories: usize,
+    /// Sampled duration per trajectory (τ1).
+    pub duration_tau1: f64,
+    /// Steps per trajectory (burn-in + sampled).
+    pub steps_per_trajectory: u64,
+    /// Measured wall time of the ensemble (s).
+    pub wall_seconds: f64,
+    /// Estimate of ⟨w²(L/2)⟩.
+    pub estimate: f64,
+    /// Its standard error.
+    pub std_error: f64,
+    /// Exact discrete value (this mesh, noise, integrator and Δt).
+    pub discrete: f64,
+    /// Continuum value.
+    pub continuum: f64,
+    /// |estimate − continuum|/continuum.
+    pub rel_error: f64,
+    /// std_error/continuum.
+    pub rel_std_error: f64,
+    /// |discrete − continuum|/continuum.
+    pub rel_bias: f64,
+    /// (estimate − discrete)/std_error.
+    pub z_discrete: f64,
+    /// Projected wall time to reach the tolerance (s), if the bias allows it.
+    pub seconds_to_tolerance: Option<f64>,
+}
+
+/// The cheapest way a method reaches the tolerance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MethodSummary {
+    /// Integrator.
+    pub integrator: String,
+    /// Noise model.
+    pub noise: String,
+    /// Smallest relative bias over the time steps studied.
+    pub min_rel_bias: f64,
+    /// Projected wall time to reach the tolerance (s), if any time step can.
+    pub seconds_to_tolerance: Option<f64>,
+    /// The time step achieving it.
+    pub best_dt_tau1: Option<f64>,
+    /// Its cost relative to the fastest method.
+    pub relative_cost: Option<f64>,
+    /// Why the tolerance cannot be reached, if it cannot.
+    pub note: String,
+}
+
+/// The JSON summary of a work–precision study.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WorkPrecisionSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Elements of the mesh.
+    pub elements: usize,
+    /// The observable.
+    pub observable: String,
+    /// Its continuum value.
+    pub continuum: f64,
+    /// The tolerance of the table (relative error).
+    pub tolerance: f64,
+    /// Trajectories per point.
+    pub trajectories: usize,
+    /// Sampled duration per trajectory (τ1), stable integrators.
+    pub duration_tau1: f64,
+    /// Sampled duration per trajectory (τ1), euler-maruyama.
+    pub em_duration_tau1: f64,
+    /// Threads of the rayon pool.
+    pub threads: usize,
+    /// Median relative standard error of the points (the sampling floor of this
+    /// ensemble).
+    pub sampling_floor: f64,
+    /// All points.
+    pub points: Vec<WpPoint>,
+    /// Per method.
+    pub methods: Vec<MethodSummary>,
+    /// Points whose estimate disagrees with the exact discrete value (|z| > 3).
+    pub inconsistent_points: usize,
+    /// Files written (relative to the output directory).
+    pub files: Vec<String>,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+}
+
+fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
+    if opts.scene.model != ModelKind::Fem {
+        return Err(Error::invalid(
+            "--scene",
+            &opts.scene.name,
+            "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d)",
+        ));
+    }
+    if opts.methods.is_empty() {
+        return Err(Error::invalid(
+            "--methods",
+            "(empty)",
+            "at least one method",
+        ));
+    }
+    for &(k, _) in &opts.methods {
+        if k == IntegratorKind::MetropolisCrankNicolson {
+            return Err(Error::invalid(
+                "--methods",
+                k,
+                "integrators euler-maruyama, backward-euler, crank-nicolson or exact-modal",
+            ));
+        }
+    }
+    for &d in &opts.dt_tau1 {
+        crate::error::require_in_range("--dt-tau1", d, 1e-12, 1.0)?;
+    }
+    for &f in &opts.em_fractions {
+        if !(f > 0.0 && f < 1.0) {
+            return Err(Error::invalid(
+                "--em-fractions",
+                f,
+                "fractions of the stability limit in (0, 1)",
+            ));
+        }
+    }
+    if !(2..=1024).contains(&opts.trajectories) {
+        return Err(Error::invalid(
+            "--trajectories",
+            opts.trajectories,
+            "an integer in [2, 1024]",
+        ));
+    }
+    crate::error::require_in_range("--duration", opts.duration_tau1, 1.0, 1e6)?;
+    crate::error::require_in_range("--em-duration", opts.em_duration_tau1, 1.0, 1e6)?;
+    crate::error::require_in_range("--tolerance", opts.tolerance, 1e-6, 1.0)?;
+    Ok(())
+}
+
+/// Projected wall time to reach relative error `eps` at 95 % (b + 2s ≤ ε).
+fn projected_seconds(p: &WpPoint, eps: f64) -> Option<f64> {
+    (eps > p.rel_bias && p.rel_std_error > 0.0)
+        .then(|| p.wall_seconds * (2.0 * p.rel_std_error / (eps - p.rel_bias)).powi(2))
+}
+
+/// The scene with one run of `method` at `dt_tau1`, sampling only the profile at L/2.
+fn point_scene(
+    opts: &WorkPrecisionOptions,
+    (kind, noise): (IntegratorKind, NoiseModel),
+    dt_tau1: f64,
+) -> Scene {
+    let mut s = opts.scene.clone();
+    let e = Ensemble {
+        trajectories: opts.trajectories,
+        duration_tau1: if kind == IntegratorKind::EulerMaruyama {
+            opts.em_duration_tau1
+        } else {
+            opts.duration_tau1
+        },
+        two_time_trajectories: 0,
+    };
+    s.runs = vec![RunSpec {
+        name: format!("{}-{}", kind.name(), noise.name()),
+        integrator: kind,
+        noise,
+        dt_tau1,
+        checks: None,
+        quick: e,
+        standard: e,
+        full: e,
+    }];
+    s.sampling.modes = 1;
+    s.sampling.profile_points = vec![0.5];
+    s.sampling.two_time.clear();
+    s
+}
+
+/// Runs the study and writes `work-precision.{csv,json,svg}` and
+/// `work-precision-projected.svg` in `opts.out`.
+///
+/// # Errors
+/// Bad options (exit 2, naming the flag); run failures.
+pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
+    let start = Instant::now();
+    validate(opts)?;
+    // Prepare every point first, so that bad input fails before any simulation.
+    let mut prepared = Vec::new();
+    for &method in &opts.methods {
+        let dts: Vec<f64> = if method.0 == IntegratorKind::EulerMaruyama {
+            let s = point_scene(opts, method, 1.0);
+            let beam =
+                crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
+            let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
+            opts.em_fractions.iter().map(|f| f * limit).collect()
+        } else {
+            opts.dt_tau1.clone()
+        };
+        for dt in dts {
+            let s = point_scene(opts, method, dt);
+            let lr = LinearRun::prepare(&s, &s.runs[0])?;
+            prepared.push((method, dt, s, lr));
+        }
+    }
+    let mut points = Vec::new();
+    for (method, dt, s, lr) in &prepared {
+        let seed = derive_seed(
+            s.seed,
+            &format!(
+                "work-precision/{}/{}/{dt:e}",
+                method.0.name(),
+                method.1.name()
+            ),
+        );
+        let duration = s.runs[0].quick.duration_tau1;
+        let steps = lr.sampled_steps(duration * s.filament.tau1());
+        let t0 = Instant::now();
+        let records = (0..opts.trajectories as u64)
+            .into_par_iter()
+            .map(|j| lr.simulate(&mut trajectory_rng(seed, j), steps))
+            .collect::<Result<Vec<_>>>()?;
+        let wall = t0.elapsed().as_secs_f64();
+        let (est, se) = lr.profile_square_estimate(&records, 0)?;
+        let cont = lr.reference.profile_continuum[0];
+        let disc = lr.reference.profile_discrete[0];
+        let mut p = WpPoint {
+            integrator: method.0.name().to_string(),
+            noise: method.1.name().to_string(),
+            dt_tau1: *dt,
+            trajectories: opts.trajectories,
+            duration_tau1: duration,
+            steps_per_trajectory: lr.burn_in_steps + steps,
+            wall_seconds: wall,
+            estimate: est,
+            std_error: se,
+            discrete: disc,
+            continuum: cont,
+            rel_error: (est - cont).abs() / cont,
+            rel_std_error: se / cont,
+            rel_bias: (disc - cont).abs() / cont,
+            z_discrete: (est - disc) / se,
+            seconds_to_tolerance: None,
+        };
+        p.seconds_to_tolerance = projected_seconds(&p, opts.tolerance);
+        if opts.progress {
+            eprintln!(
+                "work-precision {} {} dt/tau1={dt:.3e}: error {:.2e} +- {:.1e} (bias {:.1e}), {:.2} s",
+                p.integrator, p.noise, p.rel_error, p.rel_std_error, p.rel_bias, wall
+            );
+        }
+        points.push(p);
+    }
+    let methods = summarize(opts, &points);
+    let mut ses: Vec<f64> = points.iter().map(|p| p.rel_std_error).collect();
+    ses.sort_by(f64::total_cmp);
+    let sampling_floor = ses.get(ses.len() / 2).copied().unwrap_or(f64::NAN);
+
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let mut csv = String::from(
+        "integrator,noise,dt_tau1,trajectories,duration_tau1,steps_per_trajectory,wall_seconds,estimate,std_error,discrete,continuum,rel_error,rel_std_error,rel_bias,z_discrete,seconds_to_tolerance\n",
+    );
+    for p in &points {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            p.integrator,
+            p.noise,
+            p.dt_tau1,
+            p.trajectories,
+            p.duration_tau1,
+            p.steps_per_trajectory,
+            p.wall_seconds,
+            p.estimate,
+            p.std_error,
+            p.discrete,
+            p.continuum,
+            p.rel_error,
+            p.rel_std_error,
+            p.rel_bias,
+            p.z_discrete,
+            p.seconds_to_tolerance
+                .map(|t| t.to_string())
+                .unwrap_or_default()
+        ));
+    }
+    write_atomic(&opts.out.join("work-precision.csv"), csv.as_bytes())?;
+    measured_figure(opts, &points, sampling_floor)
+        .write_svg(&opts.out.join("work-precision.svg"))?;
+    projected_figure(opts, &points).write_svg(&opts.out.join("work-precision-projected.svg"))?;
+    let summary = WorkPrecisionSummary {
+        scene: opts.scene.name.clone(),
+        elements: opts.scene.mesh.elements,
+        observable: "w2(L/2)".to_string(),
+        continuum: points.first().map_or(f64::NAN, |p| p.continuum),
+        tolerance: opts.tolerance,
+        trajectories: opts.trajectories,
+        duration_tau1: opts.duration_tau1,
+        em_duration_tau1: opts.em_duration_tau1,
+        threads: rayon::current_num_threads(),
+        sampling_floor,
+        inconsistent_points: points.iter().filter(|p| p.z_discrete.abs() > 3.0).count(),
+        points,
+        methods,
+        files: [
+            "work-precision.csv",
+            "work-precision.svg",
+            "work-precision-projected.svg",
+            "work-precision.json",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    write_json(&opts.out.join("work-precision.json"), &summary)?;
+    Ok(summary)
+}
+
+fn method_points(points: &[WpPoint], (k, n): (IntegratorKind, NoiseModel)) -> Vec<&WpPoint> {
+    points
+        .iter()
+        .filter(|p| p.integrator == k.name() && p.noise == n.name())
+        .collect()
+}
+
+fn summarize(opts: &WorkPrecisionOptions, points: &[WpPoint]) -> Vec<MethodSummary> {
+    let mut out: Vec<MethodSummary> = opts
+        .methods
+        .iter()
+        .map(|&m| {
+            let ps = method_points(points, m);
+            let min_rel_bias = ps.iter().map(|p| p.rel_bias).fold(f64::INFINITY, f64::min);
+            let best = ps
+                .iter()
+                .filter_map(|p| p.seconds_to_tolerance.map(|t| (t, p.dt_tau1)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            MethodSummary {
+                integrator: m.0.name().to_string(),
+                noise: m.1.name().to_string(),
+                min_rel_bias,
+                seconds_to_tolerance: best.map(|b| b.0),
+                best_dt_tau1: best.map(|b| b.1),
+                relative_cost: None,
+                note: if best.is_none() {
+                    format!(
+                        "cannot reach {:.2e}: its smallest exact bias over these time steps is {min_rel_bias:.2e} (a smaller dt{} is needed)",
+                        opts.tolerance,
+                        if m.1 == NoiseModel::ElementUniform {
+                            " cannot remove the element-uniform noise deficit; more elements"
+                        } else {
+                            ""
+                        }
+                    )
+                } else {
+                    String::new()
+                },
+            }
+        })
+        .collect();
+    let fastest = out
+        .iter()
+        .filter_map(|m| m.seconds_to_tolerance)
+        .fold(f64::INFINITY, f64::min);
+    for m in &mut out {
+        m.relative_cost = m.seconds_to_tolerance.map(|t| t / fastest);
+    }
+    out
+}
+
+fn label((k, n): (IntegratorKind, NoiseModel)) -> String {
+    format!("{} ({})", k.name(), n.name())
+}
+
+fn measured_figure(opts: &WorkPrecisionOptions, points: &[WpPoint], floor: f64) -> Figure {
+    let mut fig = Figure::new(
+        format!(
+            "{}: error in <w2(L/2)> vs wall time ({} x {} tau1 per point, EM {} tau1)",
+            opts.scene.name, opts.trajectories, opts.duration_tau1, opts.em_duration_tau1
+        ),
+        "wall time of the ensemble (s)",
+        "|estimate - continuum| / continuum",
+    )
+    .log_x()
+    .log_y();
+    for &m in &opts.methods {
+        let ps = method_points(points, m);
+        fig = fig.series(
+            Series::line(
+                label(m),
+                ps.iter().map(|p| (p.wall_seconds, p.rel_error)).collect(),
+            )
+            .with_style(SeriesStyle::LineMarkers)
+            .with_errors(ps.iter().map(|p| p.rel_std_error).collect()),
+        );
+    }
+    fig.hline(floor, "sampling floor (median standard error)")
+        .hline(opts.tolerance, "tolerance")
+}
+
+fn projected_figure(opts: &WorkPrecisionOptions, points: &[WpPoint]) -> Figure {
+    let mut fig = Figure::new(
+        format!(
+            "{}: projected wall time to reach a relative error in <w2(L/2)> (95 %)",
+            opts.scene.name
+        ),
+        "projected wall time (s)",
+        "relative error reached",
+    )
+    .log_x()
+    .log_y();
+    for &m in &opts.methods {
+        let ps = method_points(points, m);
+        let curve: Vec<(f64, f64)> = (0..CURVE_TOLERANCES)
+            .filter_map(|j| {
+                let eps = 10f64.powf(-3.0 + 3.0 * j as f64 / (CURVE_TOLERANCES - 1) as f64);
+                ps.iter()
+                    .filter_map(|p| projected_seconds(p, eps))
+                    .min_by(f64::total_cmp)
+                    .map(|t| (t, eps))
+            })
+            .collect();
+        fig = fig.series(Series::line(label(m), curve));
+    }
+    fig.hline(opts.tolerance, "tolerance")
+}
