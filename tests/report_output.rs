@@ -315,6 +315,7 @@ fn sample_summary() -> Summary {
                     "clamped_free/autocorrelation.svg".to_string(),
                 ],
                 tables: vec!["clamped_free/mode_variance.csv".to_string()],
+                warnings: vec![],
                 notes: vec!["ratio → 1 as elements increase".to_string()],
                 checks: vec![
                     check("mode-variance/n=1", true, Some(0.42)),
@@ -327,6 +328,7 @@ fn sample_summary() -> Summary {
                 wall_seconds: 12.5,
                 figures: vec!["pinned/msd.svg".to_string()],
                 tables: vec![],
+                warnings: vec![],
                 notes: vec![],
                 checks: vec![
                     check("msd/<script>alert(1)</script>", true, Some(0.3)),

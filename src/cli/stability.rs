@@ -121,6 +121,7 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
             "FAILED somewhere (see the table)"
         }
     );
+    langevin_fem::report::write_convergence_index(&args.out)?;
     eprintln!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),

@@ -76,6 +76,9 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
         for f in failed {
             eprintln!("    failed: {f}");
         }
+        for w in &scene.warnings {
+            eprintln!("    warning: {w}");
+        }
     }
     eprintln!(
         "{} (budget {}, family-wise alpha {} per scene, Holm); report: {}",

@@ -125,6 +125,7 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
             s.inconsistent_points
         );
     }
+    langevin_fem::report::write_convergence_index(&args.out)?;
     eprintln!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),

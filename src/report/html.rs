@@ -14,7 +14,7 @@ use crate::verify::summary::{CheckResult, SceneSummary, Summary};
 
 use super::io::write_atomic;
 
-const CSS: &str = "\
+pub(crate) const CSS: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
 margin:2em auto;max-width:1200px;padding:0 1em;color:#1f2328;line-height:1.45}
 h1{margin-bottom:.2em}
@@ -108,11 +108,19 @@ pub fn render_index(summary: &Summary) -> String {
 ///
 /// # Errors
 /// [`crate::Error::Io`] naming the file if it cannot be written.
+/// If `out_dir/convergence/index.html` exists (the reduced stability map of
+/// `make verify`, or `make converge`), a section linking it is added before `</body>`.
 pub fn write_index(out_dir: &Path, summary: &Summary) -> Result<()> {
-    write_atomic(
-        &out_dir.join("index.html"),
-        render_index(summary).as_bytes(),
-    )
+    let mut html = render_index(summary);
+    if out_dir.join("convergence").join("index.html").exists()
+        && let Some(i) = html.rfind("</body>")
+    {
+        html.insert_str(
+            i,
+            "<h2>Convergence and stability</h2>\n<p>Stability map, per-mode stationary bias against each integrator's exact formula (and, after <code>make converge</code>, the convergence studies, work–precision and extreme scenes): <a href=\"convergence/index.html\">convergence/index.html</a>.</p>\n",
+        );
+    }
+    write_atomic(&out_dir.join("index.html"), html.as_bytes())
 }
 
 fn scenes_table(h: &mut String, summary: &Summary) {
@@ -152,6 +160,14 @@ fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
         s.checks.len(),
         plural(s.checks.len())
     );
+
+    if !s.warnings.is_empty() {
+        h.push_str("<ul class=\"warnings\">\n");
+        for w in &s.warnings {
+            let _ = writeln!(h, "<li><strong>Warning:</strong> {}</li>", esc(w));
+        }
+        h.push_str("</ul>\n");
+    }
 
     if !s.notes.is_empty() {
         h.push_str("<ul class=\"notes\">\n");
@@ -239,7 +255,7 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// Escapes text for HTML element content and double- or single-quoted attributes.
-fn esc(text: &str) -> String {
+pub(crate) fn esc(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         match c {
@@ -256,7 +272,7 @@ fn esc(text: &str) -> String {
 
 /// A relative file path as a URL path: `\` becomes `/`, bytes other than unreserved
 /// characters and `/` are percent-encoded (plain paths are unchanged).
-fn url_path(path: &str) -> String {
+pub(crate) fn url_path(path: &str) -> String {
     let mut out = String::with_capacity(path.len());
     for &b in path.replace('\\', "/").as_bytes() {
         if b.is_ascii_alphanumeric() || matches!(b, b'-' | b'.' | b'_' | b'~' | b'/') {

@@ -15,10 +15,12 @@
 //! Everything a report contains is a deterministic function of the run's results, except
 //! the wall-clock times.
 
+pub mod convergence;
 pub mod figure;
 pub mod html;
 pub mod io;
 
+pub use convergence::write_convergence_index;
 pub use figure::{Figure, Series, SeriesStyle};
 pub use html::{render_index, write_index};
 pub use io::{write_atomic, write_csv, write_json};

@@ -101,6 +101,28 @@ pub fn modal_probe(beam: &BeamModel, vectors: &DMatrix<f64>, x: f64) -> DVector<
     vectors.transpose() * v
 }
 
+/// RMS slope (rad) above which the small-slope models are flagged: the geometric terms
+/// they neglect (curvature w''/(1 + w'²)^{3/2}, arc length, tan θ ≈ θ) are O(θ²) relative
+/// to the retained ones, 3θ² ≈ 12 % of the bending energy density at θ = 0.2.
+pub const SMALL_SLOPE_LIMIT: f64 = 0.2;
+
+/// The warning for a run whose measured RMS slope exceeds [`SMALL_SLOPE_LIMIT`], or
+/// `None`. `what` names the run; `(rms, x_rel)` is the largest RMS slope and where (x/L).
+pub fn small_slope_warning(
+    what: &str,
+    (rms, x_rel): (f64, f64),
+    params: &crate::params::FilamentParams,
+) -> Option<String> {
+    (rms > SMALL_SLOPE_LIMIT).then(|| {
+        format!(
+            "{what}: measured RMS slope {rms:.3} rad ({:.1} deg) at x/L = {x_rel:.2} exceeds {SMALL_SLOPE_LIMIT} rad: the small-slope model neglects geometric terms of relative size ~3 theta^2 = {:.0} % here (EI/(kT L) = {}); the checks compare the model with its own exact solution and stay valid, but as a physical filament this one is too floppy for the model",
+            rms.to_degrees(),
+            300.0 * rms * rms,
+            params.bending_rigidity / (params.kt * params.length)
+        )
+    })
+}
+
 /// A filament being simulated: advances all its transverse components by one step and
 /// reports the observables.
 trait Sampler {
@@ -112,6 +134,9 @@ trait Sampler {
     fn modes(&self, out: &mut [f64]);
     /// Deflections at `xs`, component-major: `out[c * xs.len() + j]`.
     fn deflections(&self, xs: &[f64], out: &mut [f64]);
+    /// Adds θ² of every node (slope w'; summed over components) to `acc`, if the model
+    /// carries nodal rotations (the finite-element model does, the spectral one not).
+    fn add_slope_squares(&self, _acc: &mut [f64]) {}
 }
 
 struct FemSampler<'a> {
@@ -148,6 +173,15 @@ impl Sampler for FemSampler<'_> {
         for (c, s) in self.states.iter().enumerate() {
             for (j, &x) in xs.iter().enumerate() {
                 out[c * xs.len() + j] = self.beam.deflection_at(s, x);
+            }
+        }
+    }
+    fn add_slope_squares(&self, acc: &mut [f64]) {
+        for s in &self.states {
+            for (node, a) in acc.iter_mut().enumerate() {
+                if let Some(i) = self.beam.node_rotation_index(node) {
+                    *a += s[i] * s[i];
+                }
             }
         }
     }
@@ -201,6 +235,11 @@ pub struct TrajectoryRecord {
     pub profile: Vec<Vec<f64>>,
     /// Two-time products w(x,t)·w(y,η), `two_time[c * n_points + j]`.
     pub two_time: Vec<f64>,
+    /// Per node, the sum of θ² = w'² over the profile samples and components (empty for
+    /// the spectral model).
+    pub slope_squares: Vec<f64>,
+    /// Number of profile samples summed in `slope_squares`.
+    pub slope_samples: usize,
 }
 
 /// A prepared run of a linear scene: model, references and sampling plan.
@@ -322,6 +361,18 @@ impl LinearRun {
             }
             ModelKind::Fem => {
                 let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
+                // An explicit step above its limit fails at once (λ_max by an O(n)
+                // inertia bisection), before the O(n³) eigen-decomposition.
+                if spec.integrator.stability_limit(1.0).is_some() {
+                    build_integrator(
+                        spec.integrator,
+                        &beam,
+                        spec.noise,
+                        dt,
+                        beam.max_rate()?,
+                        None,
+                    )?;
+                }
                 let gm = generalized_modes(&beam)?;
                 let max_rate = gm.rates[gm.rates.len() - 1];
                 // Fails early with the stability limit if the step is too large.
@@ -469,6 +520,36 @@ impl LinearRun {
         Ok(stats::combine_independent(&parts))
     }
 
+    fn n_nodes(&self) -> usize {
+        match &self.model {
+            Model::Fem { beam, .. } => beam.mesh().n_nodes(),
+            Model::Spectral { .. } => 0,
+        }
+    }
+
+    /// The largest root-mean-square slope |w'| over the mesh nodes, measured over the
+    /// ensemble's profile samples (all components): `(rms slope, node x/L)`. `None` for
+    /// the spectral model or without samples.
+    pub fn measured_rms_slope(&self, records: &[TrajectoryRecord]) -> Option<(f64, f64)> {
+        let Model::Fem { beam, .. } = &self.model else {
+            return None;
+        };
+        let n = records.iter().map(|r| r.slope_samples).sum::<usize>() * self.components;
+        if n == 0 {
+            return None;
+        }
+        let nodes = beam.mesh().n_nodes();
+        (0..nodes)
+            .map(|k| {
+                let sum: f64 = records.iter().map(|r| r.slope_squares[k]).sum();
+                (
+                    (sum / n as f64).sqrt(),
+                    beam.mesh().nodes()[k] / beam.params().length,
+                )
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {
         Ok(match &self.model {
             Model::Fem {
@@ -566,6 +647,8 @@ impl LinearRun {
                 .collect(),
             profile: vec![Vec::with_capacity(cap(self.profile_every)); c * np],
             two_time: vec![0.0; c * tt.len()],
+            slope_squares: vec![0.0; self.n_nodes()],
+            slope_samples: 0,
         };
         // w(x, t) at the earlier time of each two-time point, per component.
         let mut at_t = vec![0.0; c * tt.len()];
@@ -619,6 +702,8 @@ impl LinearRun {
                 for (s, v) in rec.profile.iter_mut().zip(&buf_p) {
                     s.push(*v);
                 }
+                sampler.add_slope_squares(&mut rec.slope_squares);
+                rec.slope_samples += 1;
             }
         }
         Ok(rec)

@@ -13,7 +13,7 @@ use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{
     CompressionRun, CompressionTheoryTable, compression_checks, force_estimates, halving_check,
 };
-use crate::verify::linear::LinearRun;
+use crate::verify::linear::{LinearRun, small_slope_warning};
 use crate::verify::scene::{Budget, CheckKind, ModelKind, Scene};
 use crate::verify::summary::{SceneSummary, Summary};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -204,7 +204,27 @@ fn run_compression_scene(
             .collect::<Result<Vec<_>>>()?;
         let records: Vec<Vec<_>> = flat.chunks(nt).map(<[_]>::to_vec).collect();
         let budget_key = format!("{}.duration_tau1", opts.budget.name());
-        let est = force_estimates(&records).map_err(|e| scene.run_error(k, &budget_key, e))?;
+        let est = force_estimates(&records).map_err(|e| {
+            // Name the usual cause of a too-long correlation time: a sticky chain.
+            let (proposed, accepted) = records
+                .iter()
+                .flatten()
+                .fold((0u64, 0u64), |(p, a), r| (p + r.proposed, a + r.accepted));
+            let e = if proposed > 0 {
+                Error::Numerical {
+                    routine: "force estimates".into(),
+                    detail: format!(
+                        "{e}; the Metropolis acceptance rate was {:.3} (EA L/kT = {:e}, EI/(kT L) = {:e}): a low acceptance makes F strongly correlated; a smaller dt_tau1 raises it",
+                        accepted as f64 / proposed as f64,
+                        scene.filament.stretch_rigidity * scene.filament.length / scene.filament.kt,
+                        scene.filament.bending_rigidity / (scene.filament.kt * scene.filament.length),
+                    ),
+                }
+            } else {
+                e
+            };
+            scene.run_error(k, &budget_key, e)
+        })?;
         checks.extend(
             compression_checks(run, run.spec.checks(scene), theory, &records, &est)
                 .map_err(|e| scene.run_error(k, &budget_key, e))?,
@@ -342,6 +362,7 @@ fn finish_scene(
         figures: rel(figures),
         tables: rel(tables),
         notes,
+        warnings: Vec::new(),
         checks,
     })
 }
@@ -358,6 +379,7 @@ fn run_scene(
     let mut figures = Vec::new();
     let mut tables = Vec::new();
     let mut notes = vec![scene.description.clone()];
+    let mut largest_slope = None;
     for (k, run) in runs.iter().enumerate() {
         let e = run.spec.ensemble(opts.budget);
         let seed = derive_seed(scene.seed, &run.spec.name);
@@ -386,6 +408,13 @@ fn run_scene(
         let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)
             .map_err(|e| scene.run_error(k, &format!("{}.duration_tau1", opts.budget.name()), e))?;
         checks.extend(run_checks);
+        if let Some(slope) = run.measured_rms_slope(&records)
+            && largest_slope
+                .as_ref()
+                .is_none_or(|(_, s): &(String, (f64, f64))| slope.0 > s.0)
+        {
+            largest_slope = Some((run.spec.name.clone(), slope));
+        }
         notes.extend(
             est.skipped
                 .iter()
@@ -413,7 +442,15 @@ fn run_scene(
             notes.push(noise_study(scene, &dir, &mut figures, &mut tables)?);
         }
     }
-    finish_scene(scene, checks, figures, tables, notes, start, opts)
+    let mut summary = finish_scene(scene, checks, figures, tables, notes, start, opts)?;
+    if let Some((run, slope)) = largest_slope {
+        summary.warnings.extend(small_slope_warning(
+            &format!("run {run} (largest of the runs)"),
+            slope,
+            &scene.filament,
+        ));
+    }
+    Ok(summary)
 }
 
 fn write_run_outputs(

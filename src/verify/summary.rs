@@ -76,6 +76,10 @@ pub struct SceneSummary {
     pub tables: Vec<String>,
     /// Notes for a reader (e.g. how a ratio changes with element count).
     pub notes: Vec<String>,
+    /// Warnings: the run is valid for its model, but the model may not be for the
+    /// physics (e.g. slopes too large for the small-slope approximation).
+    #[serde(default)]
+    pub warnings: Vec<String>,
     /// The checks.
     pub checks: Vec<CheckResult>,
 }
