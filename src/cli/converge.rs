@@ -1,16 +1,20 @@
-//! `langevin-fem converge`: convergence study of a linear scene over the element count or
-//! the time step, with fitted orders against the expected ones.
+//! `langevin-fem converge`: convergence study of a finite-element scene (linear or
+//! compression) over the element count or the time step, with fitted orders against the
+//! expected ones.
 
+use super::{parse_list, resolve_scene};
 use clap::Args;
+use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
+use langevin_fem::report::write_convergence_index;
+use langevin_fem::verify::Budget;
 use langevin_fem::verify::converge::{ConvergeOptions, Over, run_convergence};
-use langevin_fem::verify::{Budget, Scene, resolve_scenes};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct ConvergeArgs {
-    /// Scene: a name from the scene directory or a path to a .toml file (linear fem
-    /// scenes only, e.g. hinged-linear-2d, hinged-linear-3d).
+    /// Scene: a name from the scene directory or a path to a .toml file (finite-element
+    /// scenes: hinged-linear-2d, hinged-linear-3d, compression-2d, compression-3d, ...).
     #[arg(long, value_name = "NAME|PATH")]
     scene: String,
     /// What is refined: the element count or the time step dt/tau1.
@@ -18,15 +22,30 @@ pub struct ConvergeArgs {
     over: OverArg,
     /// Comma-separated values (element counts, or dt/tau1); default 5,10,20,40 elements,
     /// or dt/tau1 4e-3,2e-3,1e-3,5e-4 (euler-maruyama: 0.9,0.5,0.25,0.125 of its
-    /// stability limit).
-    #[arg(long, value_name = "V1,V2,...")]
+    /// stability limit; compression with metropolis-crank-nicolson: 0.04,0.02,0.01,0.005).
+    #[arg(long, value_name = "V1,V2,...", allow_hyphen_values = true)]
     values: Option<String>,
     /// Run of the scene (default: its first run).
     #[arg(long)]
     run: Option<String>,
+    /// Replace the run's integrator (its noise, time step and ensembles are kept), e.g.
+    /// crank-nicolson on a compression scene to measure the time-step bias of the
+    /// explicit stretching force.
+    #[arg(long, value_name = "NAME")]
+    integrator: Option<String>,
+    /// Compression scenes: comma-separated strains eps/eps_c0 whose <F> is studied
+    /// (default 0,1,3,10).
+    #[arg(long, value_name = "R1,R2,...", allow_hyphen_values = true)]
+    strain_ratios: Option<String>,
     /// Ensemble budget of the run (trajectories and duration per value).
     #[arg(long, value_enum, default_value = "quick")]
     budget: BudgetArg,
+    /// Trajectories per value, instead of the budget's.
+    #[arg(long, value_name = "N")]
+    trajectories: Option<usize>,
+    /// Sampled duration per trajectory (tau1), instead of the budget's.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    duration_tau1: Option<f64>,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
     out: PathBuf,
@@ -48,17 +67,17 @@ enum BudgetArg {
     Full,
 }
 
-fn parse_values(text: &str) -> Result<Vec<f64>> {
-    text.split(',')
-        .map(|s| {
-            s.trim().parse::<f64>().map_err(|_| {
-                Error::invalid("--values", s.trim(), "a comma-separated list of numbers")
-            })
-        })
-        .collect()
-}
+/// The integrators a study may switch a run to.
+const INTEGRATORS: [IntegratorKind; 5] = [
+    IntegratorKind::EulerMaruyama,
+    IntegratorKind::BackwardEuler,
+    IntegratorKind::CrankNicolson,
+    IntegratorKind::ExactModal,
+    IntegratorKind::MetropolisCrankNicolson,
+];
 
-/// Runs the study and prints a summary of the fitted orders on stderr; exit code 0.
+/// Runs the study, prints a summary of the fitted orders on stderr and rebuilds the
+/// index page of the output directory; exit code 0.
 pub fn run(args: ConvergeArgs) -> Result<i32> {
     let over = match args.over {
         OverArg::Elements => Over::Elements,
@@ -69,21 +88,48 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
         BudgetArg::Standard => Budget::Standard,
         BudgetArg::Full => Budget::Full,
     };
-    let values = args.values.as_deref().map(parse_values).transpose()?;
-    let path = resolve_scenes(std::slice::from_ref(&args.scene), &args.scene_dir)?
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::invalid("--scene", &args.scene, "a scene name or .toml path"))?;
-    let scene = Scene::load(&path)?;
+    let values = args
+        .values
+        .as_deref()
+        .map(|t| parse_list("--values", t, "a comma-separated list of numbers"))
+        .transpose()?;
+    let strain_ratios = args
+        .strain_ratios
+        .as_deref()
+        .map(|t| parse_list("--strain-ratios", t, "a comma-separated list of numbers"))
+        .transpose()?;
+    let integrator = args
+        .integrator
+        .as_deref()
+        .map(|name| {
+            INTEGRATORS
+                .into_iter()
+                .find(|k| k.name() == name.trim())
+                .ok_or_else(|| {
+                    let names: Vec<&str> = INTEGRATORS.iter().map(|k| k.name()).collect();
+                    Error::invalid(
+                        "--integrator",
+                        name.trim(),
+                        format!("one of: {}", names.join(", ")),
+                    )
+                })
+        })
+        .transpose()?;
+    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
     let s = run_convergence(&ConvergeOptions {
         scene,
         run: args.run,
         over,
         values,
+        integrator,
+        strain_ratios,
         budget,
+        trajectories: args.trajectories,
+        duration_tau1: args.duration_tau1,
         out: args.out.clone(),
         progress: true,
     })?;
+    write_convergence_index(&args.out)?;
     eprintln!(
         "{} / {} ({} with {} noise), over {} (h = {}), {}; errors against the {}",
         s.scene,
@@ -126,6 +172,21 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
             eprintln!("           {}", o.note);
         }
         eprintln!("           expected: {}", o.expected.why);
+    }
+    if let Some(c) = &s.discrete_consistency {
+        eprintln!(
+            "  simulation vs exact discrete reference: largest |z| = {:.2} ({}) over {} rows, Bonferroni p = {:.3}; sum z^2 = {:.2}",
+            c.max_abs_z, c.worst, c.rows, c.p_value, c.chi2
+        );
+    }
+    for u in &s.unstable {
+        eprintln!("  UNSTABLE at {}={}: {}", s.over.name(), u.value, u.error);
+    }
+    for n in &s.notes {
+        eprintln!("  note: {n}");
+    }
+    for w in &s.warnings {
+        eprintln!("  warning: {w}");
     }
     eprintln!(
         "wrote {} in {} ({:.1} s)",

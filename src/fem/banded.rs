@@ -295,6 +295,18 @@ impl BandedCholesky {
             }
             b[i] = s * self.inv_diag[i];
         }
+        self.solve_upper_in_place(b);
+    }
+
+    /// Solves `Lᵀ x = b` in place (the backward half of [`Self::solve_in_place`]),
+    /// `O(n·bw)`. With `b` iid standard normal, `x ~ N(0, A⁻¹)`.
+    ///
+    /// # Panics
+    /// If `b.len() != n`.
+    pub fn solve_upper_in_place(&self, b: &mut [f64]) {
+        assert_eq!(b.len(), self.n, "solve_upper_in_place: wrong length");
+        let w = self.bw + 1;
+        let n = self.n;
         for i in (0..n).rev() {
             let hi = (i + w).min(n);
             let mut s = b[i];
@@ -303,6 +315,11 @@ impl BandedCholesky {
             }
             b[i] = s * self.inv_diag[i];
         }
+    }
+
+    /// `ln det A = 2 Σ_j ln L_jj`.
+    pub fn log_det(&self) -> f64 {
+        -2.0 * self.inv_diag.iter().map(|d| d.ln()).sum::<f64>()
     }
 
     /// `out = L z`. With `z` iid standard normal, `out ~ N(0, A)`.

@@ -76,7 +76,7 @@ fn convergence_section(h: &mut String, v: &Value) {
         v["duration_tau1"],
         v["wall_seconds"].as_f64().unwrap_or(0.0)
     );
-    h.push_str("<table><tr><th>observable</th><th>expected order</th><th>observed order (95 % CI)</th><th>exact-error order</th><th>sampling floor at</th><th>why / note</th></tr>\n");
+    h.push_str("<table><tr><th>observable</th><th>expected order</th><th>observed order (95 % CI)</th><th>agrees</th><th>exact-error order</th><th>sampling floor at</th><th>why / note</th></tr>\n");
     for o in v["observables"].as_array().into_iter().flatten() {
         let e = &o["expected"];
         let expected = match (e["order"].as_f64(), e["exact"].as_bool()) {
@@ -86,10 +86,15 @@ fn convergence_section(h: &mut String, v: &Value) {
         };
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"detail\">{} {}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td>{}<td class=\"num\">{}</td><td>{}</td><td class=\"detail\">{} {}</td></tr>",
             esc(o["observable"].as_str().unwrap_or("")),
             esc(&expected),
             esc(&fit(&o["observed"])),
+            match o["agrees"].as_bool() {
+                Some(true) => "<td class=\"pass\">yes</td>",
+                Some(false) => "<td class=\"warn\">no (see note)</td>",
+                None => "<td>–</td>",
+            },
             esc(&fit(&o["exact"])),
             esc(&o["floor_values"].to_string()),
             esc(e["why"].as_str().unwrap_or("")),
@@ -97,6 +102,37 @@ fn convergence_section(h: &mut String, v: &Value) {
         );
     }
     h.push_str("</table>\n");
+    let c = &v["discrete_consistency"];
+    if !c.is_null() {
+        let p = c["p_value"].as_f64().unwrap_or(f64::NAN);
+        let _ = writeln!(
+            h,
+            "<p class=\"meta\">Simulation against the exact discrete reference of each value: largest |z| = {} ({}) over {} rows, <span class=\"{}\">Bonferroni p = {}</span> (below 0.01: the simulation disagrees with its own discretization); Σz² = {}.</p>",
+            num(&c["max_abs_z"]),
+            esc(c["worst"].as_str().unwrap_or("")),
+            c["rows"],
+            if p < 0.01 { "fail" } else { "pass" },
+            num(&c["p_value"]),
+            num(&c["chi2"])
+        );
+    }
+    let list = |h: &mut String, key: &str, class: &str, label: &str| {
+        for n in v[key].as_array().into_iter().flatten() {
+            let text = match n {
+                Value::String(t) => t.clone(),
+                other => format!(
+                    "{} = {}: {}",
+                    v["over"].as_str().unwrap_or(""),
+                    other["value"],
+                    other["error"].as_str().unwrap_or("")
+                ),
+            };
+            let _ = writeln!(h, "<p class=\"{class}\">{label}{}</p>", esc(&text));
+        }
+    };
+    list(h, "unstable", "fail", "unstable: ");
+    list(h, "warnings", "warn", "warning: ");
+    list(h, "notes", "meta", "");
     files(h, v);
 }
 
@@ -227,7 +263,7 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
     let mut h = String::new();
     let _ = writeln!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>langevin-fem convergence</title><style>{CSS}td.warn{{background:#fff8c5;color:#7d4e00;font-weight:bold;text-align:center}}</style></head><body>\n<h1>langevin-fem: convergence, work–precision, stability</h1>"
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>langevin-fem convergence</title><style>{CSS}td.warn{{background:#fff8c5;color:#7d4e00;font-weight:bold;text-align:center}}p.fail,span.fail{{color:#a40e26;font-weight:bold}}p.warn{{color:#7d4e00}}</style></head><body>\n<h1>langevin-fem: convergence, work–precision, stability</h1>"
     );
     if dir.join("extreme").join("index.html").exists() {
         h.push_str("<h2>Extreme scenes</h2>\n<p>Very stiff, floppy (small-slope warning), 1000-element and huge-EA scenes: <a href=\"extreme/index.html\">extreme/index.html</a>.</p>\n");

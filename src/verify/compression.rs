@@ -5,16 +5,21 @@
 
 use crate::dynamics::nonlinear::{CompressedFilament, NonlinearIntegrator};
 use crate::error::{Error, Result};
+use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
-use crate::rng::TrajectoryRng;
+use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::stats;
 use crate::theory::compression::{CompressionTheory, Dims, ForceDistribution, StoredLengthLaw};
+use crate::verify::linear::{add_slope_squares, largest_rms_slope};
 use crate::verify::scene::{CheckKind, CompressionSpec, RunSpec, Scene};
 use crate::verify::summary::CheckResult;
+use rand::RngExt;
+use rand_distr::StandardNormal;
+use rayon::prelude::*;
 
 /// Modes of the continuum theory (plus the exact tail cumulants).
-const CONTINUUM_MODES: usize = 10_000;
+pub const CONTINUUM_MODES: usize = crate::theory::DEFAULT_CONTINUUM_MODES;
 /// Thinning of F samples for the KS test, in integrated autocorrelation times.
 const KS_THINNING_TAU: f64 = 10.0;
 
@@ -100,6 +105,8 @@ pub struct CompressionRun {
     pub sample_every: u64,
     models: Vec<CompressedFilament>,
     euler_load: f64,
+    /// Cholesky factor of the bending stiffness K, for the equilibrium start.
+    stiffness: BandedCholesky,
 }
 
 /// What one trajectory at one strain recorded.
@@ -111,6 +118,10 @@ pub struct ForceRecord {
     pub proposed: u64,
     /// Accepted proposals.
     pub accepted: u64,
+    /// Sum over the samples of θ² at each node (slope w', summed over components).
+    pub slope_squares: Vec<f64>,
+    /// Number of samples in `slope_squares`.
+    pub slope_samples: usize,
 }
 
 impl CompressionRun {
@@ -135,6 +146,7 @@ impl CompressionRun {
             dt,
             burn_in_steps: (comp.burn_in_tau1 * tau1 / dt).round() as u64,
             sample_every: ((comp.sample_every_tau1 * tau1 / dt).round() as u64).max(1),
+            stiffness: beam.stiffness().cholesky()?,
             models,
             euler_load: p.euler_load(),
         })
@@ -146,7 +158,36 @@ impl CompressionRun {
         (n / self.sample_every).max(1) * self.sample_every
     }
 
-    /// Simulates one trajectory at strain index `point` from rest.
+    /// An exact sample of the free bending equilibrium, `w_c ~ N(0, kT K⁻¹)` per
+    /// transverse component (`w = sqrt(kT) L⁻ᵀ z` with `K = LLᵀ`, O(n)): the start of
+    /// every trajectory.
+    ///
+    /// Why not from rest: Crank–Nicolson (the proposal of the Metropolis scheme, and the
+    /// θ = ½ scheme) damps a stiff mode of rate λ only by `m = (1 − a/2)/(1 + a/2) ≈
+    /// −1 + 4/a` per step (a = λΔt), so from rest its variance needs about a/8 steps to
+    /// build up: at 10 elements and Δt = 0.02 τ1 that is 300 steps for the stiffest mode,
+    /// at 40 elements 8·10⁴ steps (1600 τ1). Those modes are almost purely bending (their
+    /// buckling loads are ≫ F), so starting from the bending equilibrium puts them in
+    /// equilibrium at once; the burn-in then equilibrates the slow, strain-dependent
+    /// modes. From rest, the missing stored length of the stiff modes biased ⟨F⟩ upwards
+    /// by up to 0.04 F_c0 (3D, 40 elements, Δt = 0.04 τ1), which the convergence study
+    /// over Δt exposed.
+    pub fn equilibrium_start(&self, rng: &mut TrajectoryRng) -> Vec<Vec<f64>> {
+        let model = &self.models[0];
+        let kt_sqrt = model.beam().params().kt.sqrt();
+        (0..model.components())
+            .map(|_| {
+                let mut z: Vec<f64> = (0..model.beam().n_dofs())
+                    .map(|_| kt_sqrt * rng.sample::<f64, _>(StandardNormal))
+                    .collect();
+                self.stiffness.solve_upper_in_place(&mut z);
+                z
+            })
+            .collect()
+    }
+
+    /// Simulates one trajectory at strain index `point` from an equilibrium start
+    /// ([`Self::equilibrium_start`]).
     ///
     /// # Errors
     /// [`Error::Diverged`] naming the step, time and strain if the state becomes
@@ -161,10 +202,12 @@ impl CompressionRun {
         let mut integ =
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
         let n = model.beam().n_dofs();
-        let mut w = vec![vec![0.0; n]; model.components()];
+        let mut w = self.equilibrium_start(rng);
+        debug_assert_eq!(w.first().map(Vec::len), Some(n));
         let total = self.burn_in_steps + sampled_steps;
         let mut rec = ForceRecord {
             force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+            slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
             ..Default::default()
         };
         for step in 1..=total {
@@ -186,6 +229,10 @@ impl CompressionRun {
             {
                 let f = model.compressive_force(model.stored_length(&w));
                 rec.force_ratio.push(f / self.euler_load);
+                for c in &w {
+                    add_slope_squares(model.beam(), c, &mut rec.slope_squares);
+                }
+                rec.slope_samples += 1;
             }
         }
         rec.proposed = integ.proposed;
@@ -193,9 +240,66 @@ impl CompressionRun {
         Ok(rec)
     }
 
+    /// Simulates `trajectories` trajectories of `sampled_steps` steps at every strain, in
+    /// parallel (rayon over strain × trajectory). Trajectory `j` at strain `i` uses the
+    /// stream `trajectory_rng(seed(i), j)`, so the result does not depend on the thread
+    /// count. `tick` is called after each trajectory (progress). Returns the records per
+    /// strain.
+    ///
+    /// # Errors
+    /// As [`Self::simulate`]: the first diverged trajectory (in index order).
+    pub fn simulate_ensemble(
+        &self,
+        seed: impl Fn(usize) -> u64 + Sync,
+        trajectories: usize,
+        sampled_steps: u64,
+        tick: impl Fn() + Sync,
+    ) -> Result<Vec<Vec<ForceRecord>>> {
+        let nt = trajectories.max(1);
+        let flat = (0..self.points() * nt)
+            .into_par_iter()
+            .map(|t| {
+                let (i, j) = (t / nt, t % nt);
+                let rec = self.simulate(i, &mut trajectory_rng(seed(i), j as u64), sampled_steps);
+                tick();
+                rec
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(flat.chunks(nt).map(<[_]>::to_vec).collect())
+    }
+
     /// The strains of this run (ε/ε_c0 is in the theory table).
     pub fn points(&self) -> usize {
         self.models.len()
+    }
+
+    /// The largest root-mean-square nodal slope |w'| (all components) of the records of
+    /// one strain: `(rms slope, node x/L)`; `None` without samples. The small-slope
+    /// (von Kármán) model is flagged above
+    /// [`SMALL_SLOPE_LIMIT`](crate::verify::linear::SMALL_SLOPE_LIMIT).
+    pub fn measured_rms_slope(&self, records: &[ForceRecord]) -> Option<(f64, f64)> {
+        let beam = self.models.first()?.beam();
+        let n =
+            records.iter().map(|r| r.slope_samples).sum::<usize>() * self.models[0].components();
+        let sums: Vec<f64> = (0..beam.mesh().n_nodes())
+            .map(|k| {
+                records
+                    .iter()
+                    .map(|r| r.slope_squares.get(k).copied().unwrap_or(0.0))
+                    .sum()
+            })
+            .collect();
+        largest_rms_slope(beam, &sums, n)
+    }
+
+    /// The largest RMS slope over all strains of `records` (one entry per strain):
+    /// `(rms slope, node x/L, strain index)`.
+    pub fn largest_rms_slope(&self, records: &[Vec<ForceRecord>]) -> Option<(f64, f64, usize)> {
+        records
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| self.measured_rms_slope(r).map(|(s, x)| (s, x, i)))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
     }
 }
 
@@ -240,6 +344,45 @@ pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
         acc as f64 / prop as f64
     };
     Ok(out)
+}
+
+/// Metropolis acceptance rates below this are named as the likely cause of a failed
+/// force estimate (a sticky chain).
+pub const LOW_ACCEPTANCE: f64 = 0.2;
+
+/// [`force_estimates`], with the usual cause of a failure named: the Metropolis
+/// acceptance rate and the filament's EA·L/kT and EI/(kT·L) are added to the message,
+/// and a rate below [`LOW_ACCEPTANCE`] (a sticky chain) is named as the cause.
+///
+/// # Errors
+/// As [`force_estimates`].
+pub fn force_estimates_diagnosed(
+    records: &[Vec<ForceRecord>],
+    params: &crate::params::FilamentParams,
+) -> Result<ForceEstimates> {
+    force_estimates(records).map_err(|e| {
+        let (proposed, accepted) = records
+            .iter()
+            .flatten()
+            .fold((0u64, 0u64), |(p, a), r| (p + r.proposed, a + r.accepted));
+        if proposed == 0 {
+            return e;
+        }
+        let rate = accepted as f64 / proposed as f64;
+        let cause = if rate < LOW_ACCEPTANCE {
+            "a low acceptance makes F strongly correlated; a smaller dt_tau1 raises it"
+        } else {
+            "the acceptance is not the cause: F relaxes slowly compared with the sampled duration; raise duration_tau1"
+        };
+        Error::Numerical {
+            routine: "force estimates".into(),
+            detail: format!(
+                "{e}; the Metropolis acceptance rate was {rate:.3} (EA L/kT = {:e}, EI/(kT L) = {:e}): {cause}",
+                params.stretch_rigidity * params.length / params.kt,
+                params.bending_rigidity / (params.kt * params.length),
+            ),
+        }
+    })
 }
 
 /// The force–strain and force-distribution checks of one run.

@@ -1,4 +1,6 @@
-//! Convergence studies of the linear scenes (`langevin-fem converge`).
+//! Convergence studies (`langevin-fem converge`) of the linear scenes (here) and of the
+//! compression scenes ([`compression`]: ⟨F⟩ at imposed strains against the exact
+//! equilibrium theory).
 //!
 //! For each value of the refined parameter (the element count, or the time step Δt/τ1)
 //! the scene is rebuilt with that value, the run is prepared ([`LinearRun::prepare`]) and
@@ -22,7 +24,13 @@
 //! error exceeds [`FLOOR_SIGMAS`] standard errors; the others are flagged "sampling floor".
 //! The order of the exact error is fitted on all points whose exact error is above
 //! round-off ([`ROUNDING_FACTOR`]). Confidence intervals use Student's t with n − 2 degrees of
-//! freedom (residual scale), so at least three points are needed for an interval.
+//! freedom (residual scale), so at least three points are needed for an interval. The
+//! observed order *agrees* with the expected one when its interval holds it
+//! ([`ObservableSummary::agrees`]); a disagreement is stated in the observable's note.
+//!
+//! A value whose run diverges (a non-finite state, e.g. an explicit stretching force at a
+//! too-large Δt) is recorded with the step it failed at ([`UnstableValue`]) and the study
+//! goes on with the other values.
 
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
@@ -35,13 +43,15 @@ use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::stats;
-use crate::verify::linear::{LinearRun, TrajectoryRecord, modal_probe};
-use crate::verify::scene::{Budget, ModelKind, RunSpec, Scene};
+use crate::verify::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
+use crate::verify::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+pub mod compression;
 
 /// A total error is resolved (not at the sampling floor) if it exceeds this many
 /// standard errors.
@@ -80,6 +90,14 @@ impl Over {
         match self {
             Over::Elements => "elements",
             Over::Dt => "dt",
+        }
+    }
+
+    /// What h is for this refinement: `L/elements` or `dt/tau1`.
+    pub fn h_label(self) -> &'static str {
+        match self {
+            Over::Elements => "L/elements",
+            Over::Dt => "dt/tau1",
         }
     }
 }
@@ -494,20 +512,67 @@ pub fn validate_values(over: Over, values: &[f64]) -> Result<()> {
 /// Options of a convergence study.
 #[derive(Debug, Clone)]
 pub struct ConvergeOptions {
-    /// The scene (linear, model = "fem").
+    /// The scene (linear, model = "fem", or compression).
     pub scene: Scene,
     /// The run's name (default: the scene's first run).
     pub run: Option<String>,
     /// What is refined.
     pub over: Over,
-    /// The values (default: [`default_values`]).
+    /// The values (default: [`default_values`], or
+    /// [`compression::default_values`] for compression scenes).
     pub values: Option<Vec<f64>>,
+    /// Another integrator for the run (its noise, time step and ensembles kept).
+    pub integrator: Option<IntegratorKind>,
+    /// Strains ε/ε_c0 whose ⟨F⟩ is studied (compression scenes only; default
+    /// [`compression::DEFAULT_STRAIN_RATIOS`]).
+    pub strain_ratios: Option<Vec<f64>>,
     /// Ensemble budget.
     pub budget: Budget,
+    /// Overrides the budget's number of trajectories per value.
+    pub trajectories: Option<usize>,
+    /// Overrides the budget's sampled duration per trajectory (τ1).
+    pub duration_tau1: Option<f64>,
     /// Output directory.
     pub out: PathBuf,
     /// Progress lines on stderr.
     pub progress: bool,
+}
+
+/// Allowed `--trajectories` of a study.
+pub const TRAJECTORIES_RANGE: (usize, usize) = (1, 100_000);
+/// Allowed `--duration-tau1` of a study (τ1).
+pub const DURATION_RANGE: (f64, f64) = (1.0, 1.0e6);
+
+/// The ensemble of a study: the run's ensemble at the budget, with the options'
+/// overrides.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--trajectories` or `--duration-tau1`.
+pub fn study_ensemble(opts: &ConvergeOptions, spec: &RunSpec) -> Result<Ensemble> {
+    let mut e = spec.ensemble(opts.budget);
+    if let Some(n) = opts.trajectories {
+        let (lo, hi) = TRAJECTORIES_RANGE;
+        if !(lo..=hi).contains(&n) {
+            return Err(Error::invalid(
+                "--trajectories",
+                n,
+                format!("an integer in [{lo}, {hi}]"),
+            ));
+        }
+        e.trajectories = n;
+    }
+    if let Some(d) = opts.duration_tau1 {
+        let (lo, hi) = DURATION_RANGE;
+        if !(d.is_finite() && (lo..=hi).contains(&d)) {
+            return Err(Error::invalid(
+                "--duration-tau1",
+                d,
+                format!("a duration in [{lo}, {hi:e}] tau1"),
+            ));
+        }
+        e.duration_tau1 = d;
+    }
+    Ok(e)
 }
 
 /// One row of the table: one value and one observable.
@@ -523,21 +588,53 @@ pub struct Row {
     pub estimate: f64,
     /// Its standard error.
     pub std_error: f64,
-    /// Exact discrete reference.
-    pub discrete: f64,
+    /// Exact discrete reference, if one is known (none for the time-step bias of the
+    /// nonlinear θ-schemes).
+    pub discrete: Option<f64>,
     /// Limit reference (continuum, or Δt → 0 of this mesh).
     pub limit: f64,
     /// |estimate − limit|.
     pub total_error: f64,
     /// Its standard error (that of the estimate).
     pub total_error_se: f64,
-    /// |discrete − limit|.
-    pub exact_error: f64,
+    /// |discrete − limit|, if the discrete reference is known.
+    pub exact_error: Option<f64>,
     /// Whether the total error is at the sampling floor (≤ 3 standard errors).
     pub sampling_floor: bool,
     /// Whether the exact error is at the round-off level of the references (the
     /// discretization is exact for this observable here).
     pub exact_at_rounding: bool,
+}
+
+impl Row {
+    /// A row from the estimate `(e, se)`, the exact discrete reference (if known), the
+    /// limit and the references' absolute round-off level.
+    pub fn new(
+        value: f64,
+        h: f64,
+        observable: &str,
+        (e, se): (f64, f64),
+        discrete: Option<f64>,
+        limit: f64,
+        rounding: f64,
+    ) -> Row {
+        let total = (e - limit).abs();
+        let exact_error = discrete.map(|d| (d - limit).abs());
+        Row {
+            value,
+            h,
+            observable: observable.to_string(),
+            estimate: e,
+            std_error: se,
+            discrete,
+            limit,
+            total_error: total,
+            total_error_se: se,
+            exact_error,
+            sampling_floor: not_above(total, FLOOR_SIGMAS * se),
+            exact_at_rounding: exact_error.is_some_and(|x| not_above(x, rounding)),
+        }
+    }
 }
 
 /// The fitted and expected orders of one observable.
@@ -555,8 +652,66 @@ pub struct ObservableSummary {
     pub exact: Option<OrderFit>,
     /// Values whose exact error is at round-off (the discretization is exact there).
     pub exact_at_rounding: Vec<f64>,
-    /// Why no observed order was fitted, if none was.
+    /// Whether the observed order agrees with the expected one: its confidence interval
+    /// holds the expected order (`None` without an expected order or an interval).
+    pub agrees: Option<bool>,
+    /// Why no observed order was fitted, if none was, or why it differs from the
+    /// expected one.
     pub note: String,
+}
+
+/// The simulation against the exact discrete references of a study, all rows together:
+/// z = (estimate − discrete)/s.e. per row (two-sided z-test), the largest |z| judged with
+/// a Bonferroni correction over the rows (valid although rows of one value share their
+/// trajectories: ⟨w²(L/2)⟩ is dominated by mode 1). A small p-value says the simulation
+/// disagrees with its own discretization's exact value (an integrator, sampling or
+/// burn-in problem, not discretization error). Σz² is reported as a summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DiscreteConsistency {
+    /// Σz² (descriptive: the rows are not all independent).
+    pub chi2: f64,
+    /// Rows compared.
+    pub rows: usize,
+    /// Bonferroni-adjusted p-value of the largest |z|: min(1, rows × p).
+    pub p_value: f64,
+    /// The largest |z|.
+    pub max_abs_z: f64,
+    /// Where the largest |z| is: "observable at value".
+    pub worst: String,
+}
+
+/// [`DiscreteConsistency`] of the rows with a discrete reference; `None` without such
+/// rows.
+pub fn discrete_consistency(rows: &[Row]) -> Option<DiscreteConsistency> {
+    let tests: Vec<(stats::TestOutcome, &Row)> = rows
+        .iter()
+        .filter_map(|r| {
+            let d = r.discrete?;
+            stats::z_test(r.estimate, d, r.std_error)
+                .ok()
+                .map(|o| (o, r))
+        })
+        .collect();
+    let (worst, r) = tests
+        .iter()
+        .max_by(|a, b| a.0.statistic.abs().total_cmp(&b.0.statistic.abs()))?;
+    let n = tests.len();
+    Some(DiscreteConsistency {
+        chi2: tests.iter().map(|t| t.0.statistic.powi(2)).sum(),
+        rows: n,
+        p_value: (n as f64 * worst.p_value).min(1.0),
+        max_abs_z: worst.statistic.abs(),
+        worst: format!("{} at {}", r.observable, r.value),
+    })
+}
+
+/// A value of the study whose run went unstable (diverged): recorded, not fatal.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnstableValue {
+    /// The value (element count or Δt/τ1).
+    pub value: f64,
+    /// The error, naming the step.
+    pub error: String,
 }
 
 /// The JSON summary of a study.
@@ -564,7 +719,7 @@ pub struct ObservableSummary {
 pub struct ConvergeSummary {
     /// Scene name.
     pub scene: String,
-    /// Run name.
+    /// Run name (with `-as-<integrator>` if the integrator was overridden).
     pub run: String,
     /// Integrator.
     pub integrator: String,
@@ -588,12 +743,45 @@ pub struct ConvergeSummary {
     pub values: Vec<f64>,
     /// Per observable.
     pub observables: Vec<ObservableSummary>,
+    /// The simulation against the exact discrete references (`None` if there are none).
+    pub discrete_consistency: Option<DiscreteConsistency>,
+    /// Values whose run went unstable (no rows for them).
+    pub unstable: Vec<UnstableValue>,
+    /// Notes (acceptance rates, measured slopes, ...).
+    pub notes: Vec<String>,
+    /// Warnings about the physics (e.g. slopes too large for the small-slope model).
+    pub warnings: Vec<String>,
     /// All rows.
     pub rows: Vec<Row>,
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
     pub wall_seconds: f64,
+}
+
+/// What a study computed, before it is summarized and written.
+#[derive(Debug, Clone, Default)]
+pub struct Study {
+    /// Values studied (h descending).
+    pub values: Vec<f64>,
+    /// Observable names.
+    pub names: Vec<String>,
+    /// Expected order per observable.
+    pub expected: Vec<Expected>,
+    /// All rows.
+    pub rows: Vec<Row>,
+    /// What h is.
+    pub h: String,
+    /// What the errors are measured against.
+    pub limit_reference: String,
+    /// The fixed parameter.
+    pub fixed: String,
+    /// Values whose run went unstable.
+    pub unstable: Vec<UnstableValue>,
+    /// Notes.
+    pub notes: Vec<String>,
+    /// Warnings.
+    pub warnings: Vec<String>,
 }
 
 /// Estimates of the observables from the records: (estimate, standard error).
@@ -633,28 +821,19 @@ fn estimates(lr: &LinearRun, records: &[TrajectoryRecord]) -> Result<Vec<(f64, f
     Ok(out)
 }
 
-/// Finds run `name` (default: the first) of a linear fem scene.
+/// Finds run `name` (default: the first) of a finite-element scene (linear or
+/// compression).
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming `--scene` (compression or spectral scene) or
-/// `--run` (unknown run).
+/// [`Error::InvalidParameter`] naming `--scene` (spectral scene) or `--run` (unknown
+/// run).
 pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
-    match scene.model {
-        ModelKind::Compression => {
-            return Err(Error::invalid(
-                "--scene",
-                &scene.name,
-                "a linear finite-element scene (e.g. hinged-linear-2d, hinged-linear-3d): compression scenes are not supported by converge yet",
-            ));
-        }
-        ModelKind::Spectral => {
-            return Err(Error::invalid(
-                "--scene",
-                &scene.name,
-                "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d, hinged-linear-3d): the spectral model has no discretization to refine",
-            ));
-        }
-        ModelKind::Fem => {}
+    if scene.model == ModelKind::Spectral {
+        return Err(Error::invalid(
+            "--scene",
+            &scene.name,
+            "a finite-element scene (model = \"fem\" or \"compression\", e.g. hinged-linear-2d, compression-2d): the spectral model has no discretization to refine",
+        ));
     }
     match name {
         None => Ok(0),
@@ -665,14 +844,48 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
     }
 }
 
-/// Runs a convergence study and writes `<scene>-<run>-<over>.{csv,svg,json}` in `out`.
+/// Runs a convergence study and writes `<scene>-<run>-<over>.{csv,svg,json}` in `out`
+/// (`<run>-as-<integrator>` with an integrator override).
 ///
 /// # Errors
-/// Bad input (exit 2) naming the flag; run failures (exit 3).
+/// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
+/// diverges is recorded in [`ConvergeSummary::unstable`], not fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
-    let scene = &opts.scene;
-    let run = select_run(scene, opts.run.as_deref())?;
+    let run = select_run(&opts.scene, opts.run.as_deref())?;
+    let mut scene = opts.scene.clone();
+    let mut label = scene.runs[run].name.clone();
+    if let Some(k) = opts.integrator
+        && k != scene.runs[run].integrator
+    {
+        scene.runs[run].integrator = k;
+        label = format!("{label}-as-{}", k.name());
+    }
+    let spec = scene.runs[run].clone();
+    let ensemble = study_ensemble(opts, &spec)?;
+    let study = match scene.model {
+        ModelKind::Compression => compression::study(&scene, run, opts, ensemble)?,
+        _ => {
+            if opts.strain_ratios.is_some() {
+                return Err(Error::invalid(
+                    "--strain-ratios",
+                    &scene.name,
+                    "a compression scene (model = \"compression\"): the linear scenes have no imposed strain",
+                ));
+            }
+            linear_study(&scene, run, opts, ensemble)?
+        }
+    };
+    finish(opts, &scene, &spec, &label, study, ensemble, start)
+}
+
+/// The linear study: ⟨w²(L/2)⟩ and the variances of modes 1–3 per value.
+fn linear_study(
+    scene: &Scene,
+    run: usize,
+    opts: &ConvergeOptions,
+    ensemble: Ensemble,
+) -> Result<Study> {
     let spec = scene.runs[run].clone();
     let over = opts.over;
     let mut values = match &opts.values {
@@ -683,7 +896,6 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     // Largest h first.
     values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
     let names = observable_names();
-    let ensemble = spec.ensemble(opts.budget);
     let limit_dt = match over {
         Over::Dt => Some(semi_discrete_limit(scene, &spec)?),
         Over::Elements => None,
@@ -694,6 +906,8 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
         .map(|&v| prepare(scene, run, over, v))
         .collect::<Result<Vec<_>>>()?;
     let mut rows = Vec::new();
+    let mut unstable = Vec::new();
+    let mut largest_slope: Option<(f64, (f64, f64))> = None;
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
@@ -702,31 +916,37 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
             &format!("{}/converge/{}={v}", spec.name, over.name()),
         );
         let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-        let records = (0..ensemble.trajectories as u64)
+        let records = match (0..ensemble.trajectories as u64)
             .into_par_iter()
             .map(|j| lr.simulate(&mut trajectory_rng(seed, j), steps))
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>()
+        {
+            Ok(r) => r,
+            Err(e @ Error::Diverged { .. }) => {
+                unstable.push(UnstableValue {
+                    value: v,
+                    error: e.to_string(),
+                });
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        if let Some(slope) = lr.measured_rms_slope(&records)
+            && largest_slope.is_none_or(|l| slope.0 > l.1.0)
+        {
+            largest_slope = Some((v, slope));
+        }
         let est = estimates(lr, &records)?;
         for (k, name) in names.iter().enumerate() {
-            let (e, se) = est[k];
-            let total = (e - refp.limit[k]).abs();
-            rows.push(Row {
-                value: v,
-                h: refp.h,
-                observable: name.clone(),
-                estimate: e,
-                std_error: se,
-                discrete: refp.discrete[k],
-                limit: refp.limit[k],
-                total_error: total,
-                total_error_se: se,
-                exact_error: (refp.discrete[k] - refp.limit[k]).abs(),
-                sampling_floor: not_above(total, FLOOR_SIGMAS * se),
-                exact_at_rounding: not_above(
-                    (refp.discrete[k] - refp.limit[k]).abs(),
-                    refp.rounding_rel * refp.limit[k].abs(),
-                ),
-            });
+            rows.push(Row::new(
+                v,
+                refp.h,
+                name,
+                est[k],
+                Some(refp.discrete[k]),
+                refp.limit[k],
+                refp.rounding_rel * refp.limit[k].abs(),
+            ));
         }
         if opts.progress {
             eprintln!(
@@ -746,25 +966,30 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
             .all(|v| (v.round() as usize).is_multiple_of(2)),
         Over::Dt => scene.mesh.elements.is_multiple_of(2),
     };
-    let observables = summarize(&names, &rows, over, &spec, node_at_mid);
-
-    let stem = format!("{}-{}-{}", scene.name, spec.name, over.name());
-    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
-    let csv = opts.out.join(format!("{stem}.csv"));
-    write_rows_csv(&csv, &rows)?;
-    let svg = opts.out.join(format!("{stem}.svg"));
-    figure(scene, &spec, over, &names, &rows).write_svg(&svg)?;
-    let json = opts.out.join(format!("{stem}.json"));
-    let summary = ConvergeSummary {
-        scene: scene.name.clone(),
-        run: spec.name.clone(),
-        integrator: spec.integrator.name().to_string(),
-        noise: spec.noise.name().to_string(),
-        over,
-        h: match over {
-            Over::Elements => "L/elements".to_string(),
-            Over::Dt => "dt/tau1".to_string(),
-        },
+    let expected = (0..names.len())
+        .map(|k| expected_order(over, &spec, k, node_at_mid))
+        .collect();
+    let mut notes = Vec::new();
+    let mut warnings = Vec::new();
+    if let Some((v, slope)) = largest_slope {
+        notes.push(format!(
+            "largest measured RMS slope {:.3} rad at x/L = {:.2} ({}={v})",
+            slope.0,
+            slope.1,
+            over.name()
+        ));
+        warnings.extend(small_slope_warning(
+            &format!("{}={v}", over.name()),
+            slope,
+            &scene.filament,
+        ));
+    }
+    Ok(Study {
+        values,
+        names,
+        expected,
+        rows,
+        h: over.h_label().to_string(),
         limit_reference: match over {
             Over::Elements => "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)".to_string(),
             Over::Dt => format!(
@@ -772,19 +997,63 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
                 scene.mesh.elements
             ),
         },
-        budget: opts.budget.name().to_string(),
-        trajectories: ensemble.trajectories,
-        duration_tau1: ensemble.duration_tau1,
         fixed: match over {
             Over::Elements => format!("dt_tau1 = {:e}", spec.dt_tau1),
             Over::Dt => format!("elements = {}", scene.mesh.elements),
         },
-        values,
+        unstable,
+        notes,
+        warnings,
+    })
+}
+
+/// Summarizes `study`, writes its CSV, SVG and JSON and rebuilds nothing else (the CLI
+/// rebuilds the index page).
+fn finish(
+    opts: &ConvergeOptions,
+    scene: &Scene,
+    spec: &RunSpec,
+    label: &str,
+    study: Study,
+    ensemble: Ensemble,
+    start: Instant,
+) -> Result<ConvergeSummary> {
+    let over = opts.over;
+    let observables = summarize(&study.names, &study.rows, &study.expected);
+    let stem = format!("{}-{label}-{}", scene.name, over.name());
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let csv = opts.out.join(format!("{stem}.csv"));
+    write_rows_csv(&csv, &study.rows)?;
+    let svg = opts.out.join(format!("{stem}.svg"));
+    figure(scene, label, spec, over, &study.names, &study.rows).write_svg(&svg)?;
+    let json = opts.out.join(format!("{stem}.json"));
+    let summary = ConvergeSummary {
+        scene: scene.name.clone(),
+        run: label.to_string(),
+        integrator: spec.integrator.name().to_string(),
+        noise: spec.noise.name().to_string(),
+        over,
+        h: study.h,
+        limit_reference: study.limit_reference,
+        budget: opts.budget.name().to_string(),
+        trajectories: ensemble.trajectories,
+        duration_tau1: ensemble.duration_tau1,
+        fixed: study.fixed,
+        values: study.values,
         observables,
-        rows,
+        discrete_consistency: discrete_consistency(&study.rows),
+        unstable: study.unstable,
+        notes: study.notes,
+        warnings: study.warnings,
+        rows: study.rows,
         files: [&csv, &svg, &json]
             .iter()
-            .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+            .map(|p| {
+                p.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned()
+            })
             .collect(),
         wall_seconds: start.elapsed().as_secs_f64(),
     };
@@ -792,65 +1061,146 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     Ok(summary)
 }
 
-/// Fits the observed and exact orders per observable.
-fn summarize(
-    names: &[String],
-    rows: &[Row],
-    over: Over,
-    spec: &RunSpec,
-    node_at_mid: bool,
-) -> Vec<ObservableSummary> {
+/// Fits the observed and exact orders per observable and compares the observed order
+/// with the expected one.
+pub fn summarize(names: &[String], rows: &[Row], expected: &[Expected]) -> Vec<ObservableSummary> {
     names
         .iter()
-        .enumerate()
-        .map(|(k, name)| {
+        .zip(expected)
+        .map(|(name, expected)| {
             let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
             let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
-            let all_exact = rs.iter().all(|r| r.exact_at_rounding);
+            let all_exact = !rs.is_empty() && rs.iter().all(|r| r.exact_at_rounding);
             let within = rs.iter().filter(|r| r.sampling_floor).count();
-            let note = if all_exact {
+            let observed = if all_exact || expected.exact {
+                None
+            } else {
+                fit_order(
+                    &resolved.iter().map(|r| r.h).collect::<Vec<_>>(),
+                    &resolved.iter().map(|r| r.total_error).collect::<Vec<_>>(),
+                    Some(&resolved.iter().map(|r| r.total_error_se).collect::<Vec<_>>()),
+                )
+            };
+            let agrees = match (expected.order, observed.and_then(|f| f.ci)) {
+                (Some(p), Some((lo, hi))) => Some(lo <= p && p <= hi),
+                _ => None,
+            };
+            let note = if all_exact || expected.exact {
+                let resolved_points: Vec<f64> = resolved.iter().map(|r| r.value).collect();
                 format!(
-                    "the discretization is exact for this observable (exact error at round-off at every value): the total error is sampling noise only, no order is fitted; {within} of {} estimates within {FLOOR_SIGMAS} standard errors of the reference",
-                    rs.len()
+                    "the discretization is exact for this observable: the total error is sampling noise only, no order is fitted; {within} of {} estimates within {FLOOR_SIGMAS} standard errors of the reference{}",
+                    rs.len(),
+                    if resolved_points.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            " (NOT within at {resolved_points:?}: an error the exact theory does not predict)"
+                        )
+                    }
                 )
             } else if resolved.len() < 2 {
                 format!(
-                    "{} of {} points at the sampling floor: too few resolved points for an observed order (a larger --budget resolves more)",
+                    "{} of {} points at the sampling floor: too few resolved points for an observed order{}",
                     rs.len() - resolved.len(),
-                    rs.len()
+                    rs.len(),
+                    budget_hint(&rs)
                 )
             } else {
-                String::new()
+                let exact_fit = exact_order_fit(&rs);
+                match (agrees, expected.order, observed) {
+                    (Some(true), Some(p), _) => {
+                        format!("observed order agrees with the expected {p} (inside its 95 % interval)")
+                    }
+                    (Some(false), Some(p), Some(f)) => {
+                        let pre = exact_fit.filter(|e| {
+                            f.ci.is_some_and(|(lo, hi)| lo <= e.order && e.order <= hi)
+                        });
+                        match pre {
+                            Some(e) => format!(
+                                "observed order {:.2} differs from the asymptotic {p} but agrees with the order {:.2} of the exact discrete error over these values: the values are not yet in the asymptotic range (pre-asymptotic), not a simulation error",
+                                f.order, e.order
+                            ),
+                            None => format!(
+                                "observed order {:.2} differs from the expected {p}: its 95 % interval excludes {p}{}",
+                                f.order,
+                                if f.points < rs.len() {
+                                    " (fitted on the resolved points only; nearer the floor the sampling error inflates the measured error, which flattens the fit)"
+                                } else {
+                                    ""
+                                }
+                            ),
+                        }
+                    }
+                    (None, Some(_), Some(_)) => format!(
+                        "two resolved points: an order but no interval to compare with the expected one{}",
+                        budget_hint(&rs)
+                    ),
+                    _ => String::new(),
+                }
             };
-            let observed = if all_exact { None } else { fit_order(
-                &resolved.iter().map(|r| r.h).collect::<Vec<_>>(),
-                &resolved.iter().map(|r| r.total_error).collect::<Vec<_>>(),
-                Some(&resolved.iter().map(|r| r.total_error_se).collect::<Vec<_>>()),
-            ) };
-            let above: Vec<&&Row> = rs
-                .iter()
-                .filter(|r| !r.exact_at_rounding)
-                .collect();
-            let exact = fit_order(
-                &above.iter().map(|r| r.h).collect::<Vec<_>>(),
-                &above.iter().map(|r| r.exact_error).collect::<Vec<_>>(),
-                None,
-            );
+            let exact = exact_order_fit(&rs);
             ObservableSummary {
                 observable: name.clone(),
-                expected: expected_order(over, spec, k, node_at_mid),
+                expected: expected.clone(),
                 observed,
-                floor_values: rs.iter().filter(|r| r.sampling_floor).map(|r| r.value).collect(),
+                floor_values: rs
+                    .iter()
+                    .filter(|r| r.sampling_floor)
+                    .map(|r| r.value)
+                    .collect(),
                 exact,
                 exact_at_rounding: rs
                     .iter()
                     .filter(|r| r.exact_at_rounding)
                     .map(|r| r.value)
                     .collect(),
+                agrees,
                 note,
             }
         })
         .collect()
+}
+
+/// The order of the exact error, fitted on the rows whose exact error is known and
+/// above round-off.
+fn exact_order_fit(rs: &[&Row]) -> Option<OrderFit> {
+    let above: Vec<&&Row> = rs
+        .iter()
+        .filter(|r| r.exact_error.is_some() && !r.exact_at_rounding)
+        .collect();
+    fit_order(
+        &above.iter().map(|r| r.h).collect::<Vec<_>>(),
+        &above
+            .iter()
+            .map(|r| r.exact_error.unwrap_or(f64::NAN))
+            .collect::<Vec<_>>(),
+        None,
+    )
+}
+
+/// What it would take to resolve the floor points of an observable: with a known exact
+/// error e and standard error s at a floor point, the error is resolved (e > 3 s) with
+/// about (3s/e)² times the ensemble (s ∝ 1/sqrt(trajectories × duration)).
+fn budget_hint(rs: &[&Row]) -> String {
+    let need = rs
+        .iter()
+        .filter(|r| r.sampling_floor)
+        .filter_map(|r| {
+            let e = r.exact_error?;
+            (e > 0.0 && !r.exact_at_rounding).then(|| (FLOOR_SIGMAS * r.total_error_se / e).powi(2))
+        })
+        .fold(0.0, f64::max);
+    if need > 1.0 {
+        format!(
+            "; resolving every floor point needs about {need:.0}x this ensemble (the exact error there is below 3 standard errors: a larger --budget, --trajectories or --duration-tau1)"
+        )
+    } else {
+        "; a larger --budget, --trajectories or --duration-tau1 resolves more".to_string()
+    }
+}
+
+fn opt_cell(v: Option<f64>) -> String {
+    v.map_or(String::new(), |x| x.to_string())
 }
 
 fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
@@ -865,11 +1215,11 @@ fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
             r.observable,
             r.estimate,
             r.std_error,
-            r.discrete,
+            opt_cell(r.discrete),
             r.limit,
             r.total_error,
             r.total_error_se,
-            r.exact_error,
+            opt_cell(r.exact_error),
             if r.sampling_floor {
                 "sampling floor"
             } else {
@@ -880,16 +1230,22 @@ fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
     write_atomic(path, text.as_bytes())
 }
 
-fn figure(scene: &Scene, spec: &RunSpec, over: Over, names: &[String], rows: &[Row]) -> Figure {
+fn figure(
+    scene: &Scene,
+    label: &str,
+    spec: &RunSpec,
+    over: Over,
+    names: &[String],
+    rows: &[Row],
+) -> Figure {
     let x_label = match over {
         Over::Elements => "h = L/elements",
         Over::Dt => "h = dt/tau1",
     };
     let mut fig = Figure::new(
         format!(
-            "{} {} ({} noise): |error| vs {}",
+            "{} {label} ({} noise): |error| vs {}",
             scene.name,
-            spec.name,
             spec.noise.name(),
             over.name()
         ),
@@ -925,7 +1281,7 @@ fn figure(scene: &Scene, spec: &RunSpec, over: Over, names: &[String], rows: &[R
         let exact: Vec<(f64, f64)> = rs
             .iter()
             .filter(|r| !r.exact_at_rounding)
-            .map(|r| (r.h, r.exact_error))
+            .filter_map(|r| r.exact_error.map(|e| (r.h, e)))
             .collect();
         if !exact.is_empty() {
             fig = fig.series(

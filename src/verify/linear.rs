@@ -123,6 +123,27 @@ pub fn small_slope_warning(
     })
 }
 
+/// The largest root-mean-square nodal slope `(rms, node x/L)` from `sums[k]`, the sum of
+/// θ² at node k over `n` samples (samples × components). `None` without samples.
+pub fn largest_rms_slope(beam: &BeamModel, sums: &[f64], n: usize) -> Option<(f64, f64)> {
+    if n == 0 {
+        return None;
+    }
+    sums.iter()
+        .zip(beam.mesh().nodes())
+        .map(|(sum, x)| ((sum / n as f64).sqrt(), x / beam.params().length))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// Adds θ² of every node of `state` (a deflection vector of `beam`) to `acc`.
+pub fn add_slope_squares(beam: &BeamModel, state: &[f64], acc: &mut [f64]) {
+    for (node, a) in acc.iter_mut().enumerate() {
+        if let Some(i) = beam.node_rotation_index(node) {
+            *a += state[i] * state[i];
+        }
+    }
+}
+
 /// A filament being simulated: advances all its transverse components by one step and
 /// reports the observables.
 trait Sampler {
@@ -178,11 +199,7 @@ impl Sampler for FemSampler<'_> {
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
         for s in &self.states {
-            for (node, a) in acc.iter_mut().enumerate() {
-                if let Some(i) = self.beam.node_rotation_index(node) {
-                    *a += s[i] * s[i];
-                }
-            }
+            add_slope_squares(self.beam, s, acc);
         }
     }
 }
@@ -535,19 +552,10 @@ impl LinearRun {
             return None;
         };
         let n = records.iter().map(|r| r.slope_samples).sum::<usize>() * self.components;
-        if n == 0 {
-            return None;
-        }
-        let nodes = beam.mesh().n_nodes();
-        (0..nodes)
-            .map(|k| {
-                let sum: f64 = records.iter().map(|r| r.slope_squares[k]).sum();
-                (
-                    (sum / n as f64).sqrt(),
-                    beam.mesh().nodes()[k] / beam.params().length,
-                )
-            })
-            .max_by(|a, b| a.0.total_cmp(&b.0))
+        let sums: Vec<f64> = (0..beam.mesh().n_nodes())
+            .map(|k| records.iter().map(|r| r.slope_squares[k]).sum())
+            .collect();
+        largest_rms_slope(beam, &sums, n)
     }
 
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {

@@ -11,7 +11,8 @@ use crate::rng::{derive_seed, trajectory_rng};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{
-    CompressionRun, CompressionTheoryTable, compression_checks, force_estimates, halving_check,
+    CompressionRun, CompressionTheoryTable, compression_checks, force_estimates_diagnosed,
+    halving_check,
 };
 use crate::verify::linear::{LinearRun, small_slope_warning};
 use crate::verify::scene::{Budget, CheckKind, ModelKind, Scene};
@@ -159,6 +160,7 @@ fn run_compression_scene(
     let mut tables = Vec::new();
     let mut notes = vec![scene.description.clone()];
     let mut estimates = Vec::new();
+    let mut largest_slope = None;
     let points = theory.strain_ratios.len();
     let tau1 = scene.filament.tau1();
     let header = [
@@ -192,45 +194,24 @@ fn run_compression_scene(
         let e = run.spec.ensemble(opts.budget);
         let steps = run.sampled_steps(e.duration_tau1 * tau1);
         let nt = e.trajectories;
-        let flat = (0..points * nt)
-            .into_par_iter()
-            .map(|t| {
-                let (i, j) = (t / nt, t % nt);
-                let seed = derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
-                let rec = run.simulate(i, &mut trajectory_rng(seed, j as u64), steps);
-                bar.inc(1);
-                rec
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let records: Vec<Vec<_>> = flat.chunks(nt).map(<[_]>::to_vec).collect();
+        let records = run
+            .simulate_ensemble(
+                |i| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name)),
+                nt,
+                steps,
+                || bar.inc(1),
+            )
+            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
         let budget_key = format!("{}.duration_tau1", opts.budget.name());
-        let est = force_estimates(&records).map_err(|e| {
-            // Name the usual cause of a too-long correlation time: a sticky chain.
-            let (proposed, accepted) = records
-                .iter()
-                .flatten()
-                .fold((0u64, 0u64), |(p, a), r| (p + r.proposed, a + r.accepted));
-            let e = if proposed > 0 {
-                Error::Numerical {
-                    routine: "force estimates".into(),
-                    detail: format!(
-                        "{e}; the Metropolis acceptance rate was {:.3} (EA L/kT = {:e}, EI/(kT L) = {:e}): a low acceptance makes F strongly correlated; a smaller dt_tau1 raises it",
-                        accepted as f64 / proposed as f64,
-                        scene.filament.stretch_rigidity * scene.filament.length / scene.filament.kt,
-                        scene.filament.bending_rigidity / (scene.filament.kt * scene.filament.length),
-                    ),
-                }
-            } else {
-                e
-            };
-            scene.run_error(k, &budget_key, e)
-        })?;
+        let est = force_estimates_diagnosed(&records, &scene.filament)
+            .map_err(|e| scene.run_error(k, &budget_key, e))?;
         checks.extend(
             compression_checks(run, run.spec.checks(scene), theory, &records, &est)
                 .map_err(|e| scene.run_error(k, &budget_key, e))?,
         );
+        let slope = run.largest_rms_slope(&records);
         notes.push(format!(
-            "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples",
+            "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
             run.spec.name,
             run.spec.integrator,
             run.spec.noise.name(),
@@ -239,8 +220,25 @@ fn run_compression_scene(
             e.duration_tau1,
             scene.compression.as_ref().map_or(0.0, |c| c.burn_in_tau1),
             est.acceptance,
-            est.max_tau_int
+            est.max_tau_int,
+            slope.map_or(String::new(), |(s, x, i)| format!(
+                "; largest RMS slope {s:.3} rad at x/L = {x:.2}, strain ratio {}",
+                theory.strain_ratios[i]
+            ))
         ));
+        if let Some((s, x, i)) = slope
+            && largest_slope
+                .as_ref()
+                .is_none_or(|l: &(String, (f64, f64))| s > l.1.0)
+        {
+            largest_slope = Some((
+                format!(
+                    "run {} at strain ratio {} (largest of the runs and strains)",
+                    run.spec.name, theory.strain_ratios[i]
+                ),
+                (s, x),
+            ));
+        }
         let rows: Vec<Vec<f64>> = (0..points)
             .map(|i| {
                 vec![
@@ -292,7 +290,13 @@ fn run_compression_scene(
     fig.write_svg(&path)?;
     figures.push(path);
     figures.push(write_fig2(&opts.out, curves)?);
-    finish_scene(scene, checks, figures, tables, notes, start, opts)
+    let mut summary = finish_scene(scene, checks, figures, tables, notes, start, opts)?;
+    if let Some((what, slope)) = largest_slope {
+        summary
+            .warnings
+            .extend(small_slope_warning(&what, slope, &scene.filament));
+    }
+    Ok(summary)
 }
 
 /// The paper's Fig. 2: ⟨F⟩/F_c0 against ε/ε_c0 in 2D and 3D, exact theory (discrete:
@@ -391,7 +395,8 @@ fn run_scene(
                 bar.inc(1);
                 rec
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>()
+            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
         let extra = (0..e.two_time_trajectories as u64)
             .into_par_iter()
             .map(|j| {
@@ -399,7 +404,8 @@ fn run_scene(
                 bar.inc(1);
                 rec.map(|r| r.two_time)
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>()
+            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
         let two_time: Vec<Vec<f64>> = records
             .iter()
             .map(|r| r.two_time.clone())

@@ -659,12 +659,22 @@ impl Scene {
 
     /// Wraps an error raised while preparing or running run `run` of this scene so that
     /// the message names the scene file and the run's key (bad input, exit 2), unless it
-    /// already names them.
+    /// already names them. A divergence (exit 3) keeps its kind and step and gains the
+    /// file and run.
     pub fn run_error(&self, run: usize, what: &str, err: Error) -> Error {
         let tau1 = self.filament.tau1();
         let key = |k: &str| format!("runs[{run}].{k}");
         match err {
-            Error::Scene { .. } | Error::Io { .. } | Error::Diverged { .. } => err,
+            Error::Scene { .. } | Error::Io { .. } => err,
+            Error::Diverged { step, time, detail } => Error::Diverged {
+                step,
+                time,
+                detail: format!(
+                    "{}: runs[{run}] ({}): {detail}",
+                    self.path.display(),
+                    self.runs.get(run).map_or("?", |r| r.name.as_str())
+                ),
+            },
             Error::UnstableTimeStep {
                 integrator,
                 dt,
