@@ -28,7 +28,8 @@ enum Command {
     Theory(theory::TheoryArgs),
     /// Run verification scenes and write reports.
     Verify(verify::VerifyArgs),
-    /// Convergence study of a linear scene over the element count or the time step.
+    /// Convergence study of a finite-element scene (linear or compression) over the
+    /// element count or the time step.
     Converge(converge::ConvergeArgs),
     /// Stability map (integrator x dt*lambda_max x elements) and per-mode stationary
     /// bias against each integrator's exact discrete-time formula.
