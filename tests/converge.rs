@@ -453,7 +453,7 @@ fn compression_study_sees_the_errors_and_accepts_the_truth() {
     assert_eq!(rows.len(), 3);
     assert_eq!(rows[0]["value"], 5.0);
     assert_eq!(rows[0]["sampling_floor"], false, "{}", rows[0]);
-    assert!(v["unstable"].as_array().unwrap().is_empty());
+    assert!(v["failed"].as_array().unwrap().is_empty());
     let p = v["discrete_consistency"]["p_value"].as_f64().unwrap();
     assert!(p > 0.01, "simulation vs exact discrete: p = {p}");
     assert_eq!(v["observables"][0]["expected"]["order"], 1.0);
@@ -489,4 +489,70 @@ fn compression_study_sees_the_errors_and_accepts_the_truth() {
     );
     assert!(first(&biased)["discrete"].is_null());
     assert_eq!(biased["run"], "metropolis-as-crank-nicolson");
+}
+
+/// A value whose run diverges is recorded (kind "unstable", the message naming the step)
+/// and the study goes on: Crank–Nicolson with the stretching force explicit diverges in
+/// tension at Δt = 0.02 τ1 (10 elements) within about 10³ steps but runs at 0.002 τ1. If
+/// every value fails, nothing was measured and the command exits 3.
+#[test]
+fn diverged_values_are_recorded_and_the_study_goes_on() {
+    let v = study_json(
+        &[
+            "--scene",
+            "compression-2d",
+            "--over",
+            "dt",
+            "--values",
+            "0.02,0.002",
+            "--strain-ratios",
+            "0",
+            "--trajectories",
+            "2",
+            "--duration-tau1",
+            "40",
+            "--integrator",
+            "crank-nicolson",
+        ],
+        "diverged",
+    );
+    let failed = v["failed"].as_array().unwrap();
+    assert_eq!(failed.len(), 1, "{failed:?}");
+    assert_eq!(failed[0]["value"], 0.02);
+    assert_eq!(failed[0]["kind"], "unstable");
+    assert!(
+        failed[0]["error"]
+            .as_str()
+            .unwrap()
+            .contains("unstable at step")
+    );
+    assert_eq!(v["rows"].as_array().unwrap().len(), 1);
+    assert_eq!(v["rows"][0]["value"], 0.002);
+
+    let out = std::env::temp_dir().join(format!(
+        "langevin-fem-converge-allfail-{}",
+        std::process::id()
+    ));
+    let (code, err) = run_cli(&[
+        "converge",
+        "--scene",
+        "compression-2d",
+        "--over",
+        "dt",
+        "--values",
+        "0.02,0.03",
+        "--strain-ratios",
+        "0",
+        "--trajectories",
+        "2",
+        "--duration-tau1",
+        "40",
+        "--integrator",
+        "crank-nicolson",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 3, "{err}");
+    assert!(err.contains("every value of the study failed"), "{err}");
+    std::fs::remove_dir_all(&out).ok();
 }

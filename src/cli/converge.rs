@@ -77,7 +77,8 @@ const INTEGRATORS: [IntegratorKind; 5] = [
 ];
 
 /// Runs the study, prints a summary of the fitted orders on stderr and rebuilds the
-/// index page of the output directory; exit code 0.
+/// index page of the output directory; exit code 0, or 3 if every value failed (diverged
+/// or too short for its correlation time).
 pub fn run(args: ConvergeArgs) -> Result<i32> {
     let over = match args.over {
         OverArg::Elements => Over::Elements,
@@ -179,8 +180,14 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
             c.max_abs_z, c.worst, c.rows, c.p_value, c.chi2
         );
     }
-    for u in &s.unstable {
-        eprintln!("  UNSTABLE at {}={}: {}", s.over.name(), u.value, u.error);
+    for u in &s.failed {
+        eprintln!(
+            "  FAILED ({}) at {}={}: {}",
+            u.kind,
+            s.over.name(),
+            u.value,
+            u.error
+        );
     }
     for n in &s.notes {
         eprintln!("  note: {n}");
@@ -194,5 +201,10 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
         args.out.display(),
         s.wall_seconds
     );
+    // Every value failed: nothing was measured (exit 3, as for a failed run).
+    if s.rows.is_empty() && !s.failed.is_empty() {
+        eprintln!("error: every value of the study failed (see above); no rows were written");
+        return Ok(3);
+    }
     Ok(0)
 }

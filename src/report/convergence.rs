@@ -121,7 +121,8 @@ fn convergence_section(h: &mut String, v: &Value) {
             let text = match n {
                 Value::String(t) => t.clone(),
                 other => format!(
-                    "{} = {}: {}",
+                    "{} at {} = {}: {}",
+                    other["kind"].as_str().unwrap_or(""),
                     v["over"].as_str().unwrap_or(""),
                     other["value"],
                     other["error"].as_str().unwrap_or("")
@@ -130,7 +131,7 @@ fn convergence_section(h: &mut String, v: &Value) {
             let _ = writeln!(h, "<p class=\"{class}\">{label}{}</p>", esc(&text));
         }
     };
-    list(h, "unstable", "fail", "unstable: ");
+    list(h, "failed", "fail", "no rows: ");
     list(h, "warnings", "warn", "warning: ");
     list(h, "notes", "meta", "");
     files(h, v);

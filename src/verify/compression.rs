@@ -16,7 +16,6 @@ use crate::verify::scene::{CheckKind, CompressionSpec, RunSpec, Scene};
 use crate::verify::summary::CheckResult;
 use rand::RngExt;
 use rand_distr::StandardNormal;
-use rayon::prelude::*;
 
 /// Modes of the continuum theory (plus the exact tail cumulants).
 pub const CONTINUUM_MODES: usize = crate::theory::DEFAULT_CONTINUUM_MODES;
@@ -256,15 +255,12 @@ impl CompressionRun {
         tick: impl Fn() + Sync,
     ) -> Result<Vec<Vec<ForceRecord>>> {
         let nt = trajectories.max(1);
-        let flat = (0..self.points() * nt)
-            .into_par_iter()
-            .map(|t| {
-                let (i, j) = (t / nt, t % nt);
-                let rec = self.simulate(i, &mut trajectory_rng(seed(i), j as u64), sampled_steps);
-                tick();
-                rec
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let flat = crate::verify::par_indexed((self.points() * nt) as u64, |t| {
+            let (i, j) = (t as usize / nt, t % nt as u64);
+            let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps);
+            tick();
+            rec
+        })?;
         Ok(flat.chunks(nt).map(<[_]>::to_vec).collect())
     }
 

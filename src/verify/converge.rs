@@ -29,8 +29,9 @@
 //! ([`ObservableSummary::agrees`]); a disagreement is stated in the observable's note.
 //!
 //! A value whose run diverges (a non-finite state, e.g. an explicit stretching force at a
-//! too-large Δt) is recorded with the step it failed at ([`UnstableValue`]) and the study
-//! goes on with the other values.
+//! too-large Δt) is recorded with the step it failed at, and one whose estimators fail
+//! (a series too short for its correlation time) with the cause ([`FailedValue`]); the
+//! study goes on with the other values.
 
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
@@ -44,8 +45,8 @@ use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::stats;
 use crate::verify::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
+use crate::verify::par_indexed;
 use crate::verify::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
-use rayon::prelude::*;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::{Path, PathBuf};
@@ -705,13 +706,37 @@ pub fn discrete_consistency(rows: &[Row]) -> Option<DiscreteConsistency> {
     })
 }
 
-/// A value of the study whose run went unstable (diverged): recorded, not fatal.
+/// A value of the study that gave no rows: its run went unstable (diverged), or its
+/// estimates could not be formed (too short for the correlation time). Recorded, not
+/// fatal: the study goes on with the other values.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct UnstableValue {
+pub struct FailedValue {
     /// The value (element count or Δt/τ1).
     pub value: f64,
-    /// The error, naming the step.
+    /// `"unstable"` (a non-finite state) or `"estimate"` (the estimators failed).
+    pub kind: String,
+    /// The error, naming the step (unstable) or the cause.
     pub error: String,
+}
+
+impl FailedValue {
+    /// Records `err` for `value` if it is a divergence or an estimator failure; any other
+    /// error is returned.
+    ///
+    /// # Errors
+    /// `err` itself unless it is [`Error::Diverged`] or [`Error::Numerical`].
+    pub fn record(value: f64, err: Error) -> Result<FailedValue> {
+        let kind = match &err {
+            Error::Diverged { .. } => "unstable",
+            Error::Numerical { .. } => "estimate",
+            _ => return Err(err),
+        };
+        Ok(FailedValue {
+            value,
+            kind: kind.to_string(),
+            error: err.to_string(),
+        })
+    }
 }
 
 /// The JSON summary of a study.
@@ -745,8 +770,8 @@ pub struct ConvergeSummary {
     pub observables: Vec<ObservableSummary>,
     /// The simulation against the exact discrete references (`None` if there are none).
     pub discrete_consistency: Option<DiscreteConsistency>,
-    /// Values whose run went unstable (no rows for them).
-    pub unstable: Vec<UnstableValue>,
+    /// Values that gave no rows (unstable, or the estimators failed).
+    pub failed: Vec<FailedValue>,
     /// Notes (acceptance rates, measured slopes, ...).
     pub notes: Vec<String>,
     /// Warnings about the physics (e.g. slopes too large for the small-slope model).
@@ -776,8 +801,8 @@ pub struct Study {
     pub limit_reference: String,
     /// The fixed parameter.
     pub fixed: String,
-    /// Values whose run went unstable.
-    pub unstable: Vec<UnstableValue>,
+    /// Values that gave no rows.
+    pub failed: Vec<FailedValue>,
     /// Notes.
     pub notes: Vec<String>,
     /// Warnings.
@@ -906,7 +931,7 @@ fn linear_study(
         .map(|&v| prepare(scene, run, over, v))
         .collect::<Result<Vec<_>>>()?;
     let mut rows = Vec::new();
-    let mut unstable = Vec::new();
+    let mut failed = Vec::new();
     let mut largest_slope: Option<(f64, (f64, f64))> = None;
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
@@ -916,27 +941,22 @@ fn linear_study(
             &format!("{}/converge/{}={v}", spec.name, over.name()),
         );
         let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-        let records = match (0..ensemble.trajectories as u64)
-            .into_par_iter()
-            .map(|j| lr.simulate(&mut trajectory_rng(seed, j), steps))
-            .collect::<Result<Vec<_>>>()
-        {
+        let simulated = par_indexed(ensemble.trajectories as u64, |j| {
+            lr.simulate(&mut trajectory_rng(seed, j), steps)
+        })
+        .and_then(|records| Ok((estimates(lr, &records)?, records)));
+        let (est, records) = match simulated {
             Ok(r) => r,
-            Err(e @ Error::Diverged { .. }) => {
-                unstable.push(UnstableValue {
-                    value: v,
-                    error: e.to_string(),
-                });
+            Err(e) => {
+                failed.push(FailedValue::record(v, e)?);
                 continue;
             }
-            Err(e) => return Err(e),
         };
         if let Some(slope) = lr.measured_rms_slope(&records)
             && largest_slope.is_none_or(|l| slope.0 > l.1.0)
         {
             largest_slope = Some((v, slope));
         }
-        let est = estimates(lr, &records)?;
         for (k, name) in names.iter().enumerate() {
             rows.push(Row::new(
                 v,
@@ -1001,7 +1021,7 @@ fn linear_study(
             Over::Elements => format!("dt_tau1 = {:e}", spec.dt_tau1),
             Over::Dt => format!("elements = {}", scene.mesh.elements),
         },
-        unstable,
+        failed,
         notes,
         warnings,
     })
@@ -1042,7 +1062,7 @@ fn finish(
         values: study.values,
         observables,
         discrete_consistency: discrete_consistency(&study.rows),
-        unstable: study.unstable,
+        failed: study.failed,
         notes: study.notes,
         warnings: study.warnings,
         rows: study.rows,

@@ -15,10 +15,10 @@ use crate::verify::compression::{
     halving_check,
 };
 use crate::verify::linear::{LinearRun, small_slope_warning};
+use crate::verify::par_indexed;
 use crate::verify::scene::{Budget, CheckKind, ModelKind, Scene};
 use crate::verify::summary::{SceneSummary, Summary};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -388,24 +388,18 @@ fn run_scene(
         let e = run.spec.ensemble(opts.budget);
         let seed = derive_seed(scene.seed, &run.spec.name);
         let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
-        let records = (0..e.trajectories as u64)
-            .into_par_iter()
-            .map(|j| {
-                let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
-                bar.inc(1);
-                rec
-            })
-            .collect::<Result<Vec<_>>>()
-            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        let extra = (0..e.two_time_trajectories as u64)
-            .into_par_iter()
-            .map(|j| {
-                let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
-                bar.inc(1);
-                rec.map(|r| r.two_time)
-            })
-            .collect::<Result<Vec<_>>>()
-            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        let records = par_indexed(e.trajectories as u64, |j| {
+            let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
+            bar.inc(1);
+            rec
+        })
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        let extra = par_indexed(e.two_time_trajectories as u64, |j| {
+            let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
+            bar.inc(1);
+            rec.map(|r| r.two_time)
+        })
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
         let two_time: Vec<Vec<f64>> = records
             .iter()
             .map(|r| r.two_time.clone())

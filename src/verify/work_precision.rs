@@ -30,7 +30,6 @@ use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::verify::linear::LinearRun;
 use crate::verify::scene::{Ensemble, ModelKind, RunSpec, Scene};
-use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -295,10 +294,9 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
         let duration = s.runs[0].quick.duration_tau1;
         let steps = lr.sampled_steps(duration * s.filament.tau1());
         let t0 = Instant::now();
-        let records = (0..opts.trajectories as u64)
-            .into_par_iter()
-            .map(|j| lr.simulate(&mut trajectory_rng(seed, j), steps))
-            .collect::<Result<Vec<_>>>()?;
+        let records = crate::verify::par_indexed(opts.trajectories as u64, |j| {
+            lr.simulate(&mut trajectory_rng(seed, j), steps)
+        })?;
         let wall = t0.elapsed().as_secs_f64();
         let (est, se) = lr.profile_square_estimate(&records, 0)?;
         let cont = lr.reference.profile_continuum[0];

@@ -21,13 +21,14 @@
 //!   stationary bias is O(Δt) and has no closed form: there is no discrete reference and
 //!   the observed order is compared with 1. Their stability depends on the state (a large
 //!   stored length makes the explicit stretching force stiff), so a too-large Δt can
-//!   diverge after many steps: such a value is recorded as unstable with its step.
+//!   diverge after many steps: such a value is recorded as unstable with its step (and a
+//!   value whose force series is too short for its correlation time, as failed).
 //!
 //! Estimates and errors are those of the verification runs
 //! ([`crate::verify::compression::force_estimates`]): per trajectory the time average of
 //! F with an integrated-autocorrelation-time error, trajectories independent.
 
-use super::{ConvergeOptions, Expected, Over, Row, Study, UnstableValue, validate_values};
+use super::{ConvergeOptions, Expected, FailedValue, Over, Row, Study, validate_values};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
@@ -392,38 +393,39 @@ pub(super) fn study(
     };
     let tau1 = scene.filament.tau1();
     let mut rows = Vec::new();
-    let mut unstable = Vec::new();
+    let mut failed = Vec::new();
     let mut notes = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     for (((s, cr), point), &v) in prepared.iter().zip(&points).zip(&values) {
         let t0 = Instant::now();
         let steps = cr.sampled_steps(ensemble.duration_tau1 * tau1);
         let label = format!("{}/converge/{}={v}", spec.name, over.name());
-        let records = match cr.simulate_ensemble(
-            |i| derive_seed(s.seed, &format!("{label}/{i}")),
-            ensemble.trajectories,
-            steps,
-            || {},
-        ) {
+        let simulated = cr
+            .simulate_ensemble(
+                |i| derive_seed(s.seed, &format!("{label}/{i}")),
+                ensemble.trajectories,
+                steps,
+                || {},
+            )
+            .and_then(|records| Ok((force_estimates_diagnosed(&records, &s.filament)?, records)));
+        let (est, records) = match simulated {
             Ok(r) => r,
-            Err(e @ Error::Diverged { .. }) => {
+            Err(e) => {
+                let f = FailedValue::record(v, e)?;
                 if opts.progress {
                     eprintln!(
-                        "converge {} {}: {}={v}: unstable: {e}",
+                        "converge {} {}: {}={v}: {}: {}",
                         scene.name,
                         spec.name,
-                        over.name()
+                        over.name(),
+                        f.kind,
+                        f.error
                     );
                 }
-                unstable.push(UnstableValue {
-                    value: v,
-                    error: e.to_string(),
-                });
+                failed.push(f);
                 continue;
             }
-            Err(e) => return Err(e),
         };
-        let est = force_estimates_diagnosed(&records, &s.filament)?;
         let slope = cr.largest_rms_slope(&records);
         notes.push(format!(
             "{}={v}: {}largest integrated autocorrelation time of F {:.1} samples (every {} tau1){}",
@@ -506,7 +508,7 @@ pub(super) fn study(
                 scene.mesh.elements, comp.burn_in_tau1
             ),
         },
-        unstable,
+        failed,
         notes,
         warnings,
     })
