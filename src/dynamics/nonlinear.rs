@@ -201,13 +201,12 @@ enum Scheme {
     Metropolis,
 }
 
-/// What a θ-step needs to know about one state: the explicit right-hand side
-/// `(C − (1−θ)ΔtK) w + Δt F(w) G w` (and `(C + θΔtK) w`, a by-product).
+/// Per-component buffers of a θ-step: the explicit right-hand side
+/// `(C − (1−θ)ΔtK) w + Δt F(w) G w` (turned into the new state in place) and `K w`.
 #[derive(Debug, Clone, Default)]
-struct Evaluation {
-    state: Vec<Vec<f64>>,
+struct ThetaBuffers {
     explicit: Vec<Vec<f64>>,
-    lhs_w: Vec<Vec<f64>>,
+    kw: Vec<Vec<f64>>,
 }
 
 /// One state of the Metropolis chain and what proposals from and to it need: its energy,
@@ -238,8 +237,7 @@ pub struct NonlinearIntegrator {
     damping: BandedCholesky,
     noise: NoiseGenerator,
     zeta: Vec<Vec<f64>>,
-    current: Option<Evaluation>,
-    proposal: Evaluation,
+    theta_buffers: ThetaBuffers,
     /// Metropolis: `C + ½ΔtK`, to which `−½Δt F(w) G` is added per state.
     mh_base: SymBanded,
     /// Metropolis: the evaluated current state of the chain.
@@ -319,8 +317,7 @@ impl NonlinearIntegrator {
             damping: c.cholesky()?,
             noise: NoiseGenerator::new(noise, beam)?,
             zeta: vec![vec![0.0; n]; nc],
-            current: None,
-            proposal: Evaluation::default(),
+            theta_buffers: ThetaBuffers::default(),
             mh_base: SymBanded::linear_combination(1.0, c, 0.5 * dt, k)?,
             mh_current: None,
             scratch: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
@@ -343,23 +340,22 @@ impl NonlinearIntegrator {
         }
     }
 
-    /// Evaluates `w` into `out` with three banded products per component (G w, K w, C w).
+    /// The explicit right-hand side of `w` into `out.explicit`, with three banded products
+    /// per component (G w, K w, C w).
     /// The compressive force of the explicit stretching term comes, for the paper's
     /// explicit scheme, from the axial solve (step i), otherwise from the closed form
     /// (identical up to round-off; see the tests).
-    fn evaluate(&mut self, model: &CompressedFilament, w: &[Vec<f64>], out: &mut Evaluation) {
+    fn evaluate(&mut self, model: &CompressedFilament, w: &[Vec<f64>], out: &mut ThetaBuffers) {
         let beam = model.beam();
         let p = beam.params();
         let nc = w.len();
-        out.state.resize(nc, Vec::new());
         out.explicit.resize(nc, vec![0.0; beam.n_dofs()]);
-        out.lhs_w.resize(nc, vec![0.0; beam.n_dofs()]);
+        out.kw.resize(nc, vec![0.0; beam.n_dofs()]);
         let mut two_l_s = 0.0;
-        // First pass: G w into explicit (temporarily), K w into lhs_w.
+        // First pass: G w into explicit (temporarily), K w into kw.
         for (c, wc) in w.iter().enumerate() {
-            out.state[c].clone_from(wc);
             beam.geometric().mul_vec(wc, &mut out.explicit[c]);
-            beam.stiffness().mul_vec(wc, &mut out.lhs_w[c]);
+            beam.stiffness().mul_vec(wc, &mut out.kw[c]);
             two_l_s += wc
                 .iter()
                 .zip(&out.explicit[c])
@@ -375,11 +371,9 @@ impl NonlinearIntegrator {
         let cw = &mut self.scratch[0];
         for (c, wc) in w.iter().enumerate() {
             beam.damping().mul_vec(wc, cw);
-            let (gw, kw) = (&mut out.explicit[c], &mut out.lhs_w[c]);
+            let (gw, kw) = (&mut out.explicit[c], &out.kw[c]);
             for i in 0..cw.len() {
-                let (g, k) = (gw[i], kw[i]);
-                gw[i] = cw[i] - (1.0 - self.theta) * self.dt * k + self.dt * f * g;
-                kw[i] = cw[i] + self.theta * self.dt * k;
+                gw[i] = cw[i] - (1.0 - self.theta) * self.dt * kw[i] + self.dt * f * gw[i];
             }
         }
     }
@@ -407,27 +401,20 @@ impl NonlinearIntegrator {
             self.step_metropolis(model, w, rng);
             return;
         }
-        let mut cur = self.current.take().unwrap_or_default();
-        self.evaluate(model, w, &mut cur);
+        let mut buf = std::mem::take(&mut self.theta_buffers);
+        self.evaluate(model, w, &mut buf);
         for z in &mut self.zeta {
             self.noise.draw(rng, z);
         }
-        // The new state: (C + θΔtK) w' = explicit(w) + scale ζ.
-        let mut next: Vec<Vec<f64>> = std::mem::take(&mut self.proposal.state);
-        next.resize(w.len(), Vec::new());
-        for (c, nc) in next.iter_mut().enumerate() {
-            nc.clone_from(&cur.explicit[c]);
-            for (v, z) in nc.iter_mut().zip(&self.zeta[c]) {
+        // The new state: (C + θΔtK) w' = explicit(w) + scale ζ, solved in place.
+        for ((wc, rhs), zc) in w.iter_mut().zip(&mut buf.explicit).zip(&self.zeta) {
+            for (v, z) in rhs.iter_mut().zip(zc) {
                 *v += self.scale * z;
             }
-            self.lhs.solve_in_place(nc);
+            self.lhs.solve_in_place(rhs);
+            wc.copy_from_slice(rhs);
         }
-        for (wc, nc) in w.iter_mut().zip(&next) {
-            wc.copy_from_slice(nc);
-        }
-        self.proposal.state = next;
-        // Buffers reused by the next step.
-        self.current = Some(cur);
+        self.theta_buffers = buf;
     }
 
     /// Evaluates a state of the Metropolis chain ([`MhEvaluation`]).

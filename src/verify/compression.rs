@@ -200,9 +200,7 @@ impl CompressionRun {
         let model = &self.models[point];
         let mut integ =
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
-        let n = model.beam().n_dofs();
         let mut w = self.equilibrium_start(rng);
-        debug_assert_eq!(w.first().map(Vec::len), Some(n));
         let total = self.burn_in_steps + sampled_steps;
         let mut rec = ForceRecord {
             force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
@@ -278,12 +276,7 @@ impl CompressionRun {
         let n =
             records.iter().map(|r| r.slope_samples).sum::<usize>() * self.models[0].components();
         let sums: Vec<f64> = (0..beam.mesh().n_nodes())
-            .map(|k| {
-                records
-                    .iter()
-                    .map(|r| r.slope_squares.get(k).copied().unwrap_or(0.0))
-                    .sum()
-            })
+            .map(|k| records.iter().map(|r| r.slope_squares[k]).sum())
             .collect();
         largest_rms_slope(beam, &sums, n)
     }
@@ -320,19 +313,15 @@ pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
     let mut out = ForceEstimates::default();
     let (mut prop, mut acc) = (0u64, 0u64);
     for point in records {
-        let mut means = Vec::new();
-        let mut var = 0.0;
+        let mut parts = Vec::new();
         for r in point {
             let m = stats::mean_with_error(&r.force_ratio)?;
             out.max_tau_int = out.max_tau_int.max(m.tau_int);
-            means.push(m.mean);
-            var += m.std_error * m.std_error;
+            parts.push(m);
             prop += r.proposed;
             acc += r.accepted;
         }
-        let n = means.len() as f64;
-        out.force
-            .push((means.iter().sum::<f64>() / n, var.sqrt() / n));
+        out.force.push(stats::combine_independent(&parts));
     }
     out.acceptance = if prop == 0 {
         1.0

@@ -795,8 +795,6 @@ pub struct Study {
     pub expected: Vec<Expected>,
     /// All rows.
     pub rows: Vec<Row>,
-    /// What h is.
-    pub h: String,
     /// What the errors are measured against.
     pub limit_reference: String,
     /// The fixed parameter.
@@ -814,17 +812,6 @@ fn estimates(lr: &LinearRun, records: &[TrajectoryRecord]) -> Result<Vec<(f64, f
     let c = lr.components;
     let nm = lr.reference.modes.len();
     let np = lr.reference.profile_x.len();
-    let combine = |parts: Vec<stats::MeanEstimate>| {
-        let n = parts.len() as f64;
-        let mean = parts.iter().map(|p| p.mean).sum::<f64>() / n;
-        let se = parts
-            .iter()
-            .map(|p| p.std_error.powi(2))
-            .sum::<f64>()
-            .sqrt()
-            / n;
-        (mean, se)
-    };
     let mut out = Vec::new();
     let mut parts = Vec::new();
     for t in records {
@@ -833,7 +820,7 @@ fn estimates(lr: &LinearRun, records: &[TrajectoryRecord]) -> Result<Vec<(f64, f
             parts.push(stats::mean_with_error(&sq)?);
         }
     }
-    out.push(combine(parts));
+    out.push(stats::combine_independent(&parts));
     for i in 0..N_MODES {
         let mut parts = Vec::new();
         for t in records {
@@ -841,7 +828,7 @@ fn estimates(lr: &LinearRun, records: &[TrajectoryRecord]) -> Result<Vec<(f64, f
                 parts.push(stats::variance_with_error(&t.modes[k * nm + i], Some(0.0))?);
             }
         }
-        out.push(combine(parts));
+        out.push(stats::combine_independent(&parts));
     }
     Ok(out)
 }
@@ -874,7 +861,8 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 ///
 /// # Errors
 /// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
-/// diverges is recorded in [`ConvergeSummary::unstable`], not fatal.
+/// diverges, or whose estimators fail, is recorded in [`ConvergeSummary::failed`], not
+/// fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
     let run = select_run(&opts.scene, opts.run.as_deref())?;
@@ -1009,7 +997,6 @@ fn linear_study(
         names,
         expected,
         rows,
-        h: over.h_label().to_string(),
         limit_reference: match over {
             Over::Elements => "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)".to_string(),
             Over::Dt => format!(
@@ -1053,7 +1040,7 @@ fn finish(
         integrator: spec.integrator.name().to_string(),
         noise: spec.noise.name().to_string(),
         over,
-        h: study.h,
+        h: over.h_label().to_string(),
         limit_reference: study.limit_reference,
         budget: opts.budget.name().to_string(),
         trajectories: ensemble.trajectories,
@@ -1258,10 +1245,7 @@ fn figure(
     names: &[String],
     rows: &[Row],
 ) -> Figure {
-    let x_label = match over {
-        Over::Elements => "h = L/elements",
-        Over::Dt => "h = dt/tau1",
-    };
+    let x_label = format!("h = {}", over.h_label());
     let mut fig = Figure::new(
         format!(
             "{} {label} ({} noise): |error| vs {}",

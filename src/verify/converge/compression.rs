@@ -485,7 +485,6 @@ pub(super) fn study(
         names,
         expected,
         rows,
-        h: over.h_label().to_string(),
         limit_reference: match over {
             Over::Elements => format!(
                 "continuum exact equilibrium theory of <F>/F_c0 ({}D, EI/(kT L) = {}, EA L/kT = {:e}; {CONTINUUM_MODES} modes plus exact tail cumulants); the exact discrete reference is the same theory for each mesh",
