@@ -13,13 +13,13 @@
 //! Run: `cargo bench --bench fig2_cost`.
 
 use langevin_fem::dynamics::IntegratorKind;
-use langevin_fem::dynamics::nonlinear::{CompressedFilament, NonlinearIntegrator};
 use langevin_fem::fem::beam::BeamModel;
 use langevin_fem::fem::mesh::Mesh;
 use langevin_fem::fem::noise::NoiseModel;
 use langevin_fem::rng::trajectory_rng;
-use langevin_fem::verify::Scene;
-use langevin_fem::verify::scene::Budget;
+use langevin_fem::scene::Budget;
+use langevin_fem::scene::Scene;
+use langevin_fem::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::CompressedFilament};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;

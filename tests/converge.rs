@@ -6,11 +6,11 @@
 //! command line's bad-input exits. The whole file runs in under a minute.
 
 use langevin_fem::dynamics::IntegratorKind;
-use langevin_fem::verify::Scene;
-use langevin_fem::verify::converge::compression::{
+use langevin_fem::scene::Scene;
+use langevin_fem::studies::converge::compression::{
     self as cc, expected_over_dt, expected_over_elements,
 };
-use langevin_fem::verify::converge::{Over, exact_study, fit_order, sampling_floor};
+use langevin_fem::studies::converge::{Over, exact_study, fit_order, sampling_floor};
 use std::path::Path;
 use std::process::Command;
 

@@ -13,9 +13,9 @@
 //! round-off differences between correct builds of the same code on x86-64.
 
 use langevin_fem::rng::{derive_seed, trajectory_rng};
-use langevin_fem::verify::Scene;
-use langevin_fem::verify::compression::{CompressionRun, CompressionTheoryTable};
-use langevin_fem::verify::linear::LinearRun;
+use langevin_fem::scene::Scene;
+use langevin_fem::scene::compression::{CompressionRun, CompressionTheoryTable};
+use langevin_fem::scene::linear::LinearRun;
 use std::fmt::Write;
 use std::path::Path;
 

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use langevin_fem::Error;
-use langevin_fem::report::{
-    Figure, Series, render_index, write_atomic, write_csv, write_index, write_json,
-};
+use langevin_fem::output::{Figure, Series, write_atomic, write_csv, write_json};
+use langevin_fem::report::{render_index, write_index};
 use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
 
 /// A fresh directory under the system temp directory, unique per test, process and time.

@@ -4,9 +4,9 @@
 
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::fem::noise::NoiseModel;
-use langevin_fem::verify::Scene;
-use langevin_fem::verify::stability::{StabilityOptions, Status, run_stability};
-use langevin_fem::verify::work_precision::{WorkPrecisionOptions, run_work_precision};
+use langevin_fem::scene::Scene;
+use langevin_fem::studies::stability::{StabilityOptions, Status, run_stability};
+use langevin_fem::studies::work_precision::{WorkPrecisionOptions, run_work_precision};
 use std::path::Path;
 use std::process::Command;
 

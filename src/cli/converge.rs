@@ -7,8 +7,8 @@ use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_convergence_index;
-use langevin_fem::verify::Budget;
-use langevin_fem::verify::converge::{ConvergeOptions, Over, run_convergence};
+use langevin_fem::scene::Budget;
+use langevin_fem::studies::converge::{ConvergeOptions, Over, run_convergence};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -143,7 +143,7 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
         s.limit_reference
     );
     for o in &s.observables {
-        let fmt = |f: &Option<langevin_fem::verify::converge::OrderFit>| match f {
+        let fmt = |f: &Option<langevin_fem::studies::converge::OrderFit>| match f {
             None => "no fit (fewer than 2 points)".to_string(),
             Some(f) => match f.ci {
                 Some((lo, hi)) => {

@@ -9,7 +9,7 @@ mod work_precision;
 use clap::{Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
-use langevin_fem::verify::{Scene, resolve_scenes};
+use langevin_fem::scene::{Scene, resolve_scenes};
 use std::path::Path;
 use std::str::FromStr;
 

@@ -5,7 +5,7 @@ use super::{parse_list, resolve_scene};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
-use langevin_fem::verify::stability::{
+use langevin_fem::studies::stability::{
     DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, StabilityOptions, Status,
     run_stability,
 };

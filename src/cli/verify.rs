@@ -2,7 +2,9 @@
 
 use clap::Args;
 use langevin_fem::error::{Error, Result};
-use langevin_fem::verify::{Budget, VerifyOptions, resolve_scenes, run_verification};
+use langevin_fem::report::write_index;
+use langevin_fem::scene::{Budget, resolve_scenes};
+use langevin_fem::verify::{VerifyOptions, run_verification};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -58,6 +60,7 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
         alpha: args.alpha,
         progress: std::io::stderr().is_terminal(),
     })?;
+    write_index(&args.out, &summary)?;
     for scene in &summary.scenes {
         let failed: Vec<&str> = scene
             .checks

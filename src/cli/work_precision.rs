@@ -6,7 +6,7 @@ use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::noise::NoiseModel;
-use langevin_fem::verify::work_precision::{
+use langevin_fem::studies::work_precision::{
     DEFAULT_DT_TAU1, DEFAULT_EM_FRACTIONS, DEFAULT_METHODS, WorkPrecisionOptions,
     run_work_precision,
 };

@@ -29,9 +29,11 @@
 //! The θ-schemes cost one banded solve per step (O(n)); `exact-modal` uses dense modal
 //! transforms (O(n²)) but is exact in distribution for the linear problem at any Δt.
 
+pub mod ensemble;
 mod integrator;
 pub mod nonlinear;
 
+pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
 
 use serde::{Deserialize, Serialize};

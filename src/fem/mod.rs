@@ -9,6 +9,8 @@
 //! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
 //! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
+//! - [`vonkarman`]: the finite-deflection filament under imposed end-shortening
+//!   ([`vonkarman::CompressedFilament`]): energy, internal force, axial solve.
 
 pub mod banded;
 pub mod beam;
@@ -16,6 +18,7 @@ pub mod hermite;
 pub mod mesh;
 pub mod modal;
 pub mod noise;
+pub mod vonkarman;
 
 pub use banded::{BandedCholesky, SymBanded};
 pub use beam::{BeamModel, ElementLoad, UNIFORM_RATE_FACTOR};

@@ -4,8 +4,8 @@
 //! `converge`, `work-precision` or `stability` writes there.
 
 use super::html::{CSS, esc, url_path};
-use super::io::write_atomic;
 use crate::error::{Error, Result};
+use crate::output::write_atomic;
 use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::Path;

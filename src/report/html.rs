@@ -12,7 +12,7 @@ use std::path::Path;
 use crate::error::Result;
 use crate::verify::summary::{CheckResult, SceneSummary, Summary};
 
-use super::io::write_atomic;
+use crate::output::write_atomic;
 
 pub(crate) const CSS: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\

@@ -4,9 +4,9 @@
 //! applies the Holm correction over the scene.
 
 use crate::error::{Error, Result};
+use crate::scene::CheckKind;
+use crate::scene::linear::{LinearRun, TrajectoryRecord};
 use crate::stats::{self, TestOutcome};
-use crate::verify::linear::{LinearRun, TrajectoryRecord};
-use crate::verify::scene::CheckKind;
 use crate::verify::summary::CheckResult;
 
 /// Confidence level of the intervals reported in details.

@@ -1,22 +1,22 @@
 //! The verification runner: runs scenes, applies the family-wise correction, writes
 //! `summary.json`, per-scene CSV tables and SVG figures, and `index.html`.
 
-use crate::error::{Error, Result};
+use crate::dynamics::par_indexed;
+use crate::error::Result;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::modal::{generalized_modes, modal_noise_covariance};
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::report::{Figure, Series, SeriesStyle, write_csv, write_index, write_json};
+use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
+use crate::scene::compression::{
+    CompressionRun, CompressionTheoryTable, force_estimates_diagnosed,
+};
+use crate::scene::linear::{LinearRun, small_slope_warning};
+use crate::scene::{Budget, CheckKind, ModelKind, Scene};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
-use crate::verify::compression::{
-    CompressionRun, CompressionTheoryTable, compression_checks, force_estimates_diagnosed,
-    halving_check,
-};
-use crate::verify::linear::{LinearRun, small_slope_warning};
-use crate::verify::par_indexed;
-use crate::verify::scene::{Budget, CheckKind, ModelKind, Scene};
+use crate::verify::compression::{compression_checks, halving_check};
 use crate::verify::summary::{SceneSummary, Summary};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -128,7 +128,6 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
         scenes: summaries,
     };
     write_json(&opts.out.join("summary.json"), &summary)?;
-    write_index(&opts.out, &summary)?;
     Ok(summary)
 }
 
@@ -733,35 +732,4 @@ fn noise_study(
             .join(", "),
         1.0 - rows[k][1]
     ))
-}
-
-/// Resolves `--scene` arguments (names or paths) against `scene_dir`.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] naming an unknown scene and listing the known ones.
-pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>> {
-    if names.is_empty() {
-        return Scene::discover(scene_dir);
-    }
-    names
-        .iter()
-        .map(|n| {
-            let p = PathBuf::from(n);
-            if p.extension().is_some_and(|x| x == "toml") && p.exists() {
-                return Ok(p);
-            }
-            let known = Scene::discover(scene_dir)?;
-            known
-                .iter()
-                .find(|k| k.file_stem().is_some_and(|s| s == n.as_str()))
-                .cloned()
-                .ok_or_else(|| {
-                    let names: Vec<String> = known
-                        .iter()
-                        .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
-                        .collect();
-                    Error::invalid("--scene", n, format!("one of: {}", names.join(", ")))
-                })
-        })
-        .collect()
 }

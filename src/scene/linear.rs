@@ -18,10 +18,10 @@ use crate::fem::modal::{
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::rng::TrajectoryRng;
+use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
 use crate::spectral::simulator::ModalSimulator;
 use crate::stats;
-use crate::verify::scene::{ModelKind, RunSpec, Scene};
 use nalgebra::{DMatrix, DVector};
 
 /// Exact references for one mode of one run.

@@ -37,16 +37,16 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 
+use crate::dynamics::par_indexed;
 use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
+use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
+use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
-use crate::verify::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
-use crate::verify::par_indexed;
-use crate::verify::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::{Path, PathBuf};

@@ -25,7 +25,7 @@
 //!   value whose force series is too short for its correlation time, as failed).
 //!
 //! Estimates and errors are those of the verification runs
-//! ([`crate::verify::compression::force_estimates`]): per trajectory the time average of
+//! ([`crate::scene::compression::force_estimates`]): per trajectory the time average of
 //! F with an integrated-autocorrelation-time error, trajectories independent.
 
 use super::{ConvergeOptions, Expected, FailedValue, Over, Row, Study, validate_values};
@@ -33,12 +33,12 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
 use crate::rng::derive_seed;
+use crate::scene::compression::{CONTINUUM_MODES, CompressionRun, force_estimates_diagnosed};
+use crate::scene::linear::small_slope_warning;
+use crate::scene::{Ensemble, Scene};
 use crate::theory::compression::{
     CompressionTheory, Dims, StoredLengthLaw, buckling_load_discrete,
 };
-use crate::verify::compression::{CONTINUUM_MODES, CompressionRun, force_estimates_diagnosed};
-use crate::verify::linear::small_slope_warning;
-use crate::verify::scene::{Ensemble, Scene};
 use serde::Serialize;
 use std::time::Instant;
 

@@ -773,3 +773,34 @@ fn key_at(text: &str, offset: usize) -> String {
         (None, true) => "-".to_string(),
     }
 }
+
+/// Resolves `--scene` arguments (names or paths) against `scene_dir`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming an unknown scene and listing the known ones.
+pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>> {
+    if names.is_empty() {
+        return Scene::discover(scene_dir);
+    }
+    names
+        .iter()
+        .map(|n| {
+            let p = PathBuf::from(n);
+            if p.extension().is_some_and(|x| x == "toml") && p.exists() {
+                return Ok(p);
+            }
+            let known = Scene::discover(scene_dir)?;
+            known
+                .iter()
+                .find(|k| k.file_stem().is_some_and(|s| s == n.as_str()))
+                .cloned()
+                .ok_or_else(|| {
+                    let names: Vec<String> = known
+                        .iter()
+                        .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                        .collect();
+                    Error::invalid("--scene", n, format!("one of: {}", names.join(", ")))
+                })
+        })
+        .collect()
+}

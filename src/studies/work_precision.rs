@@ -26,10 +26,10 @@
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
-use crate::report::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
-use crate::verify::linear::LinearRun;
-use crate::verify::scene::{Ensemble, ModelKind, RunSpec, Scene};
+use crate::scene::linear::LinearRun;
+use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -294,7 +294,7 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
         let duration = s.runs[0].quick.duration_tau1;
         let steps = lr.sampled_steps(duration * s.filament.tau1());
         let t0 = Instant::now();
-        let records = crate::verify::par_indexed(opts.trajectories as u64, |j| {
+        let records = crate::dynamics::par_indexed(opts.trajectories as u64, |j| {
             lr.simulate(&mut trajectory_rng(seed, j), steps)
         })?;
         let wall = t0.elapsed().as_secs_f64();

@@ -1,0 +1,17 @@
+//! Domain-free output: SVG figures and atomic file writers. Nothing here knows about
+//! filaments, scenes or checks; every layer above writes its files through this one.
+//!
+//! - [`io`]: atomic writers. [`write_atomic`] writes through a temporary file in the
+//!   destination directory and a rename, so an interrupted run never leaves a truncated
+//!   file; [`write_csv`] writes numbers with full round-trip precision; [`write_json`]
+//!   writes pretty-printed JSON (e.g. `summary.json`).
+//! - [`figure`]: [`Figure`] and [`Series`], rendered to SVG with `plotters` (SVG backend
+//!   only, no font files: text is emitted as SVG `<text>` and laid out by the viewer).
+//!   Rendering is deterministic, tolerates non-finite data and empty figures, and draws
+//!   error bars and horizontal reference lines.
+
+pub mod figure;
+pub mod io;
+
+pub use figure::{Figure, Series, SeriesStyle};
+pub use io::{write_atomic, write_csv, write_json};

@@ -1,0 +1,369 @@
+//! Compression scenes: the force–strain curve of the paper's Fig. 2, simulated with the
+//! finite-deflection filament ([`crate::dynamics::nonlinear`]) and judged against the exact
+//! equilibrium theory of the same discretization ([`crate::theory::compression`]), with
+//! the continuum theory beside it.
+
+use crate::error::{Error, Result};
+use crate::fem::banded::BandedCholesky;
+use crate::fem::beam::BeamModel;
+use crate::fem::mesh::Mesh;
+use crate::rng::{TrajectoryRng, trajectory_rng};
+use crate::scene::linear::{add_slope_squares, largest_rms_slope};
+use crate::scene::{CompressionSpec, RunSpec, Scene};
+use crate::stats;
+use crate::theory::compression::{CompressionTheory, Dims, ForceDistribution, StoredLengthLaw};
+use crate::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::CompressedFilament};
+use rand::RngExt;
+use rand_distr::StandardNormal;
+
+/// Modes of the continuum theory (plus the exact tail cumulants).
+pub const CONTINUUM_MODES: usize = crate::theory::DEFAULT_CONTINUUM_MODES;
+
+/// Theory of one compression scene, shared by its runs.
+pub struct CompressionTheoryTable {
+    /// Imposed strains ε/ε_c0.
+    pub strain_ratios: Vec<f64>,
+    /// Exact ⟨F⟩/F_c0 of the discretized filament (same elements and energy as the
+    /// simulation).
+    pub discrete: Vec<f64>,
+    /// Exact ⟨F⟩/F_c0 of the continuum.
+    pub continuum: Vec<f64>,
+    /// Exact law of F at the distribution strains (None elsewhere).
+    pub distributions: Vec<Option<ForceDistribution>>,
+    /// The exact curves on a fine grid for figures: (ε/ε_c0, discrete, continuum).
+    pub curve: Vec<(f64, f64, f64)>,
+}
+
+/// Points of the fine theory curve drawn in the figures.
+const CURVE_POINTS: usize = 81;
+
+impl CompressionTheoryTable {
+    /// Computes the theory for `scene`.
+    ///
+    /// # Errors
+    /// Numerical failures of the theory.
+    pub fn new(scene: &Scene, spec: &CompressionSpec) -> Result<Self> {
+        let p = scene.filament;
+        let dims = Dims::from_u32(scene.dims as u32)?;
+        let disc = CompressionTheory::new(
+            &p,
+            StoredLengthLaw::discrete(&p, dims, scene.mesh.elements)?,
+        )?;
+        let cont =
+            CompressionTheory::new(&p, StoredLengthLaw::continuum(&p, dims, CONTINUUM_MODES)?)?;
+        let mut discrete = Vec::new();
+        let mut continuum = Vec::new();
+        let mut distributions = Vec::new();
+        for &r in &spec.strain_ratios {
+            discrete.push(disc.force_ratio(r)?);
+            continuum.push(cont.force_ratio(r)?);
+            distributions.push(if spec.distribution_strain_ratios.contains(&r) {
+                Some(disc.force_distribution(r * p.euler_strain())?)
+            } else {
+                None
+            });
+        }
+        let lo = spec
+            .strain_ratios
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let hi = spec
+            .strain_ratios
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let curve = (0..CURVE_POINTS)
+            .map(|k| {
+                let r = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
+                Ok((r, disc.force_ratio(r)?, cont.force_ratio(r)?))
+            })
+            .collect::<Result<_>>()?;
+        Ok(CompressionTheoryTable {
+            strain_ratios: spec.strain_ratios.clone(),
+            discrete,
+            continuum,
+            distributions,
+            curve,
+        })
+    }
+}
+
+/// One run (integrator and time step) of a compression scene.
+pub struct CompressionRun {
+    /// The run specification.
+    pub spec: RunSpec,
+    /// Time step.
+    pub dt: f64,
+    /// Burn-in steps at each strain.
+    pub burn_in_steps: u64,
+    /// Steps between samples of F.
+    pub sample_every: u64,
+    models: Vec<CompressedFilament>,
+    /// Euler buckling load F_c0 (the unit of the recorded forces).
+    pub euler_load: f64,
+    /// Cholesky factor of the bending stiffness K, for the equilibrium start.
+    stiffness: BandedCholesky,
+}
+
+/// What one trajectory at one strain recorded.
+#[derive(Debug, Clone, Default)]
+pub struct ForceRecord {
+    /// F/F_c0 every `sample_every` steps after burn-in.
+    pub force_ratio: Vec<f64>,
+    /// Metropolis proposals and acceptances (0 for θ-schemes).
+    pub proposed: u64,
+    /// Accepted proposals.
+    pub accepted: u64,
+    /// Sum over the samples of θ² at each node (slope w', summed over components).
+    pub slope_squares: Vec<f64>,
+    /// Number of samples in `slope_squares`.
+    pub slope_samples: usize,
+}
+
+impl CompressionRun {
+    /// Prepares run `spec` of compression scene `scene`.
+    ///
+    /// # Errors
+    /// Invalid integrator or a time step above an explicit stability limit (exit 2).
+    pub fn prepare(scene: &Scene, comp: &CompressionSpec, spec: &RunSpec) -> Result<Self> {
+        let p = scene.filament;
+        let tau1 = p.tau1();
+        let dt = spec.dt_tau1 * tau1;
+        let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
+        let models: Vec<CompressedFilament> = comp
+            .strain_ratios
+            .iter()
+            .map(|r| CompressedFilament::new(beam.clone(), scene.dims, r * p.euler_strain()))
+            .collect::<Result<_>>()?;
+        // Fails early (exit 2) for a bad integrator or time step.
+        NonlinearIntegrator::new(&models[0], spec.integrator, spec.noise, dt)?;
+        Ok(CompressionRun {
+            spec: spec.clone(),
+            dt,
+            burn_in_steps: (comp.burn_in_tau1 * tau1 / dt).round() as u64,
+            sample_every: ((comp.sample_every_tau1 * tau1 / dt).round() as u64).max(1),
+            stiffness: beam.stiffness().cholesky()?,
+            models,
+            euler_load: p.euler_load(),
+        })
+    }
+
+    /// Number of steps for a sampled duration (physical time).
+    pub fn sampled_steps(&self, duration: f64) -> u64 {
+        let n = (duration / self.dt).round() as u64;
+        (n / self.sample_every).max(1) * self.sample_every
+    }
+
+    /// An exact sample of the free bending equilibrium, `w_c ~ N(0, kT K⁻¹)` per
+    /// transverse component (`w = sqrt(kT) L⁻ᵀ z` with `K = LLᵀ`, O(n)): the start of
+    /// every trajectory.
+    ///
+    /// Why not from rest: Crank–Nicolson (the proposal of the Metropolis scheme, and the
+    /// θ = ½ scheme) damps a stiff mode of rate λ only by `m = (1 − a/2)/(1 + a/2) ≈
+    /// −1 + 4/a` per step (a = λΔt), so from rest its variance needs about a/8 steps to
+    /// build up: at 10 elements and Δt = 0.02 τ1 that is 300 steps for the stiffest mode,
+    /// at 40 elements 8·10⁴ steps (1600 τ1). Those modes are almost purely bending (their
+    /// buckling loads are ≫ F), so starting from the bending equilibrium puts them in
+    /// equilibrium at once; the burn-in then equilibrates the slow, strain-dependent
+    /// modes. From rest, the missing stored length of the stiff modes biased ⟨F⟩ upwards
+    /// by up to 0.04 F_c0 (3D, 40 elements, Δt = 0.04 τ1), which the convergence study
+    /// over Δt exposed.
+    pub fn equilibrium_start(&self, rng: &mut TrajectoryRng) -> Vec<Vec<f64>> {
+        let model = &self.models[0];
+        let kt_sqrt = model.beam().params().kt.sqrt();
+        (0..model.components())
+            .map(|_| {
+                let mut z: Vec<f64> = (0..model.beam().n_dofs())
+                    .map(|_| kt_sqrt * rng.sample::<f64, _>(StandardNormal))
+                    .collect();
+                self.stiffness.solve_upper_in_place(&mut z);
+                z
+            })
+            .collect()
+    }
+
+    /// Simulates one trajectory at strain index `point` from an equilibrium start
+    /// ([`Self::equilibrium_start`]).
+    ///
+    /// # Errors
+    /// [`Error::Diverged`] naming the step, time and strain if the state becomes
+    /// non-finite.
+    pub fn simulate(
+        &self,
+        point: usize,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<ForceRecord> {
+        let model = &self.models[point];
+        let mut integ =
+            NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
+        let mut w = self.equilibrium_start(rng);
+        let total = self.burn_in_steps + sampled_steps;
+        let mut rec = ForceRecord {
+            force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+            slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
+            ..Default::default()
+        };
+        for step in 1..=total {
+            integ.step(model, &mut w, rng);
+            if !w.iter().flatten().all(|v| v.is_finite()) {
+                return Err(Error::diverged(
+                    step,
+                    self.dt,
+                    format!(
+                        "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
+                        self.spec.integrator,
+                        model.strain(),
+                        self.spec.dt_tau1
+                    ),
+                ));
+            }
+            if step > self.burn_in_steps
+                && (step - self.burn_in_steps).is_multiple_of(self.sample_every)
+            {
+                let f = model.compressive_force(model.stored_length(&w));
+                rec.force_ratio.push(f / self.euler_load);
+                for c in &w {
+                    add_slope_squares(model.beam(), c, &mut rec.slope_squares);
+                }
+                rec.slope_samples += 1;
+            }
+        }
+        rec.proposed = integ.proposed;
+        rec.accepted = integ.accepted;
+        Ok(rec)
+    }
+
+    /// Simulates `trajectories` trajectories of `sampled_steps` steps at every strain, in
+    /// parallel (rayon over strain × trajectory). Trajectory `j` at strain `i` uses the
+    /// stream `trajectory_rng(seed(i), j)`, so the result does not depend on the thread
+    /// count. `tick` is called after each trajectory (progress). Returns the records per
+    /// strain.
+    ///
+    /// # Errors
+    /// As [`Self::simulate`]: the first diverged trajectory (in index order).
+    pub fn simulate_ensemble(
+        &self,
+        seed: impl Fn(usize) -> u64 + Sync,
+        trajectories: usize,
+        sampled_steps: u64,
+        tick: impl Fn() + Sync,
+    ) -> Result<Vec<Vec<ForceRecord>>> {
+        let nt = trajectories.max(1);
+        let flat = crate::dynamics::par_indexed((self.points() * nt) as u64, |t| {
+            let (i, j) = (t as usize / nt, t % nt as u64);
+            let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps);
+            tick();
+            rec
+        })?;
+        Ok(flat.chunks(nt).map(<[_]>::to_vec).collect())
+    }
+
+    /// The strains of this run (ε/ε_c0 is in the theory table).
+    pub fn points(&self) -> usize {
+        self.models.len()
+    }
+
+    /// The largest root-mean-square nodal slope |w'| (all components) of the records of
+    /// one strain: `(rms slope, node x/L)`; `None` without samples. The small-slope
+    /// (von Kármán) model is flagged above
+    /// [`SMALL_SLOPE_LIMIT`](crate::scene::linear::SMALL_SLOPE_LIMIT).
+    pub fn measured_rms_slope(&self, records: &[ForceRecord]) -> Option<(f64, f64)> {
+        let beam = self.models.first()?.beam();
+        let n =
+            records.iter().map(|r| r.slope_samples).sum::<usize>() * self.models[0].components();
+        let sums: Vec<f64> = (0..beam.mesh().n_nodes())
+            .map(|k| records.iter().map(|r| r.slope_squares[k]).sum())
+            .collect();
+        largest_rms_slope(beam, &sums, n)
+    }
+
+    /// The largest RMS slope over all strains of `records` (one entry per strain):
+    /// `(rms slope, node x/L, strain index)`.
+    pub fn largest_rms_slope(&self, records: &[Vec<ForceRecord>]) -> Option<(f64, f64, usize)> {
+        records
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| self.measured_rms_slope(r).map(|(s, x)| (s, x, i)))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+    }
+}
+
+/// Per-strain estimates of one run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ForceEstimates {
+    /// (⟨F⟩/F_c0, standard error) per strain.
+    pub force: Vec<(f64, f64)>,
+    /// Metropolis acceptance rate over the run (1 for θ-schemes).
+    pub acceptance: f64,
+    /// Largest integrated autocorrelation time of F (in samples) over the strains.
+    pub max_tau_int: f64,
+}
+
+/// ⟨F⟩/F_c0 per strain: per trajectory the time average with an autocorrelation-aware
+/// error (integrated autocorrelation time); trajectories are independent, so errors add
+/// in quadrature.
+///
+/// # Errors
+/// Estimator errors (too few samples).
+pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
+    let mut out = ForceEstimates::default();
+    let (mut prop, mut acc) = (0u64, 0u64);
+    for point in records {
+        let mut parts = Vec::new();
+        for r in point {
+            let m = stats::mean_with_error(&r.force_ratio)?;
+            out.max_tau_int = out.max_tau_int.max(m.tau_int);
+            parts.push(m);
+            prop += r.proposed;
+            acc += r.accepted;
+        }
+        out.force.push(stats::combine_independent(&parts));
+    }
+    out.acceptance = if prop == 0 {
+        1.0
+    } else {
+        acc as f64 / prop as f64
+    };
+    Ok(out)
+}
+
+/// Metropolis acceptance rates below this are named as the likely cause of a failed
+/// force estimate (a sticky chain).
+pub const LOW_ACCEPTANCE: f64 = 0.2;
+
+/// [`force_estimates`], with the usual cause of a failure named: the Metropolis
+/// acceptance rate and the filament's EA·L/kT and EI/(kT·L) are added to the message,
+/// and a rate below [`LOW_ACCEPTANCE`] (a sticky chain) is named as the cause.
+///
+/// # Errors
+/// As [`force_estimates`].
+pub fn force_estimates_diagnosed(
+    records: &[Vec<ForceRecord>],
+    params: &crate::params::FilamentParams,
+) -> Result<ForceEstimates> {
+    force_estimates(records).map_err(|e| {
+        let (proposed, accepted) = records
+            .iter()
+            .flatten()
+            .fold((0u64, 0u64), |(p, a), r| (p + r.proposed, a + r.accepted));
+        if proposed == 0 {
+            return e;
+        }
+        let rate = accepted as f64 / proposed as f64;
+        let cause = if rate < LOW_ACCEPTANCE {
+            "a low acceptance makes F strongly correlated; a smaller dt_tau1 raises it"
+        } else {
+            "the acceptance is not the cause: F relaxes slowly compared with the sampled duration; raise duration_tau1"
+        };
+        Error::Numerical {
+            routine: "force estimates".into(),
+            detail: format!(
+                "{e}; the Metropolis acceptance rate was {rate:.3} (EA L/kT = {:e}, EI/(kT L) = {:e}): {cause}",
+                params.stretch_rigidity * params.length / params.kt,
+                params.bending_rigidity / (params.kt * params.length),
+            ),
+        }
+    })
+}

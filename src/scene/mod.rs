@@ -1,0 +1,21 @@
+//! Scenes: one physical set-up plus its discretization, ensembles per budget and checks
+//! (`verification/*.toml`), and the preparation of its runs.
+//!
+//! - [`spec`]: the scene types ([`Scene`], [`RunSpec`], [`CompressionSpec`], …), loading
+//!   and validation.
+//! - [`linear`]: a prepared run of a linear scene ([`linear::LinearRun`]): model, exact
+//!   references and sampling plan, and the simulation of one trajectory.
+//! - [`compression`]: a prepared run of a compression scene
+//!   ([`compression::CompressionRun`]), its exact theory table and force estimates.
+//!
+//! Both [`crate::verify`] (pass/fail checks) and [`crate::studies`] (parametric studies)
+//! are built on the runs prepared here.
+
+pub mod compression;
+pub mod linear;
+pub mod spec;
+
+pub use spec::{
+    Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, RunSpec, Sampling, Scene,
+    resolve_scenes,
+};

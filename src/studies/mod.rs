@@ -1,0 +1,16 @@
+//! Parametric studies: how the numerics behave as a discretization parameter changes.
+//! Unlike [`crate::verify`], a study has no single pass/fail verdict over a scene; it
+//! measures orders, biases and costs and writes JSON summaries, CSV tables and figures
+//! (the convergence report, [`crate::report::convergence`], is built from those).
+//!
+//! - [`converge`]: observed orders in h and Δt for linear scenes, and for compression
+//!   scenes ([`converge::compression`]), against the exact discrete and continuum
+//!   references.
+//! - [`stability`]: the stability map, integrator × Δt·λ_max × element count, against the
+//!   integrators' exact discrete-time stationary-variance formulas.
+//! - [`work_precision`]: error in ⟨w²(L/2)⟩ against wall time, and the projected cost to a
+//!   tolerance.
+
+pub mod converge;
+pub mod stability;
+pub mod work_precision;
