@@ -1,4 +1,4 @@
-//! Physical parameters of a filament (see `physics.md` §1).
+//! Physical parameters of a filament, their units and dimensionless groups.
 
 use crate::error::{Result, require_positive};
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,4 @@
-//! Finite-element model of the filament (`physics.md` §3): Hermite-cubic beam elements,
+//! Finite-element model of the filament (the semi-discrete form of eq. 2): Hermite-cubic beam elements,
 //! banded assembly over the free DOFs of a hinged beam, the paper's element-uniform noise
 //! (eq. 5) and consistent noise, generalized modes of `(K, C)` and the exact stationary
 //! covariances of the discrete system.
