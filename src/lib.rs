@@ -10,10 +10,11 @@
 //! 1. Foundation: [`params`], [`rng`], [`error`] (physical parameters, deterministic
 //!    randomness, errors) and [`output`] (domain-free SVG figures and atomic file writers).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
-//!    (2)–(4)) and [`theory`] (the exact equilibrium theory of the compressed filament,
-//!    the paper's Fig. 2).
+//!    (2)–(4)).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
-//!    modes, exact discrete stationary covariances, and the von Kármán filament).
+//!    modes, exact discrete stationary covariances, and the von Kármán filament), and on it
+//!    [`theory`] (the exact equilibrium theory of the compressed filament, the paper's
+//!    Fig. 2, for the continuum and for a given mesh).
 //! 4. Dynamics: [`dynamics`] (every fact about an integrator in
 //!    [`dynamics::IntegratorKind`], the linear and nonlinear integrators, the trajectory
 //!    driver and parallel ensembles).
