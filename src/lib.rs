@@ -26,7 +26,7 @@
 //! 8. Reports: [`report`] (the HTML index and the convergence pages).
 //!
 //! The binary's `cli` module sits on top.
-
+//!
 //! ## Equation map: the paper → the code
 //!
 //! Equation numbers are those of Lin & Shenoy (the seed paper); notation as in
