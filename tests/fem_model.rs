@@ -1,6 +1,11 @@
 //! Tests of the finite-element model (`src/fem`) against closed forms, dense linear
 //! algebra and the continuum solution of eq. (2).
 
+mod common;
+
+use common::filament;
+use common::hinged_profile_variance;
+use common::seeds::{SEED_NOISE_COVARIANCE, SEED_NOISE_DETERMINISM};
 use langevin_fem::FilamentParams;
 use langevin_fem::fem::{
     BeamModel, GeneralizedModes, Mesh, NoiseGenerator, NoiseModel, UNIFORM_RATE_FACTOR,
@@ -11,27 +16,16 @@ use langevin_fem::rng::trajectory_rng;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
-/// Non-unit parameters so that every scaling is exercised.
-fn params() -> FilamentParams {
-    FilamentParams {
-        length: 2.0,
-        bending_rigidity: 3.0,
-        stretch_rigidity: 1e6,
-        drag: 0.7,
-        kt: 1.3,
-    }
-}
-
 fn beam(mesh: Mesh) -> BeamModel {
-    BeamModel::new(params(), mesh).unwrap()
+    BeamModel::new(filament::sample(), mesh).unwrap()
 }
 
 fn uniform(n: usize) -> BeamModel {
-    beam(Mesh::uniform(params().length, n).unwrap())
+    beam(Mesh::uniform(filament::sample().length, n).unwrap())
 }
 
 fn graded(n: usize, ratio: f64) -> BeamModel {
-    beam(Mesh::graded(params().length, n, ratio).unwrap())
+    beam(Mesh::graded(filament::sample().length, n, ratio).unwrap())
 }
 
 /// Continuum rate λ_n = π⁴n⁴EI/(ξL⁴).
@@ -45,7 +39,7 @@ fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
 
 #[test]
 fn max_rate_uniform_factor_is_2520_and_euler_limit() {
-    let p = params();
+    let p = filament::sample();
     for &n in &[1usize, 2, 3, 10, 37, 200, 1000] {
         let b = uniform(n);
         let h = p.length / n as f64;
@@ -74,7 +68,7 @@ fn max_rate_uniform_factor_is_2520_and_euler_limit() {
 
 #[test]
 fn max_rate_graded_matches_dense_eigenvalue() {
-    let p = params();
+    let p = filament::sample();
     for &(n, ratio) in &[(2usize, 3.0), (7, 0.1), (16, 5.0), (25, 0.02)] {
         let b = graded(n, ratio);
         let lmax = b.max_rate().unwrap();
@@ -88,7 +82,7 @@ fn max_rate_graded_matches_dense_eigenvalue() {
 
 #[test]
 fn dof_layout_interpolation_and_assembled_forms_are_exact_for_cubics() {
-    let p = params();
+    let p = filament::sample();
     let l = p.length;
     let b = graded(6, 0.4);
     let n = b.n_dofs();
@@ -187,7 +181,7 @@ fn check_modes(b: &BeamModel, m: &GeneralizedModes) {
 
 #[test]
 fn generalized_modes_are_orthonormal_and_match_continuum_shapes() {
-    let p = params();
+    let p = filament::sample();
     for b in [uniform(12), graded(9, 0.2), graded(5, 4.0)] {
         let m = generalized_modes(&b).unwrap();
         check_modes(&b, &m);
@@ -214,7 +208,7 @@ fn generalized_modes_are_orthonormal_and_match_continuum_shapes() {
 
 #[test]
 fn rates_converge_to_continuum_at_fourth_order() {
-    let p = params();
+    let p = filament::sample();
     let ns = [2usize, 4, 8, 16];
     let modes = 3;
     let mut errs = vec![vec![0.0; ns.len()]; modes];
@@ -243,13 +237,12 @@ fn rates_converge_to_continuum_at_fourth_order() {
 
 /// kT·x²(L−x)²/(3·EI·L): the continuum equipartition profile ⟨w²(x)⟩.
 fn continuum_variance(p: &FilamentParams, x: f64) -> f64 {
-    let l = p.length;
-    p.kt * x * x * (l - x) * (l - x) / (3.0 * p.bending_rigidity * l)
+    hinged_profile_variance(x, p.length, p.bending_rigidity, p.kt)
 }
 
 #[test]
 fn consistent_noise_gives_kt_k_inverse_and_exact_nodal_variances() {
-    let p = params();
+    let p = filament::sample();
     // the closed form equals the modal series Σ 2kT L³ sin²(nπx/L)/(π⁴n⁴EI)
     for &x in &[0.1, 0.77, 1.0, 1.9] {
         let series: f64 = (1..=4000)
@@ -318,7 +311,7 @@ fn drift_and_diffusion(b: &BeamModel, sigma_zeta: &DMatrix<f64>) -> (DMatrix<f64
 
 #[test]
 fn continuous_covariance_solves_lyapunov_for_element_uniform_noise() {
-    let p = params();
+    let p = filament::sample();
     for b in [uniform(3), graded(3, 0.25)] {
         let n = b.n_dofs();
         let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &b)
@@ -364,7 +357,7 @@ fn iterate_stationary(m: &DMatrix<f64>, noise: &DMatrix<f64>) -> DMatrix<f64> {
 
 #[test]
 fn discrete_covariance_matches_iterated_recursion() {
-    let p = params();
+    let p = filament::sample();
     let kt = p.kt;
     let b = graded(3, 0.5);
     let n = b.n_dofs();
@@ -501,7 +494,7 @@ fn noise_generator_sample_covariance_matches() {
             }
         );
         let sigma = g.covariance();
-        let mut rng = trajectory_rng(20_240_601, idx as u64);
+        let mut rng = trajectory_rng(SEED_NOISE_COVARIANCE, idx as u64);
         let mut z = vec![0.0; n];
         let mut sum = DVector::<f64>::zeros(n);
         let mut sum2 = DMatrix::<f64>::zeros(n, n);
@@ -527,8 +520,8 @@ fn noise_generator_sample_covariance_matches() {
         println!("{model}: worst |z-score| over means and covariances = {worst:.2}");
         assert!(worst < 5.0, "{model}: {worst}");
         // determinism
-        let mut r1 = trajectory_rng(1, 2);
-        let mut r2 = trajectory_rng(1, 2);
+        let mut r1 = trajectory_rng(SEED_NOISE_DETERMINISM, 2);
+        let mut r2 = trajectory_rng(SEED_NOISE_DETERMINISM, 2);
         let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
         g.draw(&mut r1, &mut a1);
         g.draw(&mut r2, &mut a2);
@@ -538,12 +531,12 @@ fn noise_generator_sample_covariance_matches() {
 
 #[test]
 fn invalid_inputs_are_errors() {
-    let mut p = params();
+    let mut p = filament::sample();
     p.drag = -1.0;
     assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
-    let p = params();
+    let p = filament::sample();
     assert!(BeamModel::new(p, Mesh::uniform(2.5, 4).unwrap()).is_err());
-    let mut p = params();
+    let mut p = filament::sample();
     p.kt = f64::NAN;
     assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
 }

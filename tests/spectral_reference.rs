@@ -12,31 +12,20 @@
 //! (Bonferroni; the suite also passed for six other seed sets).
 //! Sample moments are computed inline (plain sums), not with `crate::stats`.
 
+mod common;
+
+use common::Z;
+use common::filament::spectral_sample;
+use common::seeds::{SEED_ENSEMBLE, SEED_EQUILIBRIUM, SEED_LARGE_STEP, SEED_REPRODUCIBLE};
 use langevin_fem::error::Error;
 use langevin_fem::params::FilamentParams;
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::spectral::{HingedBeam, MAX_MODES, ModalSimulator, inverse_fourth_power_tail};
 use std::f64::consts::PI;
 
-/// Number of standard errors allowed in every statistical check.
-const Z: f64 = 4.0;
-const SEED_EQUILIBRIUM: u64 = 0x5EC7_1001;
-const SEED_ENSEMBLE: u64 = 0x5EC7_1002;
-const SEED_LARGE_STEP: u64 = 0x5EC7_1003;
-const SEED_REPRODUCIBLE: u64 = 0x5EC7_1004;
-
-fn params() -> FilamentParams {
-    FilamentParams {
-        length: 2.5,
-        bending_rigidity: 0.7,
-        stretch_rigidity: 1.0e6,
-        drag: 3.0,
-        kt: 0.4,
-    }
-}
-
+/// The hinged beam of [`spectral_sample`] (L = 2.5, EI = 0.7, ξ = 3, kT = 0.4).
 fn beam() -> HingedBeam {
-    HingedBeam::new(params()).unwrap()
+    HingedBeam::new(spectral_sample()).unwrap()
 }
 
 /// Positions (as fractions of L) used for the deterministic checks; 0 and 1 are hinges.
@@ -509,7 +498,7 @@ fn invalid_inputs_are_errors() {
     ];
     for (name, set) in setters {
         for &v in &bad_values {
-            let mut p = params();
+            let mut p = spectral_sample();
             set(&mut p, v);
             match HingedBeam::new(p) {
                 Err(Error::InvalidParameter { name: got, .. }) => assert_eq!(got, name),
