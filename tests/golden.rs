@@ -150,6 +150,11 @@ fn snapshot_of(scene: &Scene) -> String {
     s
 }
 
+/// What: the snapshot of every scene in `verification/` (see the file header) equals
+/// its reviewed copy `golden/<scene>.snap`.
+/// Reference: the snapshots themselves (a regression check, not a correctness check).
+/// Set-up: traces from [`GOLDEN_SEED`].
+/// Tolerance: exact text at 10 significant digits (see the file header).
 #[test]
 fn golden_scenes() {
     let dir = manifest_dir();

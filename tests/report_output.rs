@@ -48,8 +48,8 @@ fn svg_texts(svg: &str) -> Vec<String> {
     out
 }
 
-// write_atomic creates missing parent directories, replaces existing content and leaves no
-// temporary file behind; a failed write names the destination path.
+/// write_atomic creates missing parent directories, replaces existing content and leaves no
+/// temporary file behind; a failed write names the destination path.
 #[test]
 fn write_atomic_replaces_content_and_leaves_no_temp_files() {
     let tmp = TempDir::new("atomic");
@@ -76,7 +76,7 @@ fn write_atomic_replaces_content_and_leaves_no_temp_files() {
     assert_eq!(file_names(path.parent().unwrap()), vec!["out.txt"]);
 }
 
-// write_csv refuses a row whose length differs from the header (and writes nothing).
+/// write_csv refuses a row whose length differs from the header (and writes nothing).
 #[test]
 fn write_csv_rejects_ragged_rows() {
     let tmp = TempDir::new("csv_ragged");
@@ -91,8 +91,8 @@ fn write_csv_rejects_ragged_rows() {
     assert!(file_names(dir).is_empty());
 }
 
-// write_csv prints numbers with round-trip precision: every value, including extreme
-// magnitudes, subnormals, signed zero and non-finite values, parses back bit-identically.
+/// write_csv prints numbers with round-trip precision: every value, including extreme
+/// magnitudes, subnormals, signed zero and non-finite values, parses back bit-identically.
 #[test]
 fn write_csv_round_trips_numbers() {
     let tmp = TempDir::new("csv_roundtrip");
@@ -138,9 +138,9 @@ fn write_csv_round_trips_numbers() {
     assert!(text.ends_with('\n'));
 }
 
-// write_json writes exactly serde_json's pretty form plus a trailing newline, which
-// deserializes to the same structure. (Floats are compared only through the text: without
-// serde_json's `float_roundtrip` feature its parser may be off by one ulp.)
+/// write_json writes exactly serde_json's pretty form plus a trailing newline, which
+/// deserializes to the same structure. (Floats are compared only through the text: without
+/// serde_json's `float_roundtrip` feature its parser may be off by one ulp.)
 #[test]
 fn write_json_is_pretty_and_round_trips() {
     let tmp = TempDir::new("json");
@@ -160,9 +160,9 @@ fn write_json_is_pretty_and_round_trips() {
     );
 }
 
-// A figure with two series, error bars, a reference line and log axes renders an SVG whose
-// <text> elements contain the title, both axis labels and every legend label, and a
-// second render is byte-identical.
+/// A figure with two series, error bars, a reference line and log axes renders an SVG whose
+/// <text> elements contain the title, both axis labels and every legend label, and a
+/// second render is byte-identical.
 #[test]
 fn figure_with_errors_and_log_axes_renders_labels_deterministically() {
     let n: Vec<f64> = (1..=12).map(f64::from).collect();
@@ -208,9 +208,9 @@ fn figure_with_errors_and_log_axes_renders_labels_deterministically() {
     assert_eq!(svg, again, "rendering is not deterministic");
 }
 
-// Non-finite points, non-positive values on a log axis, mismatched data and a figure without
-// any drawable point: rendering does not fail (except for the mismatched error bars), and
-// the figure says what it left out.
+/// Non-finite points, non-positive values on a log axis, mismatched data and a figure without
+/// any drawable point: rendering does not fail (except for the mismatched error bars), and
+/// the figure says what it left out.
 #[test]
 fn figure_with_nan_and_nonpositive_on_log_axis_does_not_fail() {
     let tmp = TempDir::new("figure_robust");
@@ -325,8 +325,8 @@ fn sample_summary() -> Summary {
     }
 }
 
-// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
-// check name stays text), marks the failing check, and write_index writes the same page.
+/// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
+/// check name stays text), marks the failing check, and write_index writes the same page.
 #[test]
 fn index_html_lists_figures_and_checks_and_escapes_text() {
     let summary = sample_summary();
