@@ -20,15 +20,17 @@
 //! The whole file runs in a few seconds: every `verify` run uses the quick budget of a
 //! 4-element scene.
 
+mod common;
+
+use common::{
+    TempDir, assert_no_panic, command, describe, fixture, hinged_profile_variance, run, stderr_of,
+    stdout_of, toml_files, write_scene,
+};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{SystemTime, UNIX_EPOCH};
-
-const BIN: &str = env!("CARGO_BIN_EXE_langevin-fem");
+use std::process::Output;
 
 /// The good fixture used by the determinism and seed tests.
 const TINY: &str = "tests/scenes/good/tiny-linear.toml";
@@ -42,110 +44,11 @@ const REL: f64 = 1e-12;
 // Helpers
 // ---------------------------------------------------------------------------------------
 
-fn manifest_dir() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn fixture(rel: &str) -> PathBuf {
-    manifest_dir().join(rel)
-}
-
 /// The scene directory shipped with the crate; passed explicitly as `--scene-dir` so
 /// that the tests do not depend on the working directory (see
 /// [`verify_scene_path_works_outside_the_crate_root`]).
 fn scene_dir() -> String {
     fixture("verification").display().to_string()
-}
-
-/// A unique temporary directory under `std::env::temp_dir()`, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let nanos = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos());
-        let path = std::env::temp_dir().join(format!(
-            "langevin-fem-cli-{tag}-{}-{n}-{nanos}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&path)
-            .unwrap_or_else(|e| panic!("cannot create {}: {e}", path.display()));
-        TempDir(path)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-
-    fn join(&self, rel: &str) -> PathBuf {
-        self.0.join(rel)
-    }
-
-    fn join_str(&self, rel: &str) -> String {
-        self.join(rel).display().to_string()
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// The binary, run from the crate root, with the thread count left to rayon.
-fn command() -> Command {
-    let mut c = Command::new(BIN);
-    c.current_dir(manifest_dir());
-    c.env_remove("RAYON_NUM_THREADS");
-    c
-}
-
-fn run(args: &[&str]) -> Output {
-    command()
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"))
-}
-
-fn stderr_of(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout_of(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn describe(args: &[&str], o: &Output) -> String {
-    format!(
-        "`langevin-fem {}`: exit {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
-        args.join(" "),
-        o.status.code(),
-        stdout_of(o),
-        stderr_of(o)
-    )
-}
-
-/// The process ended by itself (not by a signal) and did not panic.
-fn assert_no_panic(args: &[&str], o: &Output) {
-    assert!(
-        o.status.code().is_some(),
-        "killed by a signal: {}",
-        describe(args, o)
-    );
-    assert!(
-        !stderr_of(o).contains("panicked"),
-        "panicked: {}",
-        describe(args, o)
-    );
-    assert_ne!(
-        o.status.code(),
-        Some(101),
-        "exit 101 (Rust panic): {}",
-        describe(args, o)
-    );
 }
 
 /// Runs `args` and asserts exit code 2, no panic, nothing on stdout, and every needle in
@@ -206,11 +109,6 @@ fn assert_rel(actual: f64, expected: f64, rel: f64, what: &str) {
         "{what}: got {actual:e}, expected {expected:e} (relative error {:e} > {rel:e})",
         err / expected.abs()
     );
-}
-
-/// Closed-form equilibrium variance of the hinged filament, kT x²(L−x)²/(3 EI L).
-fn profile_variance(x: f64, l: f64, ei: f64, kt: f64) -> f64 {
-    kt * x * x * (l - x) * (l - x) / (3.0 * ei * l)
 }
 
 /// Runs `verify --scene <scene> --out <out>` (quick budget, explicit scene dir) with
@@ -288,16 +186,6 @@ fn files_with_ext(dir: &Path, ext: &str) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
-fn toml_files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    v.sort();
-    v
-}
-
 /// Every check's estimate, by check name.
 fn estimates(summary: &Value) -> BTreeMap<String, Value> {
     summary["scenes"]
@@ -346,7 +234,7 @@ fn theory_variance_matches_closed_form() {
     assert_eq!(num(&v, "x"), 0.7);
     assert_rel(
         num(&v, "variance"),
-        profile_variance(0.7, 2.0, 3.0, 0.5),
+        hinged_profile_variance(0.7, 2.0, 3.0, 0.5),
         REL,
         "variance with L = 2, EI = 3, kT = 0.5 at x = 0.7",
     );
@@ -970,13 +858,6 @@ fn bad_scenes_with_known_bugs_name_file_and_key() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 
-/// Writes `text` as `<dir>/<name>.toml` and returns its path.
-fn write_scene(dir: &TempDir, name: &str, text: &[u8]) -> PathBuf {
-    let p = dir.join(&format!("{name}.toml"));
-    std::fs::write(&p, text).expect("write scene");
-    p
-}
-
 fn tiny_text() -> String {
     std::fs::read_to_string(fixture(TINY)).expect("tiny scene")
 }
@@ -1351,10 +1232,7 @@ fn same_seed_reproduces_and_new_seed_changes_estimates() {
 /// Tolerance: exact substrings.
 #[test]
 fn diverging_run_stops_with_the_step() {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("verification/compression-2d.toml"),
-    )
-    .unwrap();
+    let text = std::fs::read_to_string(fixture("verification/compression-2d.toml")).unwrap();
     let text = replaced(
         &text,
         "stretch_rigidity = 1.0e6",

@@ -8,6 +8,11 @@
 //! seed the family-wise false-alarm probability is below 20·6.3·10⁻⁵ + 4·10⁻³ ≈ 5.3·10⁻³
 //! (Bonferroni).
 
+mod common;
+
+use common::Z;
+use common::filament::{paper, paper_rescaled};
+use common::seeds::{SEED_COMPRESSION_KS, SEED_COMPRESSION_MC};
 use langevin_fem::FilamentParams;
 use langevin_fem::fem::{BeamModel, Mesh};
 use langevin_fem::rng::trajectory_rng;
@@ -18,36 +23,6 @@ use langevin_fem::theory::{
 use rand::RngExt;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
-use std::process::Command;
-
-const SEED_MC: u64 = 0xC04D_5EED_0001;
-const SEED_KS: u64 = 0xC04D_5EED_0002;
-/// Standard errors allowed in each Monte Carlo check.
-const Z: f64 = 4.0;
-
-/// The paper's Fig. 2: L = kT = 1, EI/(kT·L) = 100, EA·L/kT = 10⁶.
-fn paper() -> FilamentParams {
-    FilamentParams {
-        length: 1.0,
-        bending_rigidity: 100.0,
-        stretch_rigidity: 1.0e6,
-        drag: 1.0,
-        kt: 1.0,
-    }
-}
-
-/// The same dimensionless groups (P = 100, S = 10⁶) in non-unit units, so that a wrong
-/// power of L or kT cannot cancel.
-fn scaled() -> FilamentParams {
-    let (l, kt) = (2.0, 1.3);
-    FilamentParams {
-        length: l,
-        bending_rigidity: 100.0 * kt * l,
-        stretch_rigidity: 1.0e6 * kt / l,
-        drag: 0.7,
-        kt,
-    }
-}
 
 #[derive(Debug, Clone, Copy)]
 enum Kind {
@@ -105,19 +80,19 @@ fn stiffness_a(p: &FilamentParams) -> f64 {
     p.stretch_rigidity * p.length / (2.0 * p.kt)
 }
 
-// What: ⟨F⟩(ε) from `mean_force` against an independent importance-weighted Monte Carlo
-// estimate: s drawn exactly from the free law (normals, not the characteristic function),
-// weights e^{−A(s−ε)²}, self-normalized F̂ = Σ w F/Σ w with F = EA(ε − s), standard error by
-// the delta method SE² = Σ w²(F − F̂)²/(Σ w)².
-// Reference: the Boltzmann average that `mean_force` evaluates by Fourier quadrature.
-// Set-up: non-unit units with P = 100, S = 10⁶; 2D and 3D; 10 elements and the continuum
-// truncated to 40 modes plus its Gaussian tail (the MC draws the same law, so the
-// truncation is consistent); 2·10⁵ draws per law, strain ratios −2, 0, 1, 2, 3.
-// Tolerance: 4 SE (20 checks; see the file header); in addition SE < 1% of F_c0 so that
-// the check is sharp (the tilted ensemble keeps an effective sample size of thousands).
+/// What: ⟨F⟩(ε) from `mean_force` against an independent importance-weighted Monte Carlo
+/// estimate: s drawn exactly from the free law (normals, not the characteristic function),
+/// weights e^{−A(s−ε)²}, self-normalized F̂ = Σ w F/Σ w with F = EA(ε − s), standard error by
+/// the delta method SE² = Σ w²(F − F̂)²/(Σ w)².
+/// Reference: the Boltzmann average that `mean_force` evaluates by Fourier quadrature.
+/// Set-up: non-unit units with P = 100, S = 10⁶; 2D and 3D; 10 elements and the continuum
+/// truncated to 40 modes plus its Gaussian tail (the MC draws the same law, so the
+/// truncation is consistent); 2·10⁵ draws per law, strain ratios −2, 0, 1, 2, 3.
+/// Tolerance: 4 SE (20 checks; see the file header); in addition SE < 1% of F_c0 so that
+/// the check is sharp (the tilted ensemble keeps an effective sample size of thousands).
 #[test]
 fn monte_carlo_importance_weighting_agrees_with_mean_force() {
-    let p = scaled();
+    let p = paper_rescaled();
     let a = stiffness_a(&p);
     let ea = p.stretch_rigidity;
     let cases = [
@@ -129,7 +104,7 @@ fn monte_carlo_importance_weighting_agrees_with_mean_force() {
     for (stream, &(dims, kind)) in cases.iter().enumerate() {
         let law = law(&p, dims, kind);
         let th = CompressionTheory::new(&p, law.clone()).unwrap();
-        let s = draw_stored_lengths(&law, 200_000, SEED_MC, stream as u64);
+        let s = draw_stored_lengths(&law, 200_000, SEED_COMPRESSION_MC, stream as u64);
         for &r in &[-2.0, 0.0, 1.0, 2.0, 3.0] {
             let eps = r * p.euler_strain();
             let logw: Vec<f64> = s.iter().map(|&x| -a * (x - eps).powi(2)).collect();
@@ -166,14 +141,14 @@ fn monte_carlo_importance_weighting_agrees_with_mean_force() {
     }
 }
 
-// What: convergence of the Fourier quadrature: halving the trapezoid step, and raising the
-// level T from 40 to 60 (longer range, finer step, wider aliasing period).
-// Reference: the default quadrature itself (self-convergence); the trapezoid rule on an
-// analytic integrand converges exponentially, so any change is rounding.
-// Set-up: the paper's parameters, 2D/3D × 10 elements/continuum (10⁴ modes), strain
-// ratios −5 … 50, mean and variance.
-// Tolerance: 10⁻¹⁰ relative for ⟨F⟩ (relative to max(|⟨F⟩|, F_c0)) and for Var F; the
-// observed changes are ~10⁻¹⁵.
+/// What: convergence of the Fourier quadrature: halving the trapezoid step, and raising the
+/// level T from 40 to 60 (longer range, finer step, wider aliasing period).
+/// Reference: the default quadrature itself (self-convergence); the trapezoid rule on an
+/// analytic integrand converges exponentially, so any change is rounding.
+/// Set-up: the paper's parameters, 2D/3D × 10 elements/continuum (10⁴ modes), strain
+/// ratios −5 … 50, mean and variance.
+/// Tolerance: 10⁻¹⁰ relative for ⟨F⟩ (relative to max(|⟨F⟩|, F_c0)) and for Var F; the
+/// observed changes are ~10⁻¹⁵.
 #[test]
 fn quadrature_is_converged() {
     let p = paper();
@@ -211,18 +186,18 @@ fn quadrature_is_converged() {
     }
 }
 
-// What: convergence of the continuum in the number of explicit modes M, with the omitted
-// modes represented by a Gaussian with their exact mean and variance; the importance of
-// that tail treatment; and the rigorous bound on the tail's effect on ln φ.
-// Reference: M = 2·10⁴; for the bound, |ln φ_M(t) − ln φ_{2·10⁴}(t)| ≤ bound(M) +
-// bound(2·10⁴) (both laws approximate the same infinite product).
-// Set-up: paper's parameters, 2D and 3D, M = 10, 100, 10³, 10⁴, strain ratios 0 … 10.
-// Tolerance: the error must fall with M, and be below 10⁻¹² F_c0 for M ≥ 10³ (the
-// bound on ln φ at |t| ≤ 2·10⁴ is ≤ 10⁻¹¹ for M = 10³); dropping the tail at M = 100
-// must shift ⟨F⟩ by more than 10⁻³ F_c0 at ε/ε_c0 ≤ 1. (A constant tail mean m_T only
-// shifts the strain, F_no tail(ε) = F(ε + m_T), so the shift is m_T·dF/dε: ≈ 2·10⁻³ F_c0
-// before buckling, but near zero at the force peak, where dF/dε = 0.) The bound on
-// ln φ must hold and be within a factor 100 of the actual difference.
+/// What: convergence of the continuum in the number of explicit modes M, with the omitted
+/// modes represented by a Gaussian with their exact mean and variance; the importance of
+/// that tail treatment; and the rigorous bound on the tail's effect on ln φ.
+/// Reference: M = 2·10⁴; for the bound, |ln φ_M(t) − ln φ_{2·10⁴}(t)| ≤ bound(M) +
+/// bound(2·10⁴) (both laws approximate the same infinite product).
+/// Set-up: paper's parameters, 2D and 3D, M = 10, 100, 10³, 10⁴, strain ratios 0 … 10.
+/// Tolerance: the error must fall with M, and be below 10⁻¹² F_c0 for M ≥ 10³ (the
+/// bound on ln φ at |t| ≤ 2·10⁴ is ≤ 10⁻¹¹ for M = 10³); dropping the tail at M = 100
+/// must shift ⟨F⟩ by more than 10⁻³ F_c0 at ε/ε_c0 ≤ 1. (A constant tail mean m_T only
+/// shifts the strain, F_no tail(ε) = F(ε + m_T), so the shift is m_T·dF/dε: ≈ 2·10⁻³ F_c0
+/// before buckling, but near zero at the force peak, where dF/dε = 0.) The bound on
+/// ln φ must hold and be within a factor 100 of the actual difference.
 #[test]
 fn continuum_mode_truncation_converges() {
     let p = paper();
@@ -277,16 +252,16 @@ fn continuum_mode_truncation_converges() {
     }
 }
 
-// What: basic facts of the stored-length laws and input validation.
-// Reference: ⟨s⟩₀ = d·kT·L/(12EI) (Σ1/n² = π²/6) and Var s = 2d c₁²π⁴/90 for the continuum;
-// φ(0) = 1; the closed-form discrete spectrum against the dense generalized
-// eigenproblem of the assembled `BeamModel` matrices.
-// Set-up: non-unit parameters; N = 1 … 32 for the dense comparison.
-// Tolerance: 10⁻¹³ for the continuum sums (Euler–Maclaurin tail to O(M⁻⁹)); 10⁻¹¹
-// relative for the dense eigenvalues (their rounding error grows as ε·N⁴).
+/// What: basic facts of the stored-length laws and input validation.
+/// Reference: ⟨s⟩₀ = d·kT·L/(12EI) (Σ1/n² = π²/6) and Var s = 2d c₁²π⁴/90 for the continuum;
+/// φ(0) = 1; the closed-form discrete spectrum against the dense generalized
+/// eigenproblem of the assembled `BeamModel` matrices.
+/// Set-up: non-unit parameters; N = 1 … 32 for the dense comparison.
+/// Tolerance: 10⁻¹³ for the continuum sums (Euler–Maclaurin tail to O(M⁻⁹)); 10⁻¹¹
+/// relative for the dense eigenvalues (their rounding error grows as ε·N⁴).
 #[test]
 fn stored_length_laws_and_validation() {
-    let p = scaled();
+    let p = paper_rescaled();
     assert_eq!(Dims::from_u32(2).unwrap(), Dims::Two);
     assert_eq!(Dims::from_u32(3).unwrap(), Dims::Three);
     assert!(Dims::from_u32(1).is_err() && Dims::from_u32(4).is_err());
@@ -340,15 +315,15 @@ fn stored_length_laws_and_validation() {
     );
 }
 
-// What: the large-tension limit. Far in tension F ≈ EA(ε − ⟨s⟩₀): the correction
-// EA(⟨s⟩₀ − ⟨s⟩_ε) is positive (tension pulls out undulations) and below EA⟨s⟩₀, so its
-// share of F vanishes; and the Gaussian mean-field force becomes exact (the stored
-// length's fluctuations shrink relative to the stretching Gaussian).
-// Reference: the limits above; ⟨s⟩₀ = `StoredLengthLaw::mean`.
-// Set-up: paper's parameters, the four laws, ε/ε_c0 = −10, −10², −10³, −10⁴.
-// Tolerance: the relative correction must decrease, and as 1/|ε| in the last decade
-// (ratio 9–11 from −10³ to −10⁴; it is bounded by EA⟨s⟩₀/|F| ≈ 0.8·10⁻⁴·d at −10⁴); |F − F_mf| must decrease (or sit at the
-// rounding level 10⁻¹⁴|F|).
+/// What: the large-tension limit. Far in tension F ≈ EA(ε − ⟨s⟩₀): the correction
+/// EA(⟨s⟩₀ − ⟨s⟩_ε) is positive (tension pulls out undulations) and below EA⟨s⟩₀, so its
+/// share of F vanishes; and the Gaussian mean-field force becomes exact (the stored
+/// length's fluctuations shrink relative to the stretching Gaussian).
+/// Reference: the limits above; ⟨s⟩₀ = `StoredLengthLaw::mean`.
+/// Set-up: paper's parameters, the four laws, ε/ε_c0 = −10, −10², −10³, −10⁴.
+/// Tolerance: the relative correction must decrease, and as 1/|ε| in the last decade
+/// (ratio 9–11 from −10³ to −10⁴; it is bounded by EA⟨s⟩₀/|F| ≈ 0.8·10⁻⁴·d at −10⁴); |F − F_mf| must decrease (or sit at the
+/// rounding level 10⁻¹⁴|F|).
 #[test]
 fn large_tension_limit() {
     let p = paper();
@@ -381,17 +356,17 @@ fn large_tension_limit() {
     }
 }
 
-// What: the large-compression limit. 2D approaches the buckling load F_c from above,
-// 3D from below. Asymptotically Z(ε) ∝ p₀(ε − F_c/EA) with p₀(s) ∝ (s − r̄)^{d/2−1}
-// e^{−s/(2c₁)}, so F − F_c ≈ (1 − d/2)(kT/L)/(ε − F_c/EA − r̄): positive in 2D, zero to all
-// orders in 1/ε in 3D (the corrections are exponentially small and negative). Here
-// r̄ = dΣ_{i≥2} c_i/(1 − c_i/c₁) + tail_mean is the mean stored length of the other modes
-// at the tilt η = 1/(2c₁), and F_c/EA the mean shift of the Gaussian smoothing.
-// Reference: that asymptote; F_c = `buckling_load_discrete` (mesh) or F_c0 (continuum).
-// Set-up: paper's parameters, the four laws, ε/ε_c0 = 3 … 50.
-// Tolerance: at 50 ε_c0, |F/F_c − 1| < 3% (2D: ≈ 1%); the 2D asymptote within 1% of
-// F − F_c (neglected terms are O(Var r̄/(ε − r̄)²) ≈ 10⁻⁴ and O(1/(A ε²)) ≈ 10⁻³);
-// 3D: F_c − F ≥ 0 up to 10⁻¹² F_c (rounding) and < 10⁻³ F_c.
+/// What: the large-compression limit. 2D approaches the buckling load F_c from above,
+/// 3D from below. Asymptotically Z(ε) ∝ p₀(ε − F_c/EA) with p₀(s) ∝ (s − r̄)^{d/2−1}
+/// e^{−s/(2c₁)}, so F − F_c ≈ (1 − d/2)(kT/L)/(ε − F_c/EA − r̄): positive in 2D, zero to all
+/// orders in 1/ε in 3D (the corrections are exponentially small and negative). Here
+/// r̄ = dΣ_{i≥2} c_i/(1 − c_i/c₁) + tail_mean is the mean stored length of the other modes
+/// at the tilt η = 1/(2c₁), and F_c/EA the mean shift of the Gaussian smoothing.
+/// Reference: that asymptote; F_c = `buckling_load_discrete` (mesh) or F_c0 (continuum).
+/// Set-up: paper's parameters, the four laws, ε/ε_c0 = 3 … 50.
+/// Tolerance: at 50 ε_c0, |F/F_c − 1| < 3% (2D: ≈ 1%); the 2D asymptote within 1% of
+/// F − F_c (neglected terms are O(Var r̄/(ε − r̄)²) ≈ 10⁻⁴ and O(1/(A ε²)) ≈ 10⁻³);
+/// 3D: F_c − F ≥ 0 up to 10⁻¹² F_c (rounding) and < 10⁻³ F_c.
 #[test]
 fn large_compression_limit_2d_from_above_3d_from_below() {
     let p = paper();
@@ -441,16 +416,16 @@ fn large_compression_limit_2d_from_above_3d_from_below() {
     }
 }
 
-// What: convergence of the discretized filament to the continuum: buckling load, the
-// individual weights c₁, c₂, c₃, and the total ⟨s⟩₀.
-// Reference: continuum c_n = kT L/(2EIn²π²), F_c0 = π²EI/L², ⟨s⟩₀ = kT L/(12EI).
-// Set-up: paper's parameters, N = 8 … 512 (closed-form spectrum, exact to rounding).
-// Tolerance: observed orders log₂(e_N/e_{2N}) within 0.1 of 4 for the buckling load and
-// the weights (Hermite cubics: eigenvalue error O(h⁴)), F_c > F_c0; ⟨s⟩₀ is only
-// first-order: the measured identity ⟨s⟩₀,h = ⟨s⟩₀(1 − 2h/(5L)) holds to 10⁻¹². Given the
-// nodes, the continuum field is the cubic interpolant plus an independent clamped–clamped
-// "bubble" per element, which the mesh cannot represent; E∫bubble'² = kT h²/(15EI) per
-// element, hence the deficit N·kT h²/(30EI L) = (2h/5L)⟨s⟩₀.
+/// What: convergence of the discretized filament to the continuum: buckling load, the
+/// individual weights c₁, c₂, c₃, and the total ⟨s⟩₀.
+/// Reference: continuum c_n = kT L/(2EIn²π²), F_c0 = π²EI/L², ⟨s⟩₀ = kT L/(12EI).
+/// Set-up: paper's parameters, N = 8 … 512 (closed-form spectrum, exact to rounding).
+/// Tolerance: observed orders log₂(e_N/e_{2N}) within 0.1 of 4 for the buckling load and
+/// the weights (Hermite cubics: eigenvalue error O(h⁴)), F_c > F_c0; ⟨s⟩₀ is only
+/// first-order: the measured identity ⟨s⟩₀,h = ⟨s⟩₀(1 − 2h/(5L)) holds to 10⁻¹². Given the
+/// nodes, the continuum field is the cubic interpolant plus an independent clamped–clamped
+/// "bubble" per element, which the mesh cannot represent; E∫bubble'² = kT h²/(15EI) per
+/// element, hence the deficit N·kT h²/(30EI L) = (2h/5L)⟨s⟩₀.
 #[test]
 fn discretization_converges_to_continuum() {
     let p = paper();
@@ -488,14 +463,14 @@ fn discretization_converges_to_continuum() {
     }
 }
 
-// What: the paper's qualitative Fig. 2 at EI/(kT·L) = 100, EA·L/kT = 10⁶.
-// Reference: the paper's text: in 2D the force peaks near ε/ε_c0 ≈ 3 and decays to F_c0
-// from above; in 3D it rises towards F_c0 and never exceeds it; at small strain the
-// filament is in tension.
-// Set-up: 10 elements and the continuum, ε/ε_c0 = 0, 0.25, …, 10.
-// Tolerance: peak location in [2.5, 4.5] (exact theory: 3.4–3.5), peak > 1.2 F_c0,
-// strictly decreasing after the peak, F(10)/F_c0 in (1, 1.1); 3D strictly increasing and
-// below the buckling load, F(10)/F_c > 0.99; F(0) < 0 in both.
+/// What: the paper's qualitative Fig. 2 at EI/(kT·L) = 100, EA·L/kT = 10⁶.
+/// Reference: the paper's text: in 2D the force peaks near ε/ε_c0 ≈ 3 and decays to F_c0
+/// from above; in 3D it rises towards F_c0 and never exceeds it; at small strain the
+/// filament is in tension.
+/// Set-up: 10 elements and the continuum, ε/ε_c0 = 0, 0.25, …, 10.
+/// Tolerance: peak location in [2.5, 4.5] (exact theory: 3.4–3.5), peak > 1.2 F_c0,
+/// strictly decreasing after the peak, F(10)/F_c0 in (1, 1.1); 3D strictly increasing and
+/// below the buckling load, F(10)/F_c > 0.99; F(0) < 0 in both.
 #[test]
 fn paper_fig2_qualitative_shape() {
     let p = paper();
@@ -559,15 +534,15 @@ fn ks_statistic(sorted: &[f64], cdf: impl Fn(f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-// What: the equilibrium distribution of F: a proper CDF whose mean and variance are those
-// of `mean_force`/`force_variance` (an independent route: the Fourier series of the tilted
-// law vs. the moment integrals).
-// Reference: ⟨F⟩ = f_hi − ∫CDF, E(f_hi − F)² = ∫2(f_hi − f)CDF(f) df over the support.
-// Set-up: paper's parameters, the four laws, ε/ε_c0 = −3, 0, 1, 3, 10; Simpson's rule on
-// 4001 points over the support.
-// Tolerance: CDF ≤ 10⁻¹² at the lower edge, ≥ 1 − 10⁻¹² at the upper edge, decreasing steps
-// no larger than 10⁻¹² (rounding of the series); mean within 10⁻⁶σ, variance within 10⁻⁶
-// relative (Simpson with ≥ 60 points per σ and the ≤ 10⁻¹⁴ series truncation).
+/// What: the equilibrium distribution of F: a proper CDF whose mean and variance are those
+/// of `mean_force`/`force_variance` (an independent route: the Fourier series of the tilted
+/// law vs. the moment integrals).
+/// Reference: ⟨F⟩ = f_hi − ∫CDF, E(f_hi − F)² = ∫2(f_hi − f)CDF(f) df over the support.
+/// Set-up: paper's parameters, the four laws, ε/ε_c0 = −3, 0, 1, 3, 10; Simpson's rule on
+/// 4001 points over the support.
+/// Tolerance: CDF ≤ 10⁻¹² at the lower edge, ≥ 1 − 10⁻¹² at the upper edge, decreasing steps
+/// no larger than 10⁻¹² (rounding of the series); mean within 10⁻⁶σ, variance within 10⁻⁶
+/// relative (Simpson with ≥ 60 points per σ and the ≤ 10⁻¹⁴ series truncation).
 #[test]
 fn force_distribution_is_a_cdf_with_the_exact_moments() {
     let p = paper();
@@ -622,17 +597,17 @@ fn force_distribution_is_a_cdf_with_the_exact_moments() {
     }
 }
 
-// What: KS test of exact samples of F at imposed strain against `force_distribution`, and
-// power against a CDF shifted by 0.2σ.
-// Reference: exact sampling by rejection: s from the free law (normals), accepted with
-// probability e^{−A(s−ε)²} ≤ 1, which gives the tilted density p₀(s)e^{−A(s−ε)²}/Z.
-// Set-up: non-unit parameters (P = 100, S = 10⁶), 2D/3D × 10 elements/continuum (200
-// modes + tail), ε/ε_c0 = 1 and 2.5 (acceptance ≈ 0.2–0.6), 4000 accepted samples each.
-// Tolerance: p > 0.001 for the true CDF (4 checks); p < 10⁻⁶ for the shifted one (a
-// 0.2σ shift gives D ≈ 0.08, √n·D ≈ 5, p ≈ 10⁻²¹).
+/// What: KS test of exact samples of F at imposed strain against `force_distribution`, and
+/// power against a CDF shifted by 0.2σ.
+/// Reference: exact sampling by rejection: s from the free law (normals), accepted with
+/// probability e^{−A(s−ε)²} ≤ 1, which gives the tilted density p₀(s)e^{−A(s−ε)²}/Z.
+/// Set-up: non-unit parameters (P = 100, S = 10⁶), 2D/3D × 10 elements/continuum (200
+/// modes + tail), ε/ε_c0 = 1 and 2.5 (acceptance ≈ 0.2–0.6), 4000 accepted samples each.
+/// Tolerance: p > 0.001 for the true CDF (4 checks); p < 10⁻⁶ for the shifted one (a
+/// 0.2σ shift gives D ≈ 0.08, √n·D ≈ 5, p ≈ 10⁻²¹).
 #[test]
 fn force_distribution_ks_against_rejection_samples() {
-    let p = scaled();
+    let p = paper_rescaled();
     let a = stiffness_a(&p);
     let cases = [
         (Dims::Two, Kind::Discrete(10), 1.0),
@@ -644,11 +619,13 @@ fn force_distribution_ks_against_rejection_samples() {
         let law = law(&p, dims, kind);
         let th = CompressionTheory::new(&p, law.clone()).unwrap();
         let eps = r * p.euler_strain();
-        let mut rng = trajectory_rng(SEED_KS, 1000 + stream as u64);
+        let mut rng = trajectory_rng(SEED_COMPRESSION_KS, 1000 + stream as u64);
         let mut samples = Vec::new();
         let mut chunk = 0;
         while samples.len() < 4000 {
-            for s in draw_stored_lengths(&law, 1000, SEED_KS, chunk * 16 + stream as u64) {
+            for s in
+                draw_stored_lengths(&law, 1000, SEED_COMPRESSION_KS, chunk * 16 + stream as u64)
+            {
                 let u: f64 = rng.random();
                 if u < (-a * (s - eps).powi(2)).exp() && samples.len() < 4000 {
                     samples.push(p.stretch_rigidity * (eps - s));
@@ -672,20 +649,21 @@ fn force_distribution_ks_against_rejection_samples() {
     }
 }
 
+/// Runs `langevin-fem theory compression <args>`.
 fn run_cli(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_langevin-fem"))
+    common::command()
         .args(["theory", "compression"])
         .args(args)
         .output()
         .unwrap()
 }
 
-// What: `langevin-fem theory compression` prints the documented JSON and rejects bad
-// input with exit code 2 and a message naming the flag.
-// Reference: the library (same parameters: L = kT = 1, EI = P, EA = S).
-// Set-up: defaults (P = 100, S = 10⁶), 2D 10 elements and 3D continuum; a list of bad
-// inputs.
-// Tolerance: force ratios equal to the library's to 10⁻¹² (JSON round-trips f64).
+/// What: `langevin-fem theory compression` prints the documented JSON and rejects bad
+/// input with exit code 2 and a message naming the flag.
+/// Reference: the library (same parameters: L = kT = 1, EI = P, EA = S).
+/// Set-up: defaults (P = 100, S = 10⁶), 2D 10 elements and 3D continuum; a list of bad
+/// inputs.
+/// Tolerance: force ratios equal to the library's to 10⁻¹² (JSON round-trips f64).
 #[test]
 fn cli_json_and_exit_codes() {
     let out = run_cli(&[

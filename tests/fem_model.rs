@@ -1,6 +1,11 @@
 //! Tests of the finite-element model (`src/fem`) against closed forms, dense linear
 //! algebra and the continuum solution of eq. (2).
 
+mod common;
+
+use common::filament;
+use common::hinged_profile_variance;
+use common::seeds::{SEED_NOISE_COVARIANCE, SEED_NOISE_DETERMINISM};
 use langevin_fem::FilamentParams;
 use langevin_fem::fem::{
     BeamModel, GeneralizedModes, Mesh, NoiseGenerator, NoiseModel, UNIFORM_RATE_FACTOR,
@@ -11,27 +16,16 @@ use langevin_fem::rng::trajectory_rng;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
-/// Non-unit parameters so that every scaling is exercised.
-fn params() -> FilamentParams {
-    FilamentParams {
-        length: 2.0,
-        bending_rigidity: 3.0,
-        stretch_rigidity: 1e6,
-        drag: 0.7,
-        kt: 1.3,
-    }
-}
-
 fn beam(mesh: Mesh) -> BeamModel {
-    BeamModel::new(params(), mesh).unwrap()
+    BeamModel::new(filament::sample(), mesh).unwrap()
 }
 
 fn uniform(n: usize) -> BeamModel {
-    beam(Mesh::uniform(params().length, n).unwrap())
+    beam(Mesh::uniform(filament::sample().length, n).unwrap())
 }
 
 fn graded(n: usize, ratio: f64) -> BeamModel {
-    beam(Mesh::graded(params().length, n, ratio).unwrap())
+    beam(Mesh::graded(filament::sample().length, n, ratio).unwrap())
 }
 
 /// Continuum rate λ_n = π⁴n⁴EI/(ξL⁴).
@@ -43,9 +37,16 @@ fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).amax() / b.amax()
 }
 
+/// What: on uniform meshes (N = 1 … 1000) `max_rate` is λ_max = 2520·EI/(ξh⁴)
+/// ([`UNIFORM_RATE_FACTOR`]) and equals the largest dense eigenvalue for N ≤ 40; the
+/// explicit Euler limit 2/λ_max for 10 elements is 2π⁴/(2520·10⁴) τ₁ ≈ 7.73·10⁻⁶ τ₁.
+/// Reference: the closed form 2520·EI/(ξh⁴) (`src/fem/beam.rs`); the dense generalized
+/// eigenproblem K φ = λ C φ (`generalized_modes`), independent of the Sturm bisection.
+/// Set-up: non-unit filament ([`filament::sample`]).
+/// Tolerance: 10⁻¹⁰ relative: the bisection runs to 10⁻¹³, the rest is round-off.
 #[test]
 fn max_rate_uniform_factor_is_2520_and_euler_limit() {
-    let p = params();
+    let p = filament::sample();
     for &n in &[1usize, 2, 3, 10, 37, 200, 1000] {
         let b = uniform(n);
         let h = p.length / n as f64;
@@ -72,9 +73,13 @@ fn max_rate_uniform_factor_is_2520_and_euler_limit() {
     assert!((limit / expected - 1.0).abs() < 1e-10);
 }
 
+/// What: on graded meshes (N = 2 … 25, size ratios 0.02 … 5), where no closed form exists,
+/// `max_rate` (Sturm bisection) equals the largest dense generalized eigenvalue.
+/// Reference: `generalized_modes` (dense eigen-solve of K φ = λ C φ).
+/// Tolerance: 10⁻¹⁰ relative: the bisection runs to 10⁻¹³, the rest is round-off.
 #[test]
 fn max_rate_graded_matches_dense_eigenvalue() {
-    let p = params();
+    let p = filament::sample();
     for &(n, ratio) in &[(2usize, 3.0), (7, 0.1), (16, 5.0), (25, 0.02)] {
         let b = graded(n, ratio);
         let lmax = b.max_rate().unwrap();
@@ -86,9 +91,17 @@ fn max_rate_graded_matches_dense_eigenvalue() {
     }
 }
 
+/// What: the DOF layout of a graded 6-element mesh with hinged ends (no deflection DOF at
+/// the end nodes, 12 DOFs, element DOF maps); and, for the cubic w = x(L−x)(x + 0.3),
+/// which Hermite cubics represent exactly, `deflection_at` reproduces w (NaN outside
+/// [0, L]) and the assembled load vector, geometric, stiffness and damping forms give ∫w,
+/// ∫w'², EI∫w''² and ξ∫w².
+/// Reference: 5-point Gauss–Legendre on 8 panels, exact for these polynomials (degree ≤ 6).
+/// Tolerance: round-off only: 10⁻¹³ for the interpolation, 10⁻¹² to 10⁻¹⁰ (absolute) for
+/// the forms, the largest for the stiffness form, whose entries scale as EI/h³.
 #[test]
 fn dof_layout_interpolation_and_assembled_forms_are_exact_for_cubics() {
-    let p = params();
+    let p = filament::sample();
     let l = p.length;
     let b = graded(6, 0.4);
     let n = b.n_dofs();
@@ -185,9 +198,17 @@ fn check_modes(b: &BeamModel, m: &GeneralizedModes) {
     }
 }
 
+/// What: the generalized modes are C-orthonormal, K-orthogonal with ΦᵀKΦ = diag(λ),
+/// λ increasing, and the modal projector inverts Φ on the 4 leading modes (one uniform,
+/// two graded meshes); on 40 uniform elements the first 4 modes match the continuum
+/// shapes √(2/(ξL)) sin(nπx/L) at the nodes, with positive sign.
+/// Reference: the definition of the generalized eigenproblem; the continuum modes of
+/// eq. (2) with hinged ends.
+/// Tolerance: 10⁻⁹ (relative to √(λᵢλⱼ) for K) for the identities: round-off of the dense
+/// eigen-solve; 10⁻⁴ of the amplitude for the shapes: the discretization error at h = L/40.
 #[test]
 fn generalized_modes_are_orthonormal_and_match_continuum_shapes() {
-    let p = params();
+    let p = filament::sample();
     for b in [uniform(12), graded(9, 0.2), graded(5, 4.0)] {
         let m = generalized_modes(&b).unwrap();
         check_modes(&b, &m);
@@ -212,9 +233,15 @@ fn generalized_modes_are_orthonormal_and_match_continuum_shapes() {
     }
 }
 
+/// What: the first 3 discrete rates are upper bounds of the continuum rates (conforming
+/// Rayleigh–Ritz) and converge to them at fourth order in h.
+/// Reference: λₙ = π⁴n⁴EI/(ξL⁴) (eq. (2), hinged ends); Hermite-cubic eigenvalue error O(h⁴).
+/// Set-up: uniform meshes of 2, 4, 8, 16 elements.
+/// Tolerance: the observed order log₂(e_N/e_2N) from 8 to 16 elements within 0.15 of 4
+/// (higher-order terms on these coarse meshes).
 #[test]
 fn rates_converge_to_continuum_at_fourth_order() {
-    let p = params();
+    let p = filament::sample();
     let ns = [2usize, 4, 8, 16];
     let modes = 3;
     let mut errs = vec![vec![0.0; ns.len()]; modes];
@@ -243,13 +270,23 @@ fn rates_converge_to_continuum_at_fourth_order() {
 
 /// kT·x²(L−x)²/(3·EI·L): the continuum equipartition profile ⟨w²(x)⟩.
 fn continuum_variance(p: &FilamentParams, x: f64) -> f64 {
-    let l = p.length;
-    p.kt * x * x * (l - x) * (l - x) / (3.0 * p.bending_rigidity * l)
+    hinged_profile_variance(x, p.length, p.bending_rigidity, p.kt)
 }
 
+/// What: the closed-form profile kT x²(L−x)²/(3EI L) equals its mode series; with
+/// consistent noise Σ_ζ = C, the modal noise covariance is I, the stationary nodal
+/// covariance is kT K⁻¹, and the nodal variances equal the continuum profile (by banded
+/// solves and by the modal route).
+/// Reference: the equipartition series Σ 2kTL³ sin²(nπx/L)/(π⁴n⁴EI) (4000 terms); kT K⁻¹ by
+/// a dense Cholesky inverse; the continuum profile, which Hermite cubics reproduce at the
+/// nodes (the Green's function of EI ∂⁴ is cubic between nodes).
+/// Set-up: one uniform and two graded meshes.
+/// Tolerance: 10⁻⁹ for the series (its omitted tail is ~10⁻¹⁰ relative); otherwise
+/// round-off: 10⁻¹³ of max|C| for the Cholesky product, 10⁻⁹ for the modal (dense
+/// eigen-solve) routes, 10⁻¹² relative for the banded variances, 10⁻¹⁰ for the modal ones.
 #[test]
 fn consistent_noise_gives_kt_k_inverse_and_exact_nodal_variances() {
-    let p = params();
+    let p = filament::sample();
     // the closed form equals the modal series Σ 2kT L³ sin²(nπx/L)/(π⁴n⁴EI)
     for &x in &[0.1, 0.77, 1.0, 1.9] {
         let series: f64 = (1..=4000)
@@ -316,9 +353,17 @@ fn drift_and_diffusion(b: &BeamModel, sigma_zeta: &DMatrix<f64>) -> (DMatrix<f64
     (a, bm)
 }
 
+/// What: with the paper's element-uniform noise the stationary nodal covariance P from the
+/// modal route solves AP + PAᵀ + B = 0 for ẇ = −C⁻¹K w + noise, equals the solution of the
+/// Kronecker system, and is not kT K⁻¹.
+/// Reference: the Lyapunov equation, solved independently as (I⊗A + A⊗I) vec P = −vec B
+/// (dense LU).
+/// Set-up: 3 elements, uniform and graded.
+/// Tolerance: residual below 10⁻¹⁰ of max|B| and 10⁻⁹ relative between the routes
+/// (round-off); the difference from kT K⁻¹ must exceed 10⁻³ relative.
 #[test]
 fn continuous_covariance_solves_lyapunov_for_element_uniform_noise() {
-    let p = params();
+    let p = filament::sample();
     for b in [uniform(3), graded(3, 0.25)] {
         let n = b.n_dofs();
         let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &b)
@@ -362,9 +407,20 @@ fn iterate_stationary(m: &DMatrix<f64>, noise: &DMatrix<f64>) -> DMatrix<f64> {
     s
 }
 
+/// What: the exact stationary covariance of the θ-scheme
+/// (C + θΔtK) w' = (C − (1−θ)ΔtK) w + √(2kTΔt) ζ with element-uniform noise, from the
+/// modal multipliers and gains (`discrete_stationary_covariance`), equals the reference for
+/// explicit Euler at Δt = 1/λ_max, backward Euler at 10/λ₁ and Crank–Nicolson at 100/λ₁;
+/// truncation to 2 modes gives the leading block, with S₁₀ = g₁g₀Σ_q,10/(1 − m₁m₀)
+/// = 2Σ_q,10/1.1.
+/// Reference: the nodal recursion's stationary covariance by Smith's doubling iteration
+/// (no modal decomposition).
+/// Set-up: graded 3-element mesh.
+/// Tolerance: 10⁻⁸ relative (round-off of the iteration with multipliers near ±1);
+/// 10⁻¹⁴ of max|S| for the closed-form entry.
 #[test]
 fn discrete_covariance_matches_iterated_recursion() {
-    let p = params();
+    let p = filament::sample();
     let kt = p.kt;
     let b = graded(3, 0.5);
     let n = b.n_dofs();
@@ -420,6 +476,11 @@ fn discrete_covariance_matches_iterated_recursion() {
     assert!((s2[(1, 0)] - 2.0 * sigma_q[(1, 0)] / 1.1).abs() < 1e-14 * s2.amax());
 }
 
+/// What: `discrete_stationary_covariance` refuses a multiplier with |m| ≥ 1 (naming the
+/// mode, 1-based), a NaN multiplier, multipliers and gains of different lengths, and more
+/// modes than the covariance has.
+/// Reference: a stationary law exists only for |m| < 1.
+/// Tolerance: exact (errors).
 #[test]
 fn discrete_covariance_rejects_unstable_modes() {
     let sq = DMatrix::<f64>::identity(3, 3);
@@ -432,6 +493,14 @@ fn discrete_covariance_rejects_unstable_modes() {
     assert!(discrete_stationary_covariance(&sq, &[0.5; 4], &[1.0; 4]).is_err());
 }
 
+/// What: with element-uniform noise the stationary modal variance relative to kT/λᵢ,
+/// Σ_q,ii, lies in (0, 1], increases with N once the mode is resolved, and its deficit
+/// 1 − Σ_q,ii ≈ (iπh/L)²/12 is of second order in h and below 3 % at 40 elements
+/// (modes 1–6); graded meshes obey the same bound.
+/// Reference: Σ_q,ii = Σ_e h_e·mean_e(φᵢ)²/∫φᵢ² ≤ 1 (Cauchy–Schwarz per element).
+/// Set-up: uniform meshes of 5, 10, 20, 40 elements; graded meshes (ratio 0.3).
+/// Tolerance: the bound up to 10⁻⁹ (round-off); the observed order from 20 to 40
+/// elements within 0.1 of 2.
 #[test]
 fn element_uniform_modal_variance_ratios_tend_to_one() {
     let ns = [5usize, 10, 20, 40];
@@ -485,6 +554,14 @@ fn element_uniform_modal_variance_ratios_tend_to_one() {
     }
 }
 
+/// What: each noise model's generator draws vectors whose sample mean and covariance
+/// match its `covariance()`, with n (consistent) or 4 (element-uniform) draws per step, and
+/// two generators seeded alike draw alike.
+/// Reference: the exact Σ; Gaussian standard errors √(Σᵢᵢ/M) for a mean and
+/// √((ΣᵢᵢΣⱼⱼ + Σᵢⱼ²)/M) for a covariance.
+/// Set-up: graded 4-element mesh (8 DOFs), M = 40000 draws from
+/// [`SEED_NOISE_COVARIANCE`].
+/// Tolerance: every |z| < 5 (72 statistics per model at 5.7·10⁻⁷ each).
 #[test]
 fn noise_generator_sample_covariance_matches() {
     let b = graded(4, 0.5);
@@ -501,7 +578,7 @@ fn noise_generator_sample_covariance_matches() {
             }
         );
         let sigma = g.covariance();
-        let mut rng = trajectory_rng(20_240_601, idx as u64);
+        let mut rng = trajectory_rng(SEED_NOISE_COVARIANCE, idx as u64);
         let mut z = vec![0.0; n];
         let mut sum = DVector::<f64>::zeros(n);
         let mut sum2 = DMatrix::<f64>::zeros(n, n);
@@ -527,8 +604,8 @@ fn noise_generator_sample_covariance_matches() {
         println!("{model}: worst |z-score| over means and covariances = {worst:.2}");
         assert!(worst < 5.0, "{model}: {worst}");
         // determinism
-        let mut r1 = trajectory_rng(1, 2);
-        let mut r2 = trajectory_rng(1, 2);
+        let mut r1 = trajectory_rng(SEED_NOISE_DETERMINISM, 2);
+        let mut r2 = trajectory_rng(SEED_NOISE_DETERMINISM, 2);
         let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
         g.draw(&mut r1, &mut a1);
         g.draw(&mut r2, &mut a2);
@@ -536,14 +613,17 @@ fn noise_generator_sample_covariance_matches() {
     }
 }
 
+/// What: `BeamModel::new` rejects a negative drag, a mesh whose length differs from the
+/// filament's, and a NaN kT.
+/// Tolerance: exact (errors).
 #[test]
 fn invalid_inputs_are_errors() {
-    let mut p = params();
+    let mut p = filament::sample();
     p.drag = -1.0;
     assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
-    let p = params();
+    let p = filament::sample();
     assert!(BeamModel::new(p, Mesh::uniform(2.5, 4).unwrap()).is_err());
-    let mut p = params();
+    let mut p = filament::sample();
     p.kt = f64::NAN;
     assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
 }

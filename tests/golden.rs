@@ -12,16 +12,15 @@
 //! Tolerance: none beyond the printed precision; 10 significant digits are far above
 //! round-off differences between correct builds of the same code on x86-64.
 
+mod common;
+
+use common::manifest_dir;
+use common::seeds::GOLDEN_SEED;
 use langevin_fem::rng::{derive_seed, trajectory_rng};
 use langevin_fem::scene::Scene;
 use langevin_fem::scene::compression::{CompressionRun, CompressionTheoryTable};
 use langevin_fem::scene::linear::LinearRun;
 use std::fmt::Write;
-use std::path::Path;
-
-/// Seed of the golden traces (not the scenes' own seeds, so that editing a scene's seed
-/// does not move its snapshot).
-const GOLDEN_SEED: u64 = 0x0060_1DE2;
 
 fn g(v: f64) -> String {
     format!("{v:.9e}")
@@ -151,9 +150,14 @@ fn snapshot_of(scene: &Scene) -> String {
     s
 }
 
+/// What: the snapshot of every scene in `verification/` (see the file header) equals
+/// its reviewed copy `golden/<scene>.snap`.
+/// Reference: the snapshots themselves (a regression check, not a correctness check).
+/// Set-up: traces from [`GOLDEN_SEED`].
+/// Tolerance: exact text at 10 significant digits (see the file header).
 #[test]
 fn golden_scenes() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = manifest_dir();
     let scenes = Scene::discover(&dir.join("verification")).expect("scene directory");
     assert!(!scenes.is_empty(), "no scenes found");
     let mut settings = insta::Settings::clone_current();

@@ -1,28 +1,16 @@
 //! Integration tests of the report layer: atomic writers, CSV/JSON output, SVG figures and
 //! the HTML index.
 
+mod common;
+
+use common::TempDir;
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::path::Path;
 
 use langevin_fem::Error;
 use langevin_fem::output::{Figure, Series, write_atomic, write_csv, write_json};
 use langevin_fem::report::{render_index, write_index};
 use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
-
-/// A fresh directory under the system temp directory, unique per test, process and time.
-fn temp_dir(test: &str) -> PathBuf {
-    let nanos = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .expect("clock after 1970")
-        .as_nanos();
-    let dir = std::env::temp_dir().join(format!(
-        "langevin_fem_report_{test}_{}_{nanos}",
-        std::process::id()
-    ));
-    fs::create_dir_all(&dir).expect("create temp dir");
-    dir
-}
 
 fn file_names(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = fs::read_dir(dir)
@@ -60,11 +48,12 @@ fn svg_texts(svg: &str) -> Vec<String> {
     out
 }
 
-// write_atomic creates missing parent directories, replaces existing content and leaves no
-// temporary file behind; a failed write names the destination path.
+/// write_atomic creates missing parent directories, replaces existing content and leaves no
+/// temporary file behind; a failed write names the destination path.
 #[test]
 fn write_atomic_replaces_content_and_leaves_no_temp_files() {
-    let dir = temp_dir("atomic");
+    let tmp = TempDir::new("atomic");
+    let dir = tmp.path();
     let path = dir.join("nested").join("deeper").join("out.txt");
     write_atomic(&path, b"first version, longer than the second").expect("first write");
     assert_eq!(
@@ -85,14 +74,13 @@ fn write_atomic_replaces_content_and_leaves_no_temp_files() {
     assert!(matches!(err, Error::Io { .. }), "{err:?}");
     assert!(err.to_string().contains("out.txt"), "{err}");
     assert_eq!(file_names(path.parent().unwrap()), vec!["out.txt"]);
-
-    fs::remove_dir_all(&dir).ok();
 }
 
-// write_csv refuses a row whose length differs from the header (and writes nothing).
+/// write_csv refuses a row whose length differs from the header (and writes nothing).
 #[test]
 fn write_csv_rejects_ragged_rows() {
-    let dir = temp_dir("csv_ragged");
+    let tmp = TempDir::new("csv_ragged");
+    let dir = tmp.path();
     let path = dir.join("ragged.csv");
     let err = write_csv(&path, &["n", "variance"], &[vec![1.0, 0.5], vec![2.0]])
         .expect_err("ragged rows");
@@ -100,15 +88,15 @@ fn write_csv_rejects_ragged_rows() {
     let msg = err.to_string();
     assert!(msg.contains("row 1") && msg.contains("ragged.csv"), "{msg}");
     assert!(!path.exists());
-    assert!(file_names(&dir).is_empty());
-    fs::remove_dir_all(&dir).ok();
+    assert!(file_names(dir).is_empty());
 }
 
-// write_csv prints numbers with round-trip precision: every value, including extreme
-// magnitudes, subnormals, signed zero and non-finite values, parses back bit-identically.
+/// write_csv prints numbers with round-trip precision: every value, including extreme
+/// magnitudes, subnormals, signed zero and non-finite values, parses back bit-identically.
 #[test]
 fn write_csv_round_trips_numbers() {
-    let dir = temp_dir("csv_roundtrip");
+    let tmp = TempDir::new("csv_roundtrip");
+    let dir = tmp.path();
     let path = dir.join("t.csv");
     let values = [
         0.1,
@@ -148,15 +136,15 @@ fn write_csv_round_trips_numbers() {
     }
     assert!(text.contains(",nan\n"), "{text}");
     assert!(text.ends_with('\n'));
-    fs::remove_dir_all(&dir).ok();
 }
 
-// write_json writes exactly serde_json's pretty form plus a trailing newline, which
-// deserializes to the same structure. (Floats are compared only through the text: without
-// serde_json's `float_roundtrip` feature its parser may be off by one ulp.)
+/// write_json writes exactly serde_json's pretty form plus a trailing newline, which
+/// deserializes to the same structure. (Floats are compared only through the text: without
+/// serde_json's `float_roundtrip` feature its parser may be off by one ulp.)
 #[test]
 fn write_json_is_pretty_and_round_trips() {
-    let dir = temp_dir("json");
+    let tmp = TempDir::new("json");
+    let dir = tmp.path();
     let path = dir.join("summary.json");
     let summary = sample_summary();
     write_json(&path, &summary).expect("write json");
@@ -170,12 +158,11 @@ fn write_json_is_pretty_and_round_trips() {
         back.scenes[1].checks[0].name,
         summary.scenes[1].checks[0].name
     );
-    fs::remove_dir_all(&dir).ok();
 }
 
-// A figure with two series, error bars, a reference line and log axes renders an SVG whose
-// <text> elements contain the title, both axis labels and every legend label, and a
-// second render is byte-identical.
+/// A figure with two series, error bars, a reference line and log axes renders an SVG whose
+/// <text> elements contain the title, both axis labels and every legend label, and a
+/// second render is byte-identical.
 #[test]
 fn figure_with_errors_and_log_axes_renders_labels_deterministically() {
     let n: Vec<f64> = (1..=12).map(f64::from).collect();
@@ -221,12 +208,13 @@ fn figure_with_errors_and_log_axes_renders_labels_deterministically() {
     assert_eq!(svg, again, "rendering is not deterministic");
 }
 
-// Non-finite points, non-positive values on a log axis, mismatched data and a figure without
-// any drawable point: rendering does not fail (except for the mismatched error bars), and
-// the figure says what it left out.
+/// Non-finite points, non-positive values on a log axis, mismatched data and a figure without
+/// any drawable point: rendering does not fail (except for the mismatched error bars), and
+/// the figure says what it left out.
 #[test]
 fn figure_with_nan_and_nonpositive_on_log_axis_does_not_fail() {
-    let dir = temp_dir("figure_robust");
+    let tmp = TempDir::new("figure_robust");
+    let dir = tmp.path();
     let fig = Figure::new("robustness", "t", "C(t)")
         .log_y()
         .series(
@@ -280,7 +268,6 @@ fn figure_with_nan_and_nonpositive_on_log_axis_does_not_fail() {
         .series(Series::markers("s", vec![(1.0, 1.0), (2.0, 2.0)]).with_errors(vec![0.1]));
     let err = bad.render_svg().expect_err("error-bar count mismatch");
     assert!(matches!(err, Error::InvalidParameter { .. }), "{err:?}");
-    fs::remove_dir_all(&dir).ok();
 }
 
 fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
@@ -338,8 +325,8 @@ fn sample_summary() -> Summary {
     }
 }
 
-// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
-// check name stays text), marks the failing check, and write_index writes the same page.
+/// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
+/// check name stays text), marks the failing check, and write_index writes the same page.
 #[test]
 fn index_html_lists_figures_and_checks_and_escapes_text() {
     let summary = sample_summary();
@@ -379,9 +366,9 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
     // Self-contained: no scripts, no external resources.
     assert!(!html.contains("http://") && !html.contains("https://"));
 
-    let dir = temp_dir("index");
-    write_index(&dir, &summary).expect("write index");
+    let tmp = TempDir::new("index");
+    let dir = tmp.path();
+    write_index(dir, &summary).expect("write index");
     assert_eq!(fs::read_to_string(dir.join("index.html")).unwrap(), html);
-    assert_eq!(file_names(&dir), vec!["index.html"]);
-    fs::remove_dir_all(&dir).ok();
+    assert_eq!(file_names(dir), vec!["index.html"]);
 }

@@ -12,44 +12,33 @@
 //! (Bonferroni; the suite also passed for six other seed sets).
 //! Sample moments are computed inline (plain sums), not with `crate::stats`.
 
+mod common;
+
+use common::Z;
+use common::filament::spectral_sample;
+use common::seeds::{SEED_ENSEMBLE, SEED_EQUILIBRIUM, SEED_LARGE_STEP, SEED_REPRODUCIBLE};
 use langevin_fem::error::Error;
 use langevin_fem::params::FilamentParams;
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::spectral::{HingedBeam, MAX_MODES, ModalSimulator, inverse_fourth_power_tail};
 use std::f64::consts::PI;
 
-/// Number of standard errors allowed in every statistical check.
-const Z: f64 = 4.0;
-const SEED_EQUILIBRIUM: u64 = 0x5EC7_1001;
-const SEED_ENSEMBLE: u64 = 0x5EC7_1002;
-const SEED_LARGE_STEP: u64 = 0x5EC7_1003;
-const SEED_REPRODUCIBLE: u64 = 0x5EC7_1004;
-
-fn params() -> FilamentParams {
-    FilamentParams {
-        length: 2.5,
-        bending_rigidity: 0.7,
-        stretch_rigidity: 1.0e6,
-        drag: 3.0,
-        kt: 0.4,
-    }
-}
-
+/// The hinged beam of [`spectral_sample`] (L = 2.5, EI = 0.7, ξ = 3, kT = 0.4).
 fn beam() -> HingedBeam {
-    HingedBeam::new(params()).unwrap()
+    HingedBeam::new(spectral_sample()).unwrap()
 }
 
 /// Positions (as fractions of L) used for the deterministic checks; 0 and 1 are hinges.
 const FRACTIONS: [f64; 9] = [0.0, 0.05, 0.11, 0.3, 0.37, 0.5, 0.62, 0.9, 1.0];
 
-// What: the closed form ⟨w²(x)⟩ = kT x²(L−x)²/(3EI·L) against the mode sum
-// Σ_{n≤N} σₙ² sin²(nπx/L), for N = 1 … 100; plus the classical midspan value kT L³/(48EI).
-// Reference: equipartition mode sum (paper, after eq. 4) and the simply-supported-beam
-// midspan compliance L³/(48EI).
-// Tolerance: the reported rigorous tail bound (plus 10⁻¹⁴·scale for rounding) must cover
-// the actual error; and at generic x, for N ≥ 3, the bound must not be loose by more than
-// a factor 4 (it replaces sin² by 1, whose mean is ½, so the typical ratio is ≈ 2; it
-// reaches ≈ 3.7 when the first omitted modes sit near nodes, e.g. x = 0.11L, N = 7).
+/// What: the closed form ⟨w²(x)⟩ = kT x²(L−x)²/(3EI·L) against the mode sum
+/// Σ_{n≤N} σₙ² sin²(nπx/L), for N = 1 … 100; plus the classical midspan value kT L³/(48EI).
+/// Reference: equipartition mode sum (paper, after eq. 4) and the simply-supported-beam
+/// midspan compliance L³/(48EI).
+/// Tolerance: the reported rigorous tail bound (plus 10⁻¹⁴·scale for rounding) must cover
+/// the actual error; and at generic x, for N ≥ 3, the bound must not be loose by more than
+/// a factor 4 (it replaces sin² by 1, whose mean is ½, so the typical ratio is ≈ 2; it
+/// reaches ≈ 3.7 when the first omitted modes sit near nodes, e.g. x = 0.11L, N = 7).
 #[test]
 fn closed_form_profile_matches_mode_sum_within_reported_bound() {
     let b = beam();
@@ -84,12 +73,12 @@ fn closed_form_profile_matches_mode_sum_within_reported_bound() {
     assert_eq!(b.profile_variance(l), 0.0);
 }
 
-// What: the closed-form Green's function covariance kT·G(x,y) (both branches x ≤ y and
-// x > y) against the mode sum Σ σₙ² sin(nπx/L) sin(nπy/L) with 2000 modes; symmetry;
-// zeros at the hinges; and G(x,x) = profile variance.
-// Reference: the eigen-expansion of the hinged-beam Green's function.
-// Tolerance: the tail bound scale·Σ_{n>2000} n⁻⁴ ≈ 4·10⁻¹¹·scale plus 10⁻¹³·scale for
-// rounding of the 2000-term sum.
+/// What: the closed-form Green's function covariance kT·G(x,y) (both branches x ≤ y and
+/// x > y) against the mode sum Σ σₙ² sin(nπx/L) sin(nπy/L) with 2000 modes; symmetry;
+/// zeros at the hinges; and G(x,x) = profile variance.
+/// Reference: the eigen-expansion of the hinged-beam Green's function.
+/// Tolerance: the tail bound scale·Σ_{n>2000} n⁻⁴ ≈ 4·10⁻¹¹·scale plus 10⁻¹³·scale for
+/// rounding of the 2000-term sum.
 #[test]
 fn equilibrium_covariance_matches_series_and_is_symmetric_with_hinge_zeros() {
     let b = beam();
@@ -118,13 +107,13 @@ fn equilibrium_covariance_matches_series_and_is_symmetric_with_hinge_zeros() {
     }
 }
 
-// What: limits of eq. (4): (a) t = η → ∞ (t = 50τ₁) gives the equilibrium covariance;
-// (b) t = 0 gives exactly 0; (c) for η > t with t large (30τ₁) it tends to the stationary
-// two-time covariance Σ σₙ² e^{−λₙ(η−t)} sin sin (built from `mode_autocovariance`).
-// Reference: the closed-form Green's function, and a 2000-term stationary sum.
-// Tolerance: the reported truncation bound of `correlation` plus the tail of the 2000-term
-// reference plus 10⁻¹³·scale for rounding; the neglected e^{−λ₁(η+t)} ≤ e^{−60} is far
-// below that.
+/// What: limits of eq. (4): (a) t = η → ∞ (t = 50τ₁) gives the equilibrium covariance;
+/// (b) t = 0 gives exactly 0; (c) for η > t with t large (30τ₁) it tends to the stationary
+/// two-time covariance Σ σₙ² e^{−λₙ(η−t)} sin sin (built from `mode_autocovariance`).
+/// Reference: the closed-form Green's function, and a 2000-term stationary sum.
+/// Tolerance: the reported truncation bound of `correlation` plus the tail of the 2000-term
+/// reference plus 10⁻¹³·scale for rounding; the neglected e^{−λ₁(η+t)} ≤ e^{−60} is far
+/// below that.
 #[test]
 fn eq4_limits_equilibrium_rest_and_stationary_two_time() {
     let b = beam();
@@ -168,15 +157,15 @@ fn eq4_limits_equilibrium_rest_and_stationary_two_time() {
     }
 }
 
-// What: the truncation bound of eq. (4) is honest: the N-term sum differs from the
-// 10⁵-term sum by at most the reported bound, for N = 1 … 100 and several (x, y, t, η)
-// (including small t, where the bracket is far from 1, and η > t, where the bound uses
-// the exponential decay of the omitted modes); `correlation` meets its tolerance; with an
-// unreachable tolerance it stops at MAX_MODES and reports the bound it achieved; and in
-// the equilibrium regime (N ≥ 3) the bound is not loose by more than a factor 4 (as for
-// the profile variance).
-// Reference: `correlation_truncated` with 10⁵ modes (its own bound ≈ 3·10⁻¹⁶·scale).
-// Tolerance: bound_N + bound_ref + 10⁻¹³·scale (rounding).
+/// What: the truncation bound of eq. (4) is honest: the N-term sum differs from the
+/// 10⁵-term sum by at most the reported bound, for N = 1 … 100 and several (x, y, t, η)
+/// (including small t, where the bracket is far from 1, and η > t, where the bound uses
+/// the exponential decay of the omitted modes); `correlation` meets its tolerance; with an
+/// unreachable tolerance it stops at MAX_MODES and reports the bound it achieved; and in
+/// the equilibrium regime (N ≥ 3) the bound is not loose by more than a factor 4 (as for
+/// the profile variance).
+/// Reference: `correlation_truncated` with 10⁵ modes (its own bound ≈ 3·10⁻¹⁶·scale).
+/// Tolerance: bound_N + bound_ref + 10⁻¹³·scale (rounding).
 #[test]
 fn eq4_truncation_bound_is_honest() {
     let b = beam();
@@ -220,12 +209,12 @@ fn eq4_truncation_bound_is_honest() {
     assert!(capped.truncation_error <= 4e-16 * scale);
 }
 
-// What: the mode variances (equipartition) reproduce the closed-form profile variance,
-// and the Lorentzian one-sided density of each mode integrates to σₙ² over [0, ∞).
-// Reference: profile_variance; ∫₀^∞ 4σ²λ/(λ²+(2πf)²) df = σ².
-// Tolerance: the 3000-mode tail bound for the profile; for the integral, the midpoint rule
-// with 2·10⁵ nodes on the map f = (λ/2π)·s/(1−s), s ∈ [0, 1) (smooth integrand, error
-// O(h²) ≈ 10⁻¹¹), so 10⁻⁹ relative.
+/// What: the mode variances (equipartition) reproduce the closed-form profile variance,
+/// and the Lorentzian one-sided density of each mode integrates to σₙ² over [0, ∞).
+/// Reference: profile_variance; ∫₀^∞ 4σ²λ/(λ²+(2πf)²) df = σ².
+/// Tolerance: the 3000-mode tail bound for the profile; for the integral, the midpoint rule
+/// with 2·10⁵ nodes on the map f = (λ/2π)·s/(1−s), s ∈ [0, 1) (smooth integrand, error
+/// O(h²) ≈ 10⁻¹¹), so 10⁻⁹ relative.
 #[test]
 fn mode_variances_sum_to_profile_and_lorentzian_integrates_to_variance() {
     let b = beam();
@@ -259,17 +248,17 @@ fn mode_variances_sum_to_profile_and_lorentzian_integrates_to_variance() {
     }
 }
 
-// What: the sampled (AR(1)) spectrum (a) integrates to σₙ² over [0, 1/(2dt)], and (b)
-// equals the folded Lorentzian Σ_{|m|≤M} lorentzian(f + m/dt) up to the omitted images.
-// Reference: (a) the variance of the sampled sequence is σₙ²; (b) aliasing.
-// Tolerance: (a) the trapezoid rule on a smooth periodic (even) integrand converges
-// geometrically; 10⁵ intervals resolve the narrowest peak (width λdt/(2π) = 1.6·10⁻³ of a
-// period at λdt = 0.01) and give 10⁻¹⁰ relative. (b) Every image is positive, so the
-// partial sum is below the exact value, and the omitted images with |m| > M sum to at most
-// B = 2σ²λdt²/(π²M) (each ≤ 4σ²λdt²/(2π(|m|−½))², then Σ_{m>M}(m−½)⁻² ≤ 1/M); asserted:
-// 0.9·B ≤ exact − partial ≤ B with M = 500 (B is the exact tail up to O(1/M) and
-// O((λdt)²/M²), so this is sharp), within 10⁻¹² relative rounding, and B itself must be
-// at least 100 times that rounding allowance.
+/// What: the sampled (AR(1)) spectrum (a) integrates to σₙ² over [0, 1/(2dt)], and (b)
+/// equals the folded Lorentzian Σ_{|m|≤M} lorentzian(f + m/dt) up to the omitted images.
+/// Reference: (a) the variance of the sampled sequence is σₙ²; (b) aliasing.
+/// Tolerance: (a) the trapezoid rule on a smooth periodic (even) integrand converges
+/// geometrically; 10⁵ intervals resolve the narrowest peak (width λdt/(2π) = 1.6·10⁻³ of a
+/// period at λdt = 0.01) and give 10⁻¹⁰ relative. (b) Every image is positive, so the
+/// partial sum is below the exact value, and the omitted images with |m| > M sum to at most
+/// B = 2σ²λdt²/(π²M) (each ≤ 4σ²λdt²/(2π(|m|−½))², then Σ_{m>M}(m−½)⁻² ≤ 1/M); asserted:
+/// 0.9·B ≤ exact − partial ≤ B with M = 500 (B is the exact tail up to O(1/M) and
+/// O((λdt)²/M²), so this is sharp), within 10⁻¹² relative rounding, and B itself must be
+/// at least 100 times that rounding allowance.
 #[test]
 fn sampled_spectrum_integrates_to_variance_and_is_folded_lorentzian() {
     let b = beam();
@@ -323,13 +312,13 @@ fn sampled_spectrum_integrates_to_variance_and_is_folded_lorentzian() {
     }
 }
 
-// What: a long stationary run of the modal simulator (6 modes, Δt = 0.1τ₁, 2·10⁵ steps,
-// started from `set_equilibrium`): per-mode sample variance = σₙ², and lag-1 sample
-// autocorrelation = ρₙ = e^{−λₙΔt}.
-// Reference: stationary OU moments.
-// Tolerance: Z = 4 standard errors, with the exact large-sample SEs of a Gaussian AR(1)
-// with known mean 0: Var(Σa²/K) ≈ 2σ⁴(1+ρ²)/((1−ρ²)K), and (Bartlett)
-// Var(r₁) ≈ (1−ρ²)/K. For mode 1 (ρ = e^{−0.1}) the variance SE is ≈ 1 %.
+/// What: a long stationary run of the modal simulator (6 modes, Δt = 0.1τ₁, 2·10⁵ steps,
+/// started from `set_equilibrium`): per-mode sample variance = σₙ², and lag-1 sample
+/// autocorrelation = ρₙ = e^{−λₙΔt}.
+/// Reference: stationary OU moments.
+/// Tolerance: Z = 4 standard errors, with the exact large-sample SEs of a Gaussian AR(1)
+/// with known mean 0: Var(Σa²/K) ≈ 2σ⁴(1+ρ²)/((1−ρ²)K), and (Bartlett)
+/// Var(r₁) ≈ (1−ρ²)/K. For mode 1 (ρ = e^{−0.1}) the variance SE is ≈ 1 %.
 #[test]
 fn simulator_stationary_variance_and_lag1_correlation() {
     let b = beam();
@@ -371,15 +360,15 @@ fn simulator_stationary_variance_and_lag1_correlation() {
     }
 }
 
-// What: from rest, an ensemble of independent trajectories (trajectory_rng index i) of
-// the modal simulator (12 modes, Δt = 0.1τ₁) reproduces eq. (4) at several (x, y, t, η),
-// both equal-time and two-time.
-// Reference: eq. (4) truncated to the simulated 12 modes (`correlation_truncated`), which
-// is exact for the simulated process; its distance to the full eq. (4) is checked to be
-// within the reported bound (so the simulator also matches the full eq. (4) to within
-// that bound, ≈ 1.7·10⁻⁴·scale).
-// Tolerance: Z = 4 standard errors of the ensemble mean of w(x,t)w(y,η), the SE being
-// estimated from the ensemble (sample SD/√M, M = 40000; relative SE ≈ 1 %).
+/// What: from rest, an ensemble of independent trajectories (trajectory_rng index i) of
+/// the modal simulator (12 modes, Δt = 0.1τ₁) reproduces eq. (4) at several (x, y, t, η),
+/// both equal-time and two-time.
+/// Reference: eq. (4) truncated to the simulated 12 modes (`correlation_truncated`), which
+/// is exact for the simulated process; its distance to the full eq. (4) is checked to be
+/// within the reported bound (so the simulator also matches the full eq. (4) to within
+/// that bound, ≈ 1.7·10⁻⁴·scale).
+/// Tolerance: Z = 4 standard errors of the ensemble mean of w(x,t)w(y,η), the SE being
+/// estimated from the ensemble (sample SD/√M, M = 40000; relative SE ≈ 1 %).
 #[test]
 fn simulator_ensemble_from_rest_matches_eq4() {
     let b = beam();
@@ -437,12 +426,12 @@ fn simulator_ensemble_from_rest_matches_eq4() {
     }
 }
 
-// What: the OU update is exact for any Δt: one step from rest gives per-mode variance
-// σₙ²(1 − e^{−2λₙΔt}), for Δt = 0.05τ₁ (mode 1 at 9.5 % of σ₁²) and Δt = 10τ₁ (where an
-// Euler–Maruyama step would give 2λ₁Δt·σ₁² = 20σ₁²).
-// Reference: the OU transition law.
-// Tolerance: Z = 4 standard errors of a Gaussian sample variance with known mean 0,
-// SE = v·√(2/M), M = 20000 independent trajectories.
+/// What: the OU update is exact for any Δt: one step from rest gives per-mode variance
+/// σₙ²(1 − e^{−2λₙΔt}), for Δt = 0.05τ₁ (mode 1 at 9.5 % of σ₁²) and Δt = 10τ₁ (where an
+/// Euler–Maruyama step would give 2λ₁Δt·σ₁² = 20σ₁²).
+/// Reference: the OU transition law.
+/// Tolerance: Z = 4 standard errors of a Gaussian sample variance with known mean 0,
+/// SE = v·√(2/M), M = 20000 independent trajectories.
 #[test]
 fn simulator_is_exact_for_large_time_steps() {
     let b = beam();
@@ -475,8 +464,8 @@ fn simulator_is_exact_for_large_time_steps() {
     }
 }
 
-// What: the same seed gives a bit-identical trajectory; a different trajectory index gives
-// a different one. Reference: determinism contract (fixed draw order, PCG-64).
+/// What: the same seed gives a bit-identical trajectory; a different trajectory index gives
+/// a different one. Reference: determinism contract (fixed draw order, PCG-64).
 #[test]
 fn same_seed_gives_bit_identical_amplitudes() {
     let b = beam();
@@ -493,9 +482,9 @@ fn same_seed_gives_bit_identical_amplitudes() {
     assert_ne!(run(3), run(4));
 }
 
-// What: invalid inputs return Error::InvalidParameter (never panic): non-positive, NaN or
-// infinite parameters; x or y outside [0, L]; t < 0; t > η; non-finite times; bad
-// tolerance; too many modes.
+/// What: invalid inputs return Error::InvalidParameter (never panic): non-positive, NaN or
+/// infinite parameters; x or y outside [0, L]; t < 0; t > η; non-finite times; bad
+/// tolerance; too many modes.
 #[test]
 fn invalid_inputs_are_errors() {
     let bad_values = [-1.0, 0.0, f64::NAN, f64::INFINITY];
@@ -509,7 +498,7 @@ fn invalid_inputs_are_errors() {
     ];
     for (name, set) in setters {
         for &v in &bad_values {
-            let mut p = params();
+            let mut p = spectral_sample();
             set(&mut p, v);
             match HingedBeam::new(p) {
                 Err(Error::InvalidParameter { name: got, .. }) => assert_eq!(got, name),

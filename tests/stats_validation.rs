@@ -19,6 +19,12 @@
 //! ≈ 5e-4 per check for a correct implementation, and each outcome is fixed by the
 //! seeds). Other tolerances are stated at each test.
 
+mod common;
+
+use common::seeds::{
+    SEED_AR1_MOMENTS, SEED_AR1_TAU, SEED_BLOCKING, SEED_DECAY, SEED_DECAY_POWER, SEED_HOLM,
+    SEED_IID_MEAN, SEED_NULL, SEED_POWER, SEED_WELCH,
+};
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::stats::{
     TestOutcome, blocking_std_error, chi2_gof_normal, chi2_sum_test, chi2_variance_test,
@@ -30,17 +36,6 @@ use rand_distr::StandardNormal;
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal, Uniform};
 use statrs::stats_tests::NaNPolicy;
 use statrs::stats_tests::ks_test::{KSOneSampleAlternativeMethod, ks_onesample};
-
-const SEED_IID_MEAN: u64 = 0x11D_0001;
-const SEED_AR1_TAU: u64 = 0xA41_0002;
-const SEED_AR1_MOMENTS: u64 = 0xA41_0003;
-const SEED_BLOCKING: u64 = 0xB10C_0004;
-const SEED_DECAY: u64 = 0xDECA_0005;
-const SEED_NULL: u64 = 0x0_0006;
-const SEED_POWER: u64 = 0x90E_0007;
-const SEED_DECAY_POWER: u64 = 0x90E_0008;
-const SEED_HOLM: u64 = 0x4013_0009;
-const SEED_WELCH: u64 = 0x3E1C_000A;
 
 /// Half-width of the binomial acceptance band in standard deviations.
 const BAND_SIGMAS: f64 = 3.5;

@@ -320,13 +320,41 @@ impl Figure {
         })
     }
 
-    fn draw(
-        &self,
-        root: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-        prep: &Prepared,
-    ) -> std::result::Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    fn draw(&self, root: &Root<'_>, prep: &Prepared) -> DrawResult<()> {
         root.fill(&WHITE)?;
+        let mut chart = self.chart_with_mesh(root, prep)?;
+        // Reference lines first, so that data are drawn over them.
+        draw_hlines(&mut chart, prep)?;
+        for (i, (s, p)) in self.series.iter().zip(&prep.series).enumerate() {
+            draw_data_series(&mut chart, prep, s, p, series_color(i))?;
+        }
+        let n_legend = self.legend_entries(&mut chart, prep)?;
+        if !prep.has_data {
+            draw_no_data_note(root, &chart)?;
+        }
+        if n_legend > 0 {
+            self.draw_legend(&mut chart, prep)?;
+        }
+        if let Some(note) = prep.skipped_note(self.x_log || self.y_log) {
+            root.draw(&Text::new(
+                note,
+                (8, HEIGHT as i32 - 6),
+                (FONT, 14)
+                    .into_font()
+                    .color(&RGBColor(110, 110, 110))
+                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
+            ))?;
+        }
+        Ok(())
+    }
 
+    /// The chart (caption, label areas, axes in plot space) with its grid, ticks and axis
+    /// labels drawn.
+    fn chart_with_mesh<'a, 'b>(
+        &self,
+        root: &'a Root<'b>,
+        prep: &Prepared,
+    ) -> DrawResult<Chart<'a, 'b>> {
         let mut builder = ChartBuilder::on(root);
         builder
             .margin(14)
@@ -353,69 +381,16 @@ impl Figure {
             .light_line_style(RGBColor(238, 238, 238).stroke_width(1))
             .axis_style(BLACK.stroke_width(1))
             .draw()?;
+        Ok(chart)
+    }
 
-        // Reference lines first, so that data are drawn over them.
-        for (k, y, _) in &prep.hlines {
-            let color = HLINE_COLORS[k % HLINE_COLORS.len()];
-            chart.draw_series(DashedLineSeries::new(
-                vec![(prep.x.lo, *y), (prep.x.hi, *y)],
-                9,
-                6,
-                color.stroke_width(2),
-            ))?;
-        }
-
-        for (i, (s, p)) in self.series.iter().zip(&prep.series).enumerate() {
-            let color = series_color(i);
-            let bar_style = color.stroke_width(1);
-            for bar in &p.bars {
-                let hi = bar.hi.unwrap_or(prep.y.hi);
-                let lo = bar.lo.unwrap_or(prep.y.lo);
-                chart.draw_series(std::iter::once(PathElement::new(
-                    vec![(bar.x, lo), (bar.x, hi)],
-                    bar_style,
-                )))?;
-                let caps = [bar.hi, bar.lo];
-                chart.draw_series(caps.iter().flatten().map(|&y| {
-                    EmptyElement::at((bar.x, y))
-                        + PathElement::new(vec![(-CAP, 0), (CAP, 0)], bar_style)
-                }))?;
-            }
-
-            let line_style = color.stroke_width(2);
-            let draws_line = matches!(
-                s.style,
-                SeriesStyle::Line | SeriesStyle::Dashed | SeriesStyle::LineMarkers
-            );
-            let mut marker_points: Vec<(f64, f64)> = Vec::new();
-            if draws_line {
-                for run in &p.runs {
-                    if run.len() == 1 {
-                        // An isolated point would be invisible as a line.
-                        marker_points.push(run[0]);
-                    } else if s.style == SeriesStyle::Dashed {
-                        chart.draw_series(DashedLineSeries::new(
-                            run.iter().copied(),
-                            9,
-                            6,
-                            line_style,
-                        ))?;
-                    } else {
-                        chart.draw_series(LineSeries::new(run.iter().copied(), line_style))?;
-                    }
-                }
-            }
-            if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
-                marker_points.clone_from(&p.points);
-            }
-            chart.draw_series(
-                marker_points
-                    .iter()
-                    .map(|&pt| Circle::new(pt, MARKER_RADIUS, color.filled())),
-            )?;
-        }
-
-        // Legend entries: empty series that only carry a label and a glyph.
+    /// Legend entries: empty series that only carry a label and a glyph, for every
+    /// labelled series and then every labelled reference line; returns their number.
+    fn legend_entries<'a, 'b: 'a>(
+        &self,
+        chart: &mut Chart<'a, 'b>,
+        prep: &Prepared,
+    ) -> DrawResult<usize> {
         let mut n_legend = 0usize;
         for (i, s) in self.series.iter().enumerate() {
             if s.label.is_empty() {
@@ -438,50 +413,129 @@ impl Figure {
             )
             .attach(anno, label);
         }
+        Ok(n_legend)
+    }
 
-        if !prep.has_data {
-            let (xr, yr) = chart.plotting_area().get_pixel_range();
-            let centre = ((xr.start + xr.end) / 2, (yr.start + yr.end) / 2);
-            root.draw(&Text::new(
-                "no finite data to plot",
-                centre,
-                (FONT, 20)
-                    .into_font()
-                    .color(&RGBColor(120, 120, 120))
-                    .pos(Pos::new(HPos::Center, VPos::Center)),
-            ))?;
-        }
-
-        if n_legend > 0 {
-            let labels: Vec<&str> = self
-                .series
-                .iter()
-                .map(|s| s.label.as_str())
-                .chain(prep.hlines.iter().map(|(_, _, l)| l.as_str()))
-                .filter(|l| !l.is_empty())
-                .collect();
-            let position = legend_position(&chart, prep, &labels);
-            chart
-                .configure_series_labels()
-                .position(position)
-                .label_font((FONT, LEGEND_FONT))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(150, 150, 150))
-                .draw()?;
-        }
-
-        if let Some(note) = prep.skipped_note(self.x_log || self.y_log) {
-            root.draw(&Text::new(
-                note,
-                (8, HEIGHT as i32 - 6),
-                (FONT, 14)
-                    .into_font()
-                    .color(&RGBColor(110, 110, 110))
-                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
-            ))?;
-        }
+    /// The legend box, in the corner chosen by [`legend_position`].
+    fn draw_legend<'a, 'b: 'a>(
+        &self,
+        chart: &mut Chart<'a, 'b>,
+        prep: &Prepared,
+    ) -> DrawResult<()> {
+        let labels: Vec<&str> = self
+            .series
+            .iter()
+            .map(|s| s.label.as_str())
+            .chain(prep.hlines.iter().map(|(_, _, l)| l.as_str()))
+            .filter(|l| !l.is_empty())
+            .collect();
+        let position = legend_position(chart, prep, &labels);
+        chart
+            .configure_series_labels()
+            .position(position)
+            .label_font((FONT, LEGEND_FONT))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(150, 150, 150))
+            .draw()?;
         Ok(())
     }
+}
+
+/// The drawing area of a figure.
+type Root<'b> = DrawingArea<SVGBackend<'b>, plotters::coord::Shift>;
+/// The result of a plotters drawing call on the SVG backend.
+type DrawResult<T> = std::result::Result<T, DrawingAreaErrorKind<std::io::Error>>;
+
+/// The horizontal reference lines, dashed across the whole x range.
+fn draw_hlines<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, prep: &Prepared) -> DrawResult<()> {
+    for (k, y, _) in &prep.hlines {
+        let color = HLINE_COLORS[k % HLINE_COLORS.len()];
+        chart.draw_series(DashedLineSeries::new(
+            vec![(prep.x.lo, *y), (prep.x.hi, *y)],
+            9,
+            6,
+            color.stroke_width(2),
+        ))?;
+    }
+    Ok(())
+}
+
+/// One series: its error bars, then its line runs, then its markers (and isolated
+/// points of a line, which would be invisible as a line).
+fn draw_data_series<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    prep: &Prepared,
+    s: &Series,
+    p: &PreparedSeries,
+    color: RGBColor,
+) -> DrawResult<()> {
+    draw_error_bars(chart, prep, &p.bars, color)?;
+    let line_style = color.stroke_width(2);
+    let draws_line = matches!(
+        s.style,
+        SeriesStyle::Line | SeriesStyle::Dashed | SeriesStyle::LineMarkers
+    );
+    let mut marker_points: Vec<(f64, f64)> = Vec::new();
+    if draws_line {
+        for run in &p.runs {
+            if run.len() == 1 {
+                // An isolated point would be invisible as a line.
+                marker_points.push(run[0]);
+            } else if s.style == SeriesStyle::Dashed {
+                chart.draw_series(DashedLineSeries::new(run.iter().copied(), 9, 6, line_style))?;
+            } else {
+                chart.draw_series(LineSeries::new(run.iter().copied(), line_style))?;
+            }
+        }
+    }
+    if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
+        marker_points.clone_from(&p.points);
+    }
+    chart.draw_series(
+        marker_points
+            .iter()
+            .map(|&pt| Circle::new(pt, MARKER_RADIUS, color.filled())),
+    )?;
+    Ok(())
+}
+
+/// Vertical error bars with caps at the drawable ends; an end that cannot be drawn
+/// extends to the axis border.
+fn draw_error_bars<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    prep: &Prepared,
+    bars: &[Bar],
+    color: RGBColor,
+) -> DrawResult<()> {
+    let bar_style = color.stroke_width(1);
+    for bar in bars {
+        let hi = bar.hi.unwrap_or(prep.y.hi);
+        let lo = bar.lo.unwrap_or(prep.y.lo);
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(bar.x, lo), (bar.x, hi)],
+            bar_style,
+        )))?;
+        let caps = [bar.hi, bar.lo];
+        chart.draw_series(caps.iter().flatten().map(|&y| {
+            EmptyElement::at((bar.x, y)) + PathElement::new(vec![(-CAP, 0), (CAP, 0)], bar_style)
+        }))?;
+    }
+    Ok(())
+}
+
+/// "no finite data to plot", centred in the plot area.
+fn draw_no_data_note(root: &Root<'_>, chart: &Chart<'_, '_>) -> DrawResult<()> {
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let centre = ((xr.start + xr.end) / 2, (yr.start + yr.end) / 2);
+    root.draw(&Text::new(
+        "no finite data to plot",
+        centre,
+        (FONT, 20)
+            .into_font()
+            .color(&RGBColor(120, 120, 120))
+            .pos(Pos::new(HPos::Center, VPos::Center)),
+    ))?;
+    Ok(())
 }
 
 fn to_axis(v: f64, log: bool) -> Option<f64> {

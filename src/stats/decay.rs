@@ -163,6 +163,25 @@ pub fn decay_rate(
     known_mean: Option<f64>,
     confidence: f64,
 ) -> Result<RateEstimate> {
+    validate_input(series, dt, known_mean, confidence)?;
+    let n_total: usize = series.iter().map(|s| s.len()).sum();
+    let shift = match known_mean {
+        Some(mu) => mu,
+        None => series.iter().flat_map(|s| s.iter()).sum::<f64>() / n_total as f64,
+    };
+    let known = known_mean.is_some();
+    let k = choose_lag(series, n_total, shift, known)?;
+    let blocks = jackknife_blocks(series, n_total, k, shift)?;
+    jackknife_estimate(&blocks, k, dt, known, confidence)
+}
+
+/// The argument checks of [`decay_rate`] (its `Error::InvalidParameter` cases).
+fn validate_input(
+    series: &[&[f64]],
+    dt: f64,
+    known_mean: Option<f64>,
+    confidence: f64,
+) -> Result<()> {
     if series.is_empty() {
         return Err(Error::invalid("series", "no series", "at least one series"));
     }
@@ -178,22 +197,17 @@ pub fn decay_rate(
     {
         return Err(Error::invalid("known_mean", mu, "finite"));
     }
+    Ok(())
+}
 
-    let n_total: usize = series.iter().map(|s| s.len()).sum();
-    let shift = match known_mean {
-        Some(mu) => mu,
-        None => series.iter().flat_map(|s| s.iter()).sum::<f64>() / n_total as f64,
-    };
-    let known = known_mean.is_some();
-    let pooled = |k: usize| {
-        series
-            .iter()
-            .map(|s| Sums::of(s, 0, s.len(), k, shift))
-            .fold(Sums::default(), Sums::add)
-    };
-
-    // Pilot lag-1 correlation and the lag where ρ ≈ e^{-1}.
-    let rho1 = pooled(1).rho(known);
+/// The lag k = max(1, round(1/(λ̂₁ dt))) where ρ ≈ e^{−1}, from the pooled pilot ρ̂(1);
+/// an error if ρ̂(1) is not in (0, 1) or fewer than half the samples start a lag-k pair.
+fn choose_lag(series: &[&[f64]], n_total: usize, shift: f64, known: bool) -> Result<usize> {
+    let rho1 = series
+        .iter()
+        .map(|s| Sums::of(s, 0, s.len(), 1, shift))
+        .fold(Sums::default(), Sums::add)
+        .rho(known);
     if !(rho1.is_finite() && rho1 > 0.0 && rho1 < 1.0) {
         return Err(numerical(format!(
             "pilot lag-1 autocorrelation {rho1} is not in (0, 1): the series does not decay \
@@ -215,8 +229,13 @@ pub fn decay_rate(
     if 2 * n_pairs < n_total {
         return Err(too_short());
     }
+    Ok(k)
+}
 
-    // Blocks.
+/// The jackknife blocks' sums: groups of whole series when there are at least
+/// [`WHOLE_SERIES_BLOCKS`] series, else contiguous segments of each series (see the
+/// module documentation); an error if fewer than [`MIN_JACKKNIFE_BLOCKS`] result.
+fn jackknife_blocks(series: &[&[f64]], n_total: usize, k: usize, shift: f64) -> Result<Vec<Sums>> {
     let mut blocks: Vec<Sums> = Vec::new();
     let m = series.len();
     if m >= WHOLE_SERIES_BLOCKS {
@@ -245,13 +264,25 @@ pub fn decay_rate(
             }
         }
     }
-    let n_blocks = blocks.len();
-    if n_blocks < MIN_JACKKNIFE_BLOCKS {
+    if blocks.len() < MIN_JACKKNIFE_BLOCKS {
         return Err(numerical(format!(
-            "only {n_blocks} jackknife blocks (need {MIN_JACKKNIFE_BLOCKS})"
+            "only {} jackknife blocks (need {MIN_JACKKNIFE_BLOCKS})",
+            blocks.len()
         )));
     }
+    Ok(blocks)
+}
 
+/// λ̂ from the pooled `blocks` at lag `k`, its delete-one-block jackknife standard error
+/// and the t confidence interval at level `confidence`.
+fn jackknife_estimate(
+    blocks: &[Sums],
+    k: usize,
+    dt: f64,
+    known: bool,
+    confidence: f64,
+) -> Result<RateEstimate> {
+    let n_blocks = blocks.len();
     let kdt = k as f64 * dt;
     let rate_of = |s: &Sums| -> Result<f64> {
         let r = s.rho(known);

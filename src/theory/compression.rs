@@ -1039,6 +1039,48 @@ impl CompressionTheory {
         let (s, mo) = self.evaluate(strain)?;
         let mean = self.mean_from(&s, &mo);
         let std_dev = self.variance_from(&mo).sqrt();
+        let (x0, period) = self.fourier_window(&s, &mo);
+        let du = 2.0 * PI / period;
+        let rho_exp = self.options.decay_exponent + RANGE_MARGIN;
+        let rho = (4.0 * self.a * rho_exp).sqrt();
+        let (k_cap, rigorous_bound) = self.fourier_cap(&s, &mo, du, rho, rho_exp);
+        let mut sums = KernelSums {
+            contour: self.contour(&s, k_cap as f64 * du + rho),
+            h: s.h,
+            rho,
+            inv4a: 0.25 / self.a,
+            vals: Vec::new(),
+        };
+        let norm = sums.at(0.0).re;
+        if !(norm.is_finite() && norm > 0.0) {
+            return Err(numerical(
+                "compression force distribution",
+                format!("non-positive normalization {norm:e} at strain {strain:e}"),
+            ));
+        }
+        let (coeffs, truncation_bound) =
+            fourier_coefficients(&mut sums, norm, du, k_cap, rigorous_bound);
+        let mut dist = ForceDistribution {
+            strain,
+            ea: self.params.stretch_rigidity,
+            mean_field_force: self.force_unit * s.eta,
+            x0,
+            period,
+            du,
+            coeffs,
+            c0: 0.0,
+            mean,
+            std_dev,
+            truncation_bound,
+        };
+        dist.c0 = dist.series_im(x0);
+        Ok(dist)
+    }
+
+    /// The window `(x0, period)` of the Fourier series in X = s − m: the support where the
+    /// tilted density exceeds e^{−level} (Chernoff bounds, capped by the Gaussian factor),
+    /// widened by 2 % on each side.
+    fn fourier_window(&self, s: &Setup, mo: &Moments) -> (f64, f64) {
         let a = self.a;
         // Z = E_q[e^{−A(s−m)²}] = √(π/A)/(2π) · h · s0
         let z = (PI / a).sqrt() / (2.0 * PI) * s.h * mo.s0;
@@ -1050,9 +1092,21 @@ impl CompressionTheory {
         let width = (hi - lo).max(1e-300);
         let x0 = lo - 0.02 * width;
         let period = 1.04 * width;
-        let du = 2.0 * PI / period;
-        let rho_exp = self.options.decay_exponent + RANGE_MARGIN;
-        let rho = (4.0 * a * rho_exp).sqrt();
+        (x0, period)
+    }
+
+    /// The rigorous cap K on the number of Fourier terms and the bound on the CDF error at
+    /// that cap: the smallest K with bound(KΔ) ≤ [`CDF_TOLERANCE`], at most
+    /// [`MAX_FOURIER_TERMS`].
+    fn fourier_cap(
+        &self,
+        s: &Setup,
+        mo: &Moments,
+        du: f64,
+        rho: f64,
+        rho_exp: f64,
+    ) -> (usize, f64) {
+        let a = self.a;
         let kernel_mass = (4.0 * PI * a).sqrt() / s.h + 1.0;
         let bound = |u: f64| {
             (self.abs_phi(s.eta, (u - rho).max(0.0)) * kernel_mass
@@ -1075,70 +1129,70 @@ impl CompressionTheory {
             }
         }
         let k_cap = k_hi;
-        let rigorous_bound = bound(k_cap as f64 * du);
-        let c = self.contour(&s, k_cap as f64 * du + rho);
-        let inv4a = 0.25 / a;
-        // φ_η(τ_j) e^{−iτ_j m} at τ_j = j h, j ≥ 0, extended on demand
-        let mut vals: Vec<Complex<f64>> = Vec::new();
-        let mut kernel_sum = |u: f64| -> Complex<f64> {
-            let jlo = ((u - rho) / s.h).ceil() as i64;
-            let jhi = ((u + rho) / s.h).floor() as i64;
-            while (vals.len() as i64) <= jhi.max(-jlo) {
-                let tau = vals.len() as f64 * s.h;
-                vals.push(c.shifted(tau));
-            }
-            let mut acc = Complex::new(0.0, 0.0);
-            for j in jlo..=jhi {
-                let v = if j >= 0 {
-                    vals[j as usize]
-                } else {
-                    vals[(-j) as usize].conj()
-                };
-                let d = j as f64 * s.h - u;
-                acc += v * (-d * d * inv4a).exp();
-            }
-            acc
-        };
-        let norm = kernel_sum(0.0).re;
-        if !(norm.is_finite() && norm > 0.0) {
-            return Err(numerical(
-                "compression force distribution",
-                format!("non-positive normalization {norm:e} at strain {strain:e}"),
-            ));
-        }
-        // Terms k = 1..K; stop at K = 2^j ≥ 16 once every |χ(kΔ)|, K/2 < k ≤ K, is below
-        // the tolerance (observed decay), or at the rigorous cap.
-        let mut coeffs: Vec<Complex<f64>> = Vec::new();
-        let mut block_max = 0.0_f64;
-        let mut truncation_bound = rigorous_bound;
-        for k in 1..=k_cap {
-            let chi = kernel_sum(k as f64 * du) / norm;
-            block_max = block_max.max(chi.norm());
-            coeffs.push(chi / k as f64);
-            if k.is_power_of_two() {
-                if k >= 16 && block_max < CDF_TOLERANCE {
-                    truncation_bound = block_max;
-                    break;
-                }
-                block_max = 0.0;
-            }
-        }
-        let mut dist = ForceDistribution {
-            strain,
-            ea: self.params.stretch_rigidity,
-            mean_field_force: self.force_unit * s.eta,
-            x0,
-            period,
-            du,
-            coeffs,
-            c0: 0.0,
-            mean,
-            std_dev,
-            truncation_bound,
-        };
-        dist.c0 = dist.series_im(x0);
-        Ok(dist)
+        (k_cap, bound(k_cap as f64 * du))
     }
+}
+
+/// Gaussian-kernel sums Σ_j φ_η(τ_j) e^{−iτ_j m} e^{−(τ_j − u)²/(4A)} over the nodes
+/// τ_j = j h within `rho` of u, with φ_η(τ_j) e^{−iτ_j m} for j ≥ 0 computed on demand and
+/// kept (negative j by conjugation).
+struct KernelSums {
+    contour: Contour,
+    h: f64,
+    rho: f64,
+    inv4a: f64,
+    vals: Vec<Complex<f64>>,
+}
+
+impl KernelSums {
+    fn at(&mut self, u: f64) -> Complex<f64> {
+        let jlo = ((u - self.rho) / self.h).ceil() as i64;
+        let jhi = ((u + self.rho) / self.h).floor() as i64;
+        while (self.vals.len() as i64) <= jhi.max(-jlo) {
+            let tau = self.vals.len() as f64 * self.h;
+            self.vals.push(self.contour.shifted(tau));
+        }
+        let mut acc = Complex::new(0.0, 0.0);
+        for j in jlo..=jhi {
+            let v = if j >= 0 {
+                self.vals[j as usize]
+            } else {
+                self.vals[(-j) as usize].conj()
+            };
+            let d = j as f64 * self.h - u;
+            acc += v * (-d * d * self.inv4a).exp();
+        }
+        acc
+    }
+}
+
+/// The coefficients χ(kΔ)/k, k = 1..K, of the force distribution's series and its
+/// truncation bound. Terms k = 1..K; stop at K = 2^j ≥ 16 once every |χ(kΔ)|,
+/// K/2 < k ≤ K, is below the tolerance (observed decay; the bound is then that maximum),
+/// or at the rigorous cap `k_cap` (bound `rigorous_bound`).
+fn fourier_coefficients(
+    sums: &mut KernelSums,
+    norm: f64,
+    du: f64,
+    k_cap: usize,
+    rigorous_bound: f64,
+) -> (Vec<Complex<f64>>, f64) {
+    let mut coeffs: Vec<Complex<f64>> = Vec::new();
+    let mut block_max = 0.0_f64;
+    let mut truncation_bound = rigorous_bound;
+    for k in 1..=k_cap {
+        let chi = sums.at(k as f64 * du) / norm;
+        block_max = block_max.max(chi.norm());
+        coeffs.push(chi / k as f64);
+        if k.is_power_of_two() {
+            if k >= 16 && block_max < CDF_TOLERANCE {
+                truncation_bound = block_max;
+                break;
+            }
+            block_max = 0.0;
+        }
+    }
+    (coeffs, truncation_bound)
 }
 
 /// The exact equilibrium distribution of the compressive force `F = EA(ε − s)` at one
