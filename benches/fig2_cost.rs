@@ -12,7 +12,7 @@
 //!
 //! Run: `cargo bench --bench fig2_cost`.
 
-use langevin_fem::dynamics::IntegratorKind;
+use langevin_fem::dynamics::{Driver, IntegratorKind, NonlinearState, Observer};
 use langevin_fem::fem::beam::BeamModel;
 use langevin_fem::fem::mesh::Mesh;
 use langevin_fem::fem::noise::NoiseModel;
@@ -22,23 +22,53 @@ use langevin_fem::scene::Scene;
 use langevin_fem::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::CompressedFilament};
 use std::hint::black_box;
 use std::path::Path;
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+/// Starts a clock at the end of the warm-up and reads it at the end of the run.
+struct Timer {
+    warm_up: u64,
+    start: Option<Instant>,
+    elapsed: Duration,
+}
+
+impl<S> Observer<S> for Timer {
+    fn on_start(&mut self, _: usize, _: &S) {
+        if self.warm_up == 0 {
+            self.start = Some(Instant::now());
+        }
+    }
+    fn on_step(&mut self, _: usize, step: u64, _: &S) {
+        if step == self.warm_up {
+            self.start = Some(Instant::now());
+        }
+    }
+    fn on_finish(&mut self, _: usize, system: &S) {
+        black_box(system);
+        self.elapsed = self.start.map(|t| t.elapsed()).unwrap_or_default();
+    }
+}
 
 fn ns_per_step(model: &CompressedFilament, kind: IntegratorKind, dt: f64, steps: u64) -> f64 {
-    let mut integ =
+    let integrator =
         NonlinearIntegrator::new(model, kind, NoiseModel::Consistent, dt).expect("integrator");
-    let mut w = vec![vec![0.0; model.beam().n_dofs()]; model.components()];
+    let mut state = NonlinearState {
+        integrator,
+        w: vec![vec![0.0; model.beam().n_dofs()]; model.components()],
+    };
     let mut rng = trajectory_rng(1, 0);
-    // Warm up into the fluctuating state, then time.
-    for _ in 0..steps / 4 {
-        integ.step(model, &mut w, &mut rng);
-    }
-    let t = Instant::now();
-    for _ in 0..steps {
-        integ.step(model, &mut w, &mut rng);
-    }
-    black_box(&w);
-    t.elapsed().as_nanos() as f64 / steps as f64
+    // Warm up into the fluctuating state, then time (the driver's finiteness check
+    // included, as in a real trajectory).
+    let mut timer = Timer {
+        warm_up: steps / 4,
+        start: None,
+        elapsed: Duration::ZERO,
+    };
+    Driver::new(dt, steps / 4, steps, steps)
+        .run(0, &mut state, &mut rng, &mut timer, |_| {
+            format!("{kind} diverged")
+        })
+        .expect("finite trajectory");
+    timer.elapsed.as_nanos() as f64 / steps as f64
 }
 
 fn main() {

@@ -27,7 +27,9 @@
 //! `exact-modal` cases run last, so an abandoned setup never competes with a measurement.
 
 use langevin_fem::FilamentParams;
-use langevin_fem::dynamics::{Integrator, IntegratorKind, build_integrator};
+use langevin_fem::dynamics::{
+    Components, Integrator, IntegratorKind, Trajectory, build_integrator,
+};
 use langevin_fem::fem::modal::{GeneralizedModes, generalized_modes};
 use langevin_fem::fem::{BeamModel, Mesh, NoiseGenerator, NoiseModel};
 use langevin_fem::rng::{TrajectoryRng, trajectory_rng};
@@ -51,8 +53,7 @@ const NOISES: [NoiseModel; 2] = [NoiseModel::Consistent, NoiseModel::ElementUnif
 /// Something to time: one integrator step, or one step's worth of standard normals.
 enum Work {
     Step {
-        integ: Box<dyn Integrator>,
-        state: Vec<f64>,
+        filament: Components<Box<dyn Integrator>>,
         rng: TrajectoryRng,
     },
     Normals {
@@ -64,8 +65,7 @@ enum Work {
 impl Work {
     fn step(integ: Box<dyn Integrator>, n_dofs: usize, stream: u64) -> Self {
         Work::Step {
-            integ,
-            state: vec![0.0; n_dofs],
+            filament: Components::at_rest(integ, 1, n_dofs),
             rng: trajectory_rng(SEED, stream),
         }
     }
@@ -81,9 +81,9 @@ impl Work {
     fn run(&mut self, iters: u64) -> Duration {
         let t = Instant::now();
         match self {
-            Work::Step { integ, state, rng } => {
+            Work::Step { filament, rng } => {
                 for _ in 0..iters {
-                    integ.step(black_box(state.as_mut_slice()), rng);
+                    black_box(&mut *filament).step(rng);
                 }
             }
             Work::Normals { buf, rng } => {
@@ -119,7 +119,7 @@ impl Work {
 
     fn state_is_finite(&self) -> bool {
         match self {
-            Work::Step { state, .. } => state.iter().all(|v| v.is_finite()),
+            Work::Step { filament, .. } => filament.is_finite(),
             Work::Normals { .. } => true,
         }
     }
@@ -157,12 +157,12 @@ fn beam(n_elements: usize) -> BeamModel {
     .expect("beam")
 }
 
-/// Δt of the benchmark for `kind`: half the explicit limit for Euler–Maruyama, 10⁻³ τ₁
-/// otherwise.
+/// Δt of the benchmark for `kind`: half the explicit limit for Euler–Maruyama (any scheme
+/// with a stability limit), 10⁻³ τ₁ otherwise.
 fn time_step(kind: IntegratorKind, beam: &BeamModel, max_rate: f64) -> f64 {
-    match kind {
-        IntegratorKind::EulerMaruyama => 0.5 * 2.0 / max_rate,
-        _ => 1e-3 * beam.params().tau1(),
+    match kind.stability_limit(max_rate) {
+        Some(limit) => 0.5 * limit,
+        None => 1e-3 * beam.params().tau1(),
     }
 }
 
@@ -198,7 +198,7 @@ struct Row {
 
 /// A stream index unique to (size, integrator, noise).
 fn stream(elements: usize, kind: IntegratorKind, noise: NoiseModel) -> u64 {
-    let k = IntegratorKind::ALL
+    let k = IntegratorKind::LINEAR
         .iter()
         .position(|&k| k == kind)
         .unwrap_or(9);
@@ -206,13 +206,21 @@ fn stream(elements: usize, kind: IntegratorKind, noise: NoiseModel) -> u64 {
     (elements * 100 + k * 10 + z) as u64
 }
 
-fn main() {
-    let quick = std::env::args().skip(1).any(|a| a == "quick");
-    let sizes: &[usize] = if quick { &[10, 100] } else { &[10, 100, 1000] };
-    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    let started = Instant::now();
+/// The normals-alone baselines: (elements, noise, normals per step, ns).
+type Baselines = Vec<(usize, NoiseModel, usize, f64)>;
 
-    // --- θ-schemes and normals-alone baselines: interleaved measurement -------------
+/// The normals per step and their cost alone at `ne` elements with `noise`.
+fn normals_ns(baselines: &Baselines, ne: usize, noise: NoiseModel) -> (usize, f64) {
+    baselines
+        .iter()
+        .find(|b| b.0 == ne && b.1 == noise)
+        .map(|b| (b.2, b.3))
+        .expect("normals baseline")
+}
+
+/// θ-schemes and normals-alone baselines, measured interleaved: the table rows, the
+/// baselines, and the beams with their λ_max for the `exact-modal` part.
+fn measure_theta_schemes(sizes: &[usize]) -> (Vec<Row>, Baselines, Vec<(BeamModel, f64)>) {
     struct Case {
         elements: usize,
         kind: Option<IntegratorKind>,
@@ -236,7 +244,7 @@ fn main() {
                 normals,
             });
             works.push(Work::normals(normals, (ne * 100 + 90) as u64));
-            for kind in IntegratorKind::ALL
+            for kind in IntegratorKind::LINEAR
                 .into_iter()
                 .filter(|k| k.theta().is_some())
             {
@@ -269,20 +277,18 @@ fn main() {
         );
     }
     drop(works);
-    let normals_ns = |ne: usize, noise: NoiseModel| -> (usize, f64) {
-        cases
-            .iter()
-            .zip(&medians)
-            .find(|(c, _)| c.elements == ne && c.noise == noise && c.kind.is_none())
-            .map(|(c, &m)| (c.normals, m))
-            .expect("normals baseline")
-    };
-    let mut rows: Vec<Row> = cases
+    let baselines: Baselines = cases
+        .iter()
+        .zip(&medians)
+        .filter(|(c, _)| c.kind.is_none())
+        .map(|(c, &m)| (c.elements, c.noise, c.normals, m))
+        .collect();
+    let rows: Vec<Row> = cases
         .iter()
         .zip(&medians)
         .filter_map(|(c, &m)| {
             c.kind.map(|kind| {
-                let (normals, normals_ns) = normals_ns(c.elements, c.noise);
+                let (normals, normals_ns) = normals_ns(&baselines, c.elements, c.noise);
                 Row {
                     elements: c.elements,
                     kind,
@@ -294,8 +300,16 @@ fn main() {
             })
         })
         .collect();
+    (rows, baselines, beams)
+}
 
-    // --- exact-modal: dense setup under a deadline, measured last -------------------
+/// `exact-modal`: dense setup under a deadline, measured last. The table rows and the
+/// setup notes.
+fn measure_exact_modal(
+    beams: Vec<(BeamModel, f64)>,
+    baselines: &Baselines,
+) -> (Vec<Row>, Vec<String>) {
+    let mut rows = Vec::new();
     let mut setup_notes = Vec::new();
     let mut skipping = false;
     for (b, max_rate) in beams {
@@ -333,7 +347,7 @@ fn main() {
             None => (None, None),
         };
         for noise in NOISES {
-            let (normals, normals_ns) = normals_ns(ne, noise);
+            let (normals, normals_ns) = normals_ns(baselines, ne, noise);
             let step_ns = modes.as_ref().map(|modes| {
                 let integ = first
                     .take()
@@ -357,10 +371,13 @@ fn main() {
             });
         }
     }
+    (rows, setup_notes)
+}
 
-    // --- report -----------------------------------------------------------------------
+/// Prints the table and the linearity and cost summaries.
+fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: usize) {
     let order = |r: &Row| {
-        let k = IntegratorKind::ALL.iter().position(|&k| k == r.kind);
+        let k = IntegratorKind::LINEAR.iter().position(|&k| k == r.kind);
         let z = NOISES.iter().position(|&z| z == r.noise);
         (r.elements, k, z)
     };
@@ -413,7 +430,7 @@ fn main() {
         println!();
         println!("| integrator | noise | ratio 1000/100 |");
         println!("|---|---|---:|");
-        for kind in IntegratorKind::ALL
+        for kind in IntegratorKind::LINEAR
             .into_iter()
             .filter(|k| k.theta().is_some())
         {
@@ -436,6 +453,17 @@ fn main() {
             println!("  {:>5} elements: {:.2}", r.elements, s / r.normals_ns);
         }
     }
+}
+
+fn main() {
+    let quick = std::env::args().skip(1).any(|a| a == "quick");
+    let sizes: &[usize] = if quick { &[10, 100] } else { &[10, 100, 1000] };
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let started = Instant::now();
+    let (mut rows, baselines, beams) = measure_theta_schemes(sizes);
+    let (exact_rows, setup_notes) = measure_exact_modal(beams, &baselines);
+    rows.extend(exact_rows);
+    report(rows, sizes, &setup_notes, cores);
     println!();
     println!(
         "total benchmark time {:.1} s",

@@ -56,7 +56,7 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         Some(t) => t
             .split(',')
             .map(|s| {
-                IntegratorKind::ALL
+                IntegratorKind::LINEAR
                     .into_iter()
                     .find(|k| k.name() == s.trim())
                     .ok_or_else(|| {

@@ -57,7 +57,7 @@ fn parse_method(text: &str) -> Result<(IntegratorKind, NoiseModel)> {
         .trim()
         .split_once('/')
         .ok_or_else(|| Error::invalid("--methods", text.trim(), allowed))?;
-    let kind = IntegratorKind::ALL
+    let kind = IntegratorKind::LINEAR
         .into_iter()
         .find(|k| k.name() == i)
         .ok_or_else(|| Error::invalid("--methods", text.trim(), allowed))?;

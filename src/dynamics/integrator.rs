@@ -1,6 +1,6 @@
 //! The [`Integrator`] trait and its implementations.
 
-use super::IntegratorKind;
+use super::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::banded::{BandedCholesky, SymBanded};
 use crate::fem::beam::BeamModel;
@@ -14,6 +14,49 @@ pub trait Integrator: Send {
     /// Advances `state` (the free degrees of freedom of one transverse component) by one
     /// time step, drawing its noise from `rng`.
     fn step(&mut self, state: &mut [f64], rng: &mut TrajectoryRng);
+}
+
+impl<I: Integrator + ?Sized> Integrator for Box<I> {
+    fn step(&mut self, state: &mut [f64], rng: &mut TrajectoryRng) {
+        (**self).step(state, rng);
+    }
+}
+
+/// The step-size refusal shared by the linear and the nonlinear integrators (with
+/// [`check_stability`]): `dt` must be finite and positive.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] otherwise.
+pub(super) fn check_dt(dt: f64) -> Result<()> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::invalid("dt", dt, "finite and > 0"));
+    }
+    Ok(())
+}
+
+/// The stability half of the shared step-size refusal: `dt` must lie below
+/// [`IntegratorKind::stability_limit`] for the fastest rate `max_rate` (the amplification
+/// factor of the fastest mode reaches −1 there); `suggestion` names stable alternatives.
+///
+/// # Errors
+/// [`Error::UnstableTimeStep`] at or above the limit.
+pub(super) fn check_stability(
+    kind: IntegratorKind,
+    dt: f64,
+    max_rate: f64,
+    suggestion: &str,
+) -> Result<()> {
+    if let Some(limit) = kind.stability_limit(max_rate)
+        && dt >= limit
+    {
+        return Err(Error::UnstableTimeStep {
+            integrator: kind.name().to_string(),
+            dt,
+            limit,
+            suggestion: suggestion.to_string(),
+        });
+    }
+    Ok(())
 }
 
 /// θ-scheme `(C + θΔtK) w_{k+1} = (C − (1−θ)ΔtK) w_k + sqrt(2kTΔt) ζ_k`: θ = 0 is
@@ -135,37 +178,34 @@ pub fn build_integrator(
     max_rate: f64,
     modes: Option<&GeneralizedModes>,
 ) -> Result<Box<dyn Integrator>> {
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(Error::invalid("dt", dt, "finite and > 0"));
-    }
-    if kind == IntegratorKind::MetropolisCrankNicolson {
-        return Err(Error::invalid(
-            "integrator",
-            kind,
-            "euler-maruyama, backward-euler, crank-nicolson or exact-modal for the linear filament \
-             (metropolis-crank-nicolson is for the nonlinear one; on the linear problem it equals crank-nicolson)",
-        ));
-    }
-    if let Some(limit) = kind.stability_limit(max_rate)
-        && dt >= limit
-    {
-        return Err(Error::UnstableTimeStep {
-            integrator: kind.name().to_string(),
-            dt,
-            limit,
-            suggestion: "crank-nicolson (O(n), exact stationary variance) or exact-modal"
-                .to_string(),
-        });
-    }
-    Ok(match (kind.theta(), modes) {
-        (Some(theta), _) => Box::new(ThetaScheme::new(beam, noise, theta, dt)?),
-        (None, Some(modes)) => Box::new(ExactModal::new(beam, modes, noise, dt)?),
-        (None, None) => {
+    check_dt(dt)?;
+    let suggestion = "crank-nicolson (O(n), exact stationary variance) or exact-modal";
+    Ok(match kind.family() {
+        Family::Metropolis => {
             return Err(Error::invalid(
-                "modes",
-                "none",
-                "the generalized modes of the beam (required by exact-modal)",
+                "integrator",
+                kind,
+                format!(
+                    "{} for the linear filament \
+                     (metropolis-crank-nicolson is for the nonlinear one; on the linear problem it equals crank-nicolson)",
+                    IntegratorKind::list(&IntegratorKind::LINEAR)
+                ),
             ));
+        }
+        Family::Theta(theta) => {
+            check_stability(kind, dt, max_rate, suggestion)?;
+            Box::new(ThetaScheme::new(beam, noise, theta, dt)?)
+        }
+        Family::ExactModal => {
+            check_stability(kind, dt, max_rate, suggestion)?;
+            let Some(modes) = modes else {
+                return Err(Error::invalid(
+                    "modes",
+                    "none",
+                    "the generalized modes of the beam (required by exact-modal)",
+                ));
+            };
+            Box::new(ExactModal::new(beam, modes, noise, dt)?)
         }
     })
 }

@@ -29,16 +29,27 @@
 //! The θ-schemes cost one banded solve per step (O(n)); `exact-modal` uses dense modal
 //! transforms (O(n²)) but is exact in distribution for the linear problem at any Δt.
 
+pub mod driver;
 pub mod ensemble;
 mod integrator;
 pub mod nonlinear;
 
+pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
+pub use nonlinear::{NonlinearIntegrator, NonlinearStep};
 
+use crate::error::Error;
 use serde::{Deserialize, Serialize};
 
-/// The time integrators available for the linear filament.
+/// The time integrators, for the linear and the nonlinear filament.
+///
+/// Every fact about an integrator is a method here, each an exhaustive `match` (no
+/// catch-all arm), so that a new variant is a compile error until every fact is decided:
+/// [`name`](Self::name), [`family`](Self::family), [`needs_modes`](Self::needs_modes),
+/// [`exact_stationary`](Self::exact_stationary), and from the family the discrete-time
+/// [`modal_form`](Self::modal_form), [`stationary_variance_ratio`](Self::stationary_variance_ratio)
+/// and [`stability_limit`](Self::stability_limit). Names parse with [`std::str::FromStr`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
@@ -56,14 +67,56 @@ pub enum IntegratorKind {
     MetropolisCrankNicolson,
 }
 
+/// How an integrator steps: the family decides its construction and its discrete-time
+/// modal form on the linear problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Family {
+    /// θ-scheme `(C + θΔtK) w_{k+1} = (C − (1−θ)ΔtK) w_k + sqrt(2kTΔt) ζ_k` with this θ.
+    Theta(f64),
+    /// Exact Ornstein–Uhlenbeck transition of every generalized mode of (K, C).
+    ExactModal,
+    /// Crank–Nicolson proposal with a Metropolis–Hastings accept/reject step.
+    Metropolis,
+}
+
 impl IntegratorKind {
     /// Every integrator, in a fixed order.
-    pub const ALL: [IntegratorKind; 4] = [
+    pub const ALL: [IntegratorKind; 5] = [
+        IntegratorKind::EulerMaruyama,
+        IntegratorKind::BackwardEuler,
+        IntegratorKind::CrankNicolson,
+        IntegratorKind::ExactModal,
+        IntegratorKind::MetropolisCrankNicolson,
+    ];
+
+    /// The integrators of the linear filament, in a fixed order.
+    pub const LINEAR: [IntegratorKind; 4] = [
         IntegratorKind::EulerMaruyama,
         IntegratorKind::BackwardEuler,
         IntegratorKind::CrankNicolson,
         IntegratorKind::ExactModal,
     ];
+
+    /// The integrators of the nonlinear (finite-deflection) filament, in a fixed order.
+    pub const NONLINEAR: [IntegratorKind; 4] = [
+        IntegratorKind::EulerMaruyama,
+        IntegratorKind::BackwardEuler,
+        IntegratorKind::CrankNicolson,
+        IntegratorKind::MetropolisCrankNicolson,
+    ];
+
+    /// The names of `kinds` for messages: `"a, b, c or d"` (", " between, " or " before
+    /// the last).
+    pub fn list(kinds: &[IntegratorKind]) -> String {
+        match kinds.split_last() {
+            None => String::new(),
+            Some((last, [])) => last.name().to_string(),
+            Some((last, rest)) => {
+                let head: Vec<&str> = rest.iter().map(|k| k.name()).collect();
+                format!("{} or {}", head.join(", "), last.name())
+            }
+        }
+    }
 
     /// The name used in scene files and reports.
     pub fn name(self) -> &'static str {
@@ -76,14 +129,47 @@ impl IntegratorKind {
         }
     }
 
+    /// The family of the integrator ([`Family`]).
+    pub fn family(self) -> Family {
+        match self {
+            IntegratorKind::EulerMaruyama => Family::Theta(0.0),
+            IntegratorKind::BackwardEuler => Family::Theta(1.0),
+            IntegratorKind::CrankNicolson => Family::Theta(0.5),
+            IntegratorKind::ExactModal => Family::ExactModal,
+            IntegratorKind::MetropolisCrankNicolson => Family::Metropolis,
+        }
+    }
+
+    /// Whether building the integrator needs the generalized modes of (K, C) (a dense
+    /// O(n³) eigen-decomposition).
+    pub fn needs_modes(self) -> bool {
+        match self {
+            IntegratorKind::ExactModal => true,
+            IntegratorKind::EulerMaruyama
+            | IntegratorKind::BackwardEuler
+            | IntegratorKind::CrankNicolson
+            | IntegratorKind::MetropolisCrankNicolson => false,
+        }
+    }
+
+    /// Whether the stationary variance of the linear problem is exact (kT/λ per mode under
+    /// consistent noise) at any Δt: Crank–Nicolson, the exact modal update and the
+    /// Metropolis scheme (whose proposals are all accepted on the linear problem).
+    pub fn exact_stationary(self) -> bool {
+        match self {
+            IntegratorKind::CrankNicolson
+            | IntegratorKind::ExactModal
+            | IntegratorKind::MetropolisCrankNicolson => true,
+            IntegratorKind::EulerMaruyama | IntegratorKind::BackwardEuler => false,
+        }
+    }
+
     /// The implicitness θ of the θ-scheme, or `None` for `exact-modal` and the Metropolis
     /// scheme.
     pub fn theta(self) -> Option<f64> {
-        match self {
-            IntegratorKind::EulerMaruyama => Some(0.0),
-            IntegratorKind::BackwardEuler => Some(1.0),
-            IntegratorKind::CrankNicolson => Some(0.5),
-            IntegratorKind::ExactModal | IntegratorKind::MetropolisCrankNicolson => None,
+        match self.family() {
+            Family::Theta(theta) => Some(theta),
+            Family::ExactModal | Family::Metropolis => None,
         }
     }
 
@@ -92,22 +178,23 @@ impl IntegratorKind {
     ///
     /// θ-scheme: `m = (1 − (1−θ)a)/(1 + θa)`, `g = sqrt(2kTΔt)/(1 + θa)`, a = λΔt.
     /// Exact OU: `m = e^{−a}`, `g = sqrt(kT(1 − e^{−2a})/λ)`, so that the stationary
-    /// variance `g²/(1 − m²)` is kT/λ for consistent noise (Σ_q = I).
+    /// variance `g²/(1 − m²)` is kT/λ for consistent noise (Σ_q = I). Metropolis: the
+    /// Crank–Nicolson form (on the linear problem every proposal is accepted).
     pub fn modal_form(self, rate: f64, dt: f64, kt: f64) -> (f64, f64) {
         let a = rate * dt;
-        match self.theta() {
-            Some(theta) => {
+        match self.family() {
+            Family::Theta(theta) => {
                 let den = 1.0 + theta * a;
                 (
                     (1.0 - (1.0 - theta) * a) / den,
                     (2.0 * kt * dt).sqrt() / den,
                 )
             }
-            None if self == IntegratorKind::MetropolisCrankNicolson => {
+            Family::Metropolis => {
                 // On the linear problem every Crank–Nicolson proposal is accepted.
                 IntegratorKind::CrankNicolson.modal_form(rate, dt, kt)
             }
-            None => {
+            Family::ExactModal => {
                 let m = (-a).exp();
                 // 1 − e^{−2a} computed without cancellation for small a.
                 let one_minus_m2 = -(-2.0 * a).exp_m1();
@@ -129,10 +216,27 @@ impl IntegratorKind {
     /// the amplification factor `m = (1 − (1−θ)a)/(1 + θa)` reaches −1 at
     /// `a = 2/(1 − 2θ)`; Euler–Maruyama is stable for Δt < 2/λ_max.
     pub fn stability_limit(self, max_rate: f64) -> Option<f64> {
-        match self.theta() {
-            Some(theta) if theta < 0.5 => Some(2.0 / ((1.0 - 2.0 * theta) * max_rate)),
-            _ => None,
+        match self.family() {
+            Family::Theta(theta) if theta < 0.5 => Some(2.0 / ((1.0 - 2.0 * theta) * max_rate)),
+            Family::Theta(_) | Family::ExactModal | Family::Metropolis => None,
         }
+    }
+}
+
+impl std::str::FromStr for IntegratorKind {
+    type Err = Error;
+
+    /// Parses an integrator name ([`IntegratorKind::name`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] listing the allowed names.
+    fn from_str(s: &str) -> Result<Self, Error> {
+        IntegratorKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                Error::invalid("integrator", s, IntegratorKind::list(&IntegratorKind::ALL))
+            })
     }
 }
 
@@ -169,6 +273,32 @@ mod tests {
                 .stationary_variance_ratio(1e6, 1.0)
                 .is_some()
         );
+    }
+
+    /// Names round-trip through parsing; lists read "a, b or c"; an unknown name is refused
+    /// with the allowed names.
+    #[test]
+    fn names_parse_and_list() {
+        for k in IntegratorKind::ALL {
+            assert_eq!(k.name().parse::<IntegratorKind>().unwrap(), k);
+        }
+        assert_eq!(
+            IntegratorKind::list(&IntegratorKind::LINEAR),
+            "euler-maruyama, backward-euler, crank-nicolson or exact-modal"
+        );
+        assert_eq!(
+            IntegratorKind::list(&[IntegratorKind::ExactModal]),
+            "exact-modal"
+        );
+        assert_eq!(IntegratorKind::list(&[]), "");
+        let e = "rk4".parse::<IntegratorKind>().unwrap_err().to_string();
+        assert!(
+            e.contains("exact-modal or metropolis-crank-nicolson"),
+            "{e}"
+        );
+        assert!(IntegratorKind::ExactModal.needs_modes());
+        assert!(!IntegratorKind::BackwardEuler.exact_stationary());
+        assert!(IntegratorKind::MetropolisCrankNicolson.exact_stationary());
     }
 
     #[test]

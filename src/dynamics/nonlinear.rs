@@ -28,7 +28,8 @@
 //!   correlated F). A proposal from, or into, a state whose `A_w` is not positive definite
 //!   (F beyond about `F_1(1 + 2/(λ_1Δt))`) is rejected.
 
-use super::IntegratorKind;
+use super::integrator::{check_dt, check_stability};
+use super::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::banded::{BandedCholesky, SymBanded};
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
@@ -67,8 +68,17 @@ struct MhEvaluation {
     lhs: Option<(BandedCholesky, f64)>,
 }
 
-/// A time integrator for [`CompressedFilament`].
-pub struct NonlinearIntegrator {
+/// One step of a stochastic time integrator for the nonlinear filament: the same shape as
+/// [`super::Integrator`], with the model held by the integrator.
+pub trait NonlinearStep: Send {
+    /// Advances the state `w` (one vector per transverse component) by one time step,
+    /// drawing its noise from `rng`.
+    fn step(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng);
+}
+
+/// A time integrator for [`CompressedFilament`] (the model is borrowed for its lifetime).
+pub struct NonlinearIntegrator<'m> {
+    model: &'m CompressedFilament,
     scheme: Scheme,
     kind: IntegratorKind,
     theta: f64,
@@ -91,9 +101,9 @@ pub struct NonlinearIntegrator {
     pub accepted: u64,
 }
 
-impl NonlinearIntegrator {
-    /// Builds integrator `kind` (euler-maruyama, backward-euler, crank-nicolson or
-    /// metropolis-crank-nicolson) with step `dt` and noise model `noise`.
+impl<'m> NonlinearIntegrator<'m> {
+    /// Builds integrator `kind` for `model` (one of [`IntegratorKind::NONLINEAR`]) with step
+    /// `dt` and noise model `noise`.
     ///
     /// # Errors
     /// [`Error::UnstableTimeStep`] for euler-maruyama above the linear stability limit
@@ -101,27 +111,26 @@ impl NonlinearIntegrator {
     /// nonlinear filament) or for Metropolis with element-uniform noise (its proposal
     /// density is singular).
     pub fn new(
-        model: &CompressedFilament,
+        model: &'m CompressedFilament,
         kind: IntegratorKind,
         noise: NoiseModel,
         dt: f64,
     ) -> Result<Self> {
         let beam = model.beam();
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::invalid("dt", dt, "finite and > 0"));
-        }
-        let scheme = match kind {
-            IntegratorKind::MetropolisCrankNicolson => Scheme::Metropolis,
-            k => match k.theta() {
-                Some(t) => Scheme::Theta(t),
-                None => {
-                    return Err(Error::invalid(
-                        "integrator",
-                        k,
-                        "euler-maruyama, backward-euler, crank-nicolson or metropolis-crank-nicolson for the nonlinear filament",
-                    ));
-                }
-            },
+        check_dt(dt)?;
+        let scheme = match kind.family() {
+            Family::Metropolis => Scheme::Metropolis,
+            Family::Theta(t) => Scheme::Theta(t),
+            Family::ExactModal => {
+                return Err(Error::invalid(
+                    "integrator",
+                    kind,
+                    format!(
+                        "{} for the nonlinear filament",
+                        IntegratorKind::list(&IntegratorKind::NONLINEAR)
+                    ),
+                ));
+            }
         };
         if scheme == Scheme::Metropolis && noise != NoiseModel::Consistent {
             return Err(Error::invalid(
@@ -130,17 +139,12 @@ impl NonlinearIntegrator {
                 "consistent for metropolis-crank-nicolson (the element-uniform proposal density is singular)",
             ));
         }
-        if let Some(limit) = kind.stability_limit(beam.max_rate()?)
-            && dt >= limit
-        {
-            return Err(Error::UnstableTimeStep {
-                integrator: kind.name().to_string(),
-                dt,
-                limit,
-                suggestion: "metropolis-crank-nicolson (exact stationary law, stable at any dt)"
-                    .to_string(),
-            });
-        }
+        check_stability(
+            kind,
+            dt,
+            beam.max_rate()?,
+            "metropolis-crank-nicolson (exact stationary law, stable at any dt)",
+        )?;
         let theta = match scheme {
             Scheme::Theta(t) => t,
             Scheme::Metropolis => 0.5,
@@ -149,6 +153,7 @@ impl NonlinearIntegrator {
         let n = beam.n_dofs();
         let nc = model.components();
         Ok(NonlinearIntegrator {
+            model,
             scheme,
             kind,
             theta,
@@ -187,7 +192,8 @@ impl NonlinearIntegrator {
     /// The compressive force of the explicit stretching term comes, for the paper's
     /// explicit scheme, from the axial solve (step i), otherwise from the closed form
     /// (identical up to round-off; see the tests).
-    fn evaluate(&mut self, model: &CompressedFilament, w: &[Vec<f64>], out: &mut ThetaBuffers) {
+    fn evaluate(&mut self, w: &[Vec<f64>], out: &mut ThetaBuffers) {
+        let model = self.model;
         let beam = model.beam();
         let p = beam.params();
         let nc = w.len();
@@ -232,19 +238,10 @@ impl NonlinearIntegrator {
             .sum()
     }
 
-    /// Advances the state `w` (one vector per transverse component) by one step.
-    pub fn step(
-        &mut self,
-        model: &CompressedFilament,
-        w: &mut [Vec<f64>],
-        rng: &mut TrajectoryRng,
-    ) {
-        if self.scheme == Scheme::Metropolis {
-            self.step_metropolis(model, w, rng);
-            return;
-        }
+    /// One θ-step (see [`NonlinearIntegrator`]).
+    fn step_theta(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng) {
         let mut buf = std::mem::take(&mut self.theta_buffers);
-        self.evaluate(model, w, &mut buf);
+        self.evaluate(w, &mut buf);
         for z in &mut self.zeta {
             self.noise.draw(rng, z);
         }
@@ -260,7 +257,8 @@ impl NonlinearIntegrator {
     }
 
     /// Evaluates a state of the Metropolis chain ([`MhEvaluation`]).
-    fn evaluate_mh(&self, model: &CompressedFilament, w: &[Vec<f64>]) -> MhEvaluation {
+    fn evaluate_mh(&self, w: &[Vec<f64>]) -> MhEvaluation {
+        let model = self.model;
         let beam = model.beam();
         let p = beam.params();
         let n = beam.n_dofs();
@@ -360,15 +358,10 @@ impl NonlinearIntegrator {
     }
 
     /// One Metropolis-adjusted step (see [`NonlinearIntegrator`]).
-    fn step_metropolis(
-        &mut self,
-        model: &CompressedFilament,
-        w: &mut [Vec<f64>],
-        rng: &mut TrajectoryRng,
-    ) {
+    fn step_metropolis(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng) {
         let cur = match self.mh_current.take() {
             Some(e) if e.state.as_slice() == &*w => e,
-            _ => self.evaluate_mh(model, w),
+            _ => self.evaluate_mh(w),
         };
         for z in &mut self.zeta {
             self.noise.draw(rng, z);
@@ -381,7 +374,7 @@ impl NonlinearIntegrator {
             .filter(|n| n.iter().flatten().all(|v| v.is_finite()));
         let mut keep = cur;
         if let Some(next) = next {
-            let prop = self.evaluate_mh(model, &next);
+            let prop = self.evaluate_mh(&next);
             let log_alpha = self.log_acceptance(&keep, &prop, &zeta);
             if log_alpha >= 0.0 || u < log_alpha.exp() {
                 for (wc, nc) in w.iter_mut().zip(&prop.state) {
@@ -393,6 +386,15 @@ impl NonlinearIntegrator {
         }
         self.zeta = zeta;
         self.mh_current = Some(keep);
+    }
+}
+
+impl NonlinearStep for NonlinearIntegrator<'_> {
+    fn step(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng) {
+        match self.scheme {
+            Scheme::Metropolis => self.step_metropolis(w, rng),
+            Scheme::Theta(_) => self.step_theta(w, rng),
+        }
     }
 }
 
@@ -471,9 +473,9 @@ mod tests {
                         z
                     })
                     .collect();
-                let cur = integ.evaluate_mh(&m, &w);
+                let cur = integ.evaluate_mh(&w);
                 let next = integ.propose(&cur, &zeta).unwrap();
-                let prop = integ.evaluate_mh(&m, &next);
+                let prop = integ.evaluate_mh(&next);
                 let zeta_r = integ.reverse_noise(&cur, &prop);
                 let back = integ.propose(&prop, &zeta_r).unwrap();
                 let scale = w.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -554,7 +556,7 @@ mod tests {
         let mut w = vec![vec![0.0; m.beam().n_dofs()]; 2];
         let mut rng = trajectory_rng(SEED, 99);
         for _ in 0..2000 {
-            integ.step(&m, &mut w, &mut rng);
+            integ.step(&mut w, &mut rng);
         }
         assert_eq!(integ.accepted, integ.proposed);
     }

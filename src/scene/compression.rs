@@ -3,6 +3,7 @@
 //! equilibrium theory of the same discretization ([`crate::theory::compression`]), with
 //! the continuum theory beside it.
 
+use crate::dynamics::{Driver, NonlinearState, Observer};
 use crate::error::{Error, Result};
 use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
@@ -86,6 +87,31 @@ impl CompressionTheoryTable {
             distributions,
             curve,
         })
+    }
+}
+
+/// The observer of [`CompressionRun::simulate`]: F/F_c0 and the nodal slopes at every
+/// sample, the Metropolis counts at the end.
+struct ForceRecorder<'m> {
+    model: &'m CompressedFilament,
+    euler_load: f64,
+    rec: ForceRecord,
+}
+
+impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
+    fn on_sample(&mut self, _: usize, _: u64, state: &NonlinearState<NonlinearIntegrator<'_>>) {
+        let (model, w) = (self.model, &state.w);
+        let f = model.compressive_force(model.stored_length(w));
+        self.rec.force_ratio.push(f / self.euler_load);
+        for c in w {
+            add_slope_squares(model.beam(), c, &mut self.rec.slope_squares);
+        }
+        self.rec.slope_samples += 1;
+    }
+
+    fn on_finish(&mut self, _: usize, state: &NonlinearState<NonlinearIntegrator<'_>>) {
+        self.rec.proposed = state.integrator.proposed;
+        self.rec.accepted = state.integrator.accepted;
     }
 }
 
@@ -196,43 +222,36 @@ impl CompressionRun {
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
         let model = &self.models[point];
-        let mut integ =
+        let integrator =
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
-        let mut w = self.equilibrium_start(rng);
-        let total = self.burn_in_steps + sampled_steps;
-        let mut rec = ForceRecord {
-            force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
-            slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
-            ..Default::default()
+        let mut state = NonlinearState {
+            integrator,
+            w: self.equilibrium_start(rng),
         };
-        for step in 1..=total {
-            integ.step(model, &mut w, rng);
-            if !w.iter().flatten().all(|v| v.is_finite()) {
-                return Err(Error::diverged(
-                    step,
-                    self.dt,
-                    format!(
-                        "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
-                        self.spec.integrator,
-                        model.strain(),
-                        self.spec.dt_tau1
-                    ),
-                ));
-            }
-            if step > self.burn_in_steps
-                && (step - self.burn_in_steps).is_multiple_of(self.sample_every)
-            {
-                let f = model.compressive_force(model.stored_length(&w));
-                rec.force_ratio.push(f / self.euler_load);
-                for c in &w {
-                    add_slope_squares(model.beam(), c, &mut rec.slope_squares);
-                }
-                rec.slope_samples += 1;
-            }
-        }
-        rec.proposed = integ.proposed;
-        rec.accepted = integ.accepted;
-        Ok(rec)
+        let mut recorder = ForceRecorder {
+            model,
+            euler_load: self.euler_load,
+            rec: ForceRecord {
+                force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+                slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
+                ..Default::default()
+            },
+        };
+        Driver::new(
+            self.dt,
+            self.burn_in_steps,
+            sampled_steps,
+            self.sample_every,
+        )
+        .run(point, &mut state, rng, &mut recorder, |_| {
+            format!(
+                "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
+                self.spec.integrator,
+                model.strain(),
+                self.spec.dt_tau1
+            )
+        })?;
+        Ok(recorder.rec)
     }
 
     /// Simulates `trajectories` trajectories of `sampled_steps` steps at every strain, in

@@ -10,7 +10,9 @@
 //! the *continuum* reference is the modal solution of eq. (2) (per-mode variance
 //! 2kTL³/(π⁴n⁴EI), rate λ_n, profile kT x²(L−x)²/(3EI L), eq. 4).
 
-use crate::dynamics::{Integrator, IntegratorKind, build_integrator};
+use crate::dynamics::{
+    Components, Driver, Integrator, IntegratorKind, Observer, Trajectory, build_integrator,
+};
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 use crate::fem::modal::{
@@ -144,13 +146,9 @@ pub fn add_slope_squares(beam: &BeamModel, state: &[f64], acc: &mut [f64]) {
     }
 }
 
-/// A filament being simulated: advances all its transverse components by one step and
-/// reports the observables.
-trait Sampler {
-    /// One step of every component.
-    fn step(&mut self, rng: &mut TrajectoryRng);
-    /// Whether the state is finite.
-    fn is_finite(&self) -> bool;
+/// A filament being simulated ([`Trajectory`]: advances all its transverse components by
+/// one step) that reports the observables.
+trait Sampler: Trajectory {
     /// Modal amplitudes, component-major: `out[c * n_modes + i]`.
     fn modes(&self, out: &mut [f64]);
     /// Deflections at `xs`, component-major: `out[c * xs.len() + j]`.
@@ -163,22 +161,22 @@ trait Sampler {
 struct FemSampler<'a> {
     beam: &'a BeamModel,
     projector: &'a DMatrix<f64>,
-    integrator: Box<dyn Integrator>,
-    states: Vec<Vec<f64>>,
+    filament: Components<Box<dyn Integrator>>,
+}
+
+impl Trajectory for FemSampler<'_> {
+    fn step(&mut self, rng: &mut TrajectoryRng) {
+        self.filament.step(rng);
+    }
+    fn is_finite(&self) -> bool {
+        self.filament.is_finite()
+    }
 }
 
 impl Sampler for FemSampler<'_> {
-    fn step(&mut self, rng: &mut TrajectoryRng) {
-        for s in &mut self.states {
-            self.integrator.step(s, rng);
-        }
-    }
-    fn is_finite(&self) -> bool {
-        self.states.iter().flatten().all(|v| v.is_finite())
-    }
     fn modes(&self, out: &mut [f64]) {
         let m = self.projector.nrows();
-        for (c, s) in self.states.iter().enumerate() {
+        for (c, s) in self.filament.states.iter().enumerate() {
             for i in 0..m {
                 out[c * m + i] = self
                     .projector
@@ -191,14 +189,14 @@ impl Sampler for FemSampler<'_> {
         }
     }
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
-        for (c, s) in self.states.iter().enumerate() {
+        for (c, s) in self.filament.states.iter().enumerate() {
             for (j, &x) in xs.iter().enumerate() {
                 out[c * xs.len() + j] = self.beam.deflection_at(s, x);
             }
         }
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
-        for s in &self.states {
+        for s in &self.filament.states {
             add_slope_squares(self.beam, s, acc);
         }
     }
@@ -209,7 +207,7 @@ struct SpectralSampler {
     n_modes: usize,
 }
 
-impl Sampler for SpectralSampler {
+impl Trajectory for SpectralSampler {
     fn step(&mut self, rng: &mut TrajectoryRng) {
         for s in &mut self.sims {
             s.step(rng);
@@ -220,6 +218,9 @@ impl Sampler for SpectralSampler {
             .iter()
             .all(|s| s.amplitudes().iter().all(|a| a.is_finite()))
     }
+}
+
+impl Sampler for SpectralSampler {
     fn modes(&self, out: &mut [f64]) {
         for (c, s) in self.sims.iter().enumerate() {
             out[c * self.n_modes..(c + 1) * self.n_modes]
@@ -233,6 +234,114 @@ impl Sampler for SpectralSampler {
             }
         }
     }
+}
+
+/// The observer of [`LinearRun::trace`]: every sample, the checked modal amplitudes and
+/// the profile deflections (component-major).
+struct TraceObserver<'r> {
+    profile_x: &'r [f64],
+    m: Vec<f64>,
+    p: Vec<f64>,
+    out: Vec<Vec<f64>>,
+}
+
+impl<S: Sampler + ?Sized> Observer<S> for TraceObserver<'_> {
+    fn on_sample(&mut self, _: usize, _: u64, sampler: &S) {
+        sampler.modes(&mut self.m);
+        sampler.deflections(self.profile_x, &mut self.p);
+        self.out
+            .push(self.m.iter().chain(&self.p).copied().collect());
+    }
+}
+
+/// The observer of [`LinearRun::simulate`]: the two-time products on every step, each
+/// series at its own cadence after the burn-in.
+struct Recorder<'r> {
+    run: &'r LinearRun,
+    rec: TrajectoryRecord,
+    /// w(x, t) at the earlier time of each two-time point, per component.
+    at_t: Vec<f64>,
+    buf_m: Vec<f64>,
+    buf_p: Vec<f64>,
+    one: Vec<f64>,
+}
+
+impl<'r> Recorder<'r> {
+    fn new(run: &'r LinearRun, sampled_steps: u64) -> Self {
+        let r = &run.reference;
+        let (nm, c, np, ntt) = (
+            r.modes.len(),
+            run.components,
+            r.profile_x.len(),
+            r.two_time.len(),
+        );
+        let cap = |every: u64| ((sampled_steps / every) as usize).min(MAX_SAMPLES);
+        Recorder {
+            run,
+            rec: TrajectoryRecord {
+                modes: (0..c * nm)
+                    .map(|k| Vec::with_capacity(cap(run.mode_every[k % nm])))
+                    .collect(),
+                profile: vec![Vec::with_capacity(cap(run.profile_every)); c * np],
+                two_time: vec![0.0; c * ntt],
+                slope_squares: vec![0.0; run.n_nodes()],
+                slope_samples: 0,
+            },
+            at_t: vec![0.0; c * ntt],
+            buf_m: vec![0.0; c * nm],
+            buf_p: vec![0.0; c * np],
+            one: vec![0.0; c],
+        }
+    }
+}
+
+impl<S: Sampler + ?Sized> Observer<S> for Recorder<'_> {
+    fn on_step(&mut self, _: usize, step: u64, sampler: &S) {
+        let tt = &self.run.reference.two_time;
+        for (j, q) in tt.iter().enumerate() {
+            if step == q.t_step {
+                sampler.deflections(&[q.x], &mut self.one);
+                for k in 0..self.run.components {
+                    self.at_t[k * tt.len() + j] = self.one[k];
+                }
+            }
+            if step == q.eta_step {
+                sampler.deflections(&[q.y], &mut self.one);
+                for k in 0..self.run.components {
+                    self.rec.two_time[k * tt.len() + j] = self.at_t[k * tt.len() + j] * self.one[k];
+                }
+            }
+        }
+    }
+
+    fn on_sample(&mut self, _: usize, since: u64, sampler: &S) {
+        let run = self.run;
+        let nm = run.reference.modes.len();
+        let rec = &mut self.rec;
+        if run.mode_every.iter().any(|&e| since.is_multiple_of(e)) {
+            sampler.modes(&mut self.buf_m);
+            for (k, s) in rec.modes.iter_mut().enumerate() {
+                if since.is_multiple_of(run.mode_every[k % nm]) && s.len() < MAX_SAMPLES {
+                    s.push(self.buf_m[k]);
+                }
+            }
+        }
+        if since.is_multiple_of(run.profile_every)
+            && rec.profile.first().is_some_and(|s| s.len() < MAX_SAMPLES)
+        {
+            sampler.deflections(&run.reference.profile_x, &mut self.buf_p);
+            for (s, v) in rec.profile.iter_mut().zip(&self.buf_p) {
+                s.push(*v);
+            }
+            sampler.add_slope_squares(&mut rec.slope_squares);
+            rec.slope_samples += 1;
+        }
+    }
+}
+
+/// Greatest common divisor (the cadence at which every series' own cadence is met).
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 { a } else { gcd(b, a % b) }
 }
 
 /// Largest number of samples of one series in one trajectory: fast modes are recorded
@@ -290,6 +399,211 @@ enum Model {
     },
 }
 
+/// What the preparation of a model yields besides the sampling plan.
+struct Prepared {
+    model: Model,
+    modes: Vec<ModeReference>,
+    profile_discrete: Vec<f64>,
+    two_time: Vec<TwoTimeReference>,
+    max_rate: f64,
+}
+
+/// The quantities shared by the preparation steps of a run.
+struct Setup<'s> {
+    scene: &'s Scene,
+    spec: &'s RunSpec,
+    continuum: HingedBeam,
+    tau1: f64,
+    dt: f64,
+    profile_x: Vec<f64>,
+}
+
+impl Setup<'_> {
+    /// Number of steps of a duration (physical time), rounded.
+    fn steps(&self, t: f64) -> u64 {
+        (t / self.dt).round() as u64
+    }
+
+    /// The exact modal simulator of eq. (2): its references are the continuum's, the
+    /// profile truncated to the simulated modes.
+    fn spectral(&self) -> Result<Prepared> {
+        let (continuum, dt) = (&self.continuum, self.dt);
+        let n_modes = self.scene.mesh.elements;
+        let mut refs = Vec::new();
+        for n in 1..=self.scene.sampling.modes {
+            let rate = continuum.mode_rate(n);
+            let var = continuum.mode_variance(n);
+            refs.push(ModeReference {
+                n,
+                variance_discrete: var,
+                variance_equipartition: var,
+                variance_continuum: var,
+                multiplier: (-rate * dt).exp(),
+                rate_discrete: Some(rate),
+                rate_continuum: rate,
+            });
+        }
+        // The simulator carries n_modes modes: its exact profile is the truncated sum.
+        let profile_discrete = self
+            .profile_x
+            .iter()
+            .map(|&x| continuum.profile_variance_series(x, n_modes).value)
+            .collect();
+        let length = self.scene.filament.length;
+        let mut tt = Vec::new();
+        for q in &self.scene.sampling.two_time {
+            let (x, y) = (q[0] * length, q[1] * length);
+            let (ts, es) = (self.steps(q[2] * self.tau1), self.steps(q[3] * self.tau1));
+            let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+            tt.push(TwoTimeReference {
+                x,
+                y,
+                t,
+                eta,
+                t_step: ts,
+                eta_step: es,
+                discrete: continuum
+                    .correlation_truncated(x, y, t, eta, n_modes)?
+                    .value,
+                continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
+            });
+        }
+        Ok(Prepared {
+            model: Model::Spectral {
+                beam: *continuum,
+                n_modes,
+            },
+            modes: refs,
+            profile_discrete,
+            two_time: tt,
+            max_rate: continuum.mode_rate(n_modes),
+        })
+    }
+
+    /// The finite-element filament: fails early above the stability limit, then the
+    /// exact discrete references from the generalized modes
+    /// ([`discrete_stationary_covariance`]).
+    fn fem(&self) -> Result<Prepared> {
+        let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
+        let kt = p.kt;
+        let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
+        // An explicit step above its limit fails at once (λ_max by an O(n)
+        // inertia bisection), before the O(n³) eigen-decomposition.
+        if spec.integrator.stability_limit(1.0).is_some() {
+            build_integrator(
+                spec.integrator,
+                &beam,
+                spec.noise,
+                dt,
+                beam.max_rate()?,
+                None,
+            )?;
+        }
+        let gm = generalized_modes(&beam)?;
+        let max_rate = gm.rates[gm.rates.len() - 1];
+        // Fails early with the stability limit if the step is too large.
+        build_integrator(spec.integrator, &beam, spec.noise, dt, max_rate, Some(&gm))?;
+        let sigma_zeta = NoiseGenerator::new(spec.noise, &beam)?.covariance();
+        let sigma_q = modal_noise_covariance(&gm, &sigma_zeta);
+        let (m, g): (Vec<f64>, Vec<f64>) = gm
+            .rates
+            .iter()
+            .map(|&r| spec.integrator.modal_form(r, dt, kt))
+            .unzip();
+        let s = discrete_stationary_covariance(&sigma_q, &m, &g)?;
+        let mut refs = Vec::new();
+        for i in 0..self.scene.sampling.modes {
+            let n = i + 1;
+            let rate = gm.rates[i];
+            refs.push(ModeReference {
+                n,
+                variance_discrete: s[(i, i)],
+                variance_equipartition: kt / rate,
+                variance_continuum: kt / self.continuum.mode_rate(n),
+                multiplier: m[i],
+                rate_discrete: (m[i] > 0.0).then(|| -m[i].ln() / dt),
+                rate_continuum: self.continuum.mode_rate(n),
+            });
+        }
+        // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
+        let probe = |x: f64| modal_probe(&beam, &gm.vectors, x);
+        let profile_discrete = self
+            .profile_x
+            .iter()
+            .map(|&x| {
+                let a = probe(x);
+                (a.transpose() * &s * &a)[(0, 0)]
+            })
+            .collect();
+        let two_time = self.fem_two_time(&m, &g, &sigma_q, &probe)?;
+        let projector = gm.projector(&beam, self.scene.sampling.modes);
+        let keep_modes = spec.integrator.needs_modes();
+        Ok(Prepared {
+            model: Model::Fem {
+                beam: Box::new(beam),
+                modes: keep_modes.then_some(gm),
+                projector,
+                noise: spec.noise,
+                integrator: spec.integrator,
+            },
+            modes: refs,
+            profile_discrete,
+            two_time,
+            max_rate,
+        })
+    }
+
+    /// The two-time references of the finite-element filament from rest, with per-mode
+    /// multipliers `m` and gains `g`, modal noise covariance `sigma_q` and the modal
+    /// probe vectors `probe(x)`.
+    fn fem_two_time(
+        &self,
+        m: &[f64],
+        g: &[f64],
+        sigma_q: &DMatrix<f64>,
+        probe: &dyn Fn(f64) -> DVector<f64>,
+    ) -> Result<Vec<TwoTimeReference>> {
+        let (length, dt, tau1) = (self.scene.filament.length, self.dt, self.tau1);
+        let mut tt = Vec::new();
+        for q in &self.scene.sampling.two_time {
+            let (x, y) = (q[0] * length, q[1] * length);
+            let (ts, es) = (
+                self.steps(q[2] * tau1).max(1),
+                self.steps(q[3] * tau1).max(1),
+            );
+            let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+            // From rest: S_k,ij = g_i g_j Σq_ij (1 − (m_i m_j)^k)/(1 − m_i m_j), then
+            // ⟨q(η) q(t)ᵀ⟩ = diag(m^{η−t}) S_t.
+            let n = m.len();
+            let mut st = DMatrix::zeros(n, n);
+            for i in 0..n {
+                for j in 0..n {
+                    let mm = m[i] * m[j];
+                    let transient = if mm == 1.0 {
+                        0.0
+                    } else {
+                        1.0 - mm.powf(ts as f64)
+                    };
+                    st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * transient / (1.0 - mm)
+                        * m[i].powf((es - ts) as f64);
+                }
+            }
+            let (ax, ay) = (probe(x), probe(y));
+            tt.push(TwoTimeReference {
+                x,
+                y,
+                t,
+                eta,
+                t_step: ts,
+                eta_step: es,
+                discrete: (ay.transpose() * &st * &ax)[(0, 0)],
+                continuum: self.continuum.correlation(x, y, t, eta, 1e-12)?.value,
+            });
+        }
+        Ok(tt)
+    }
+}
+
 impl LinearRun {
     /// Prepares run `spec` of `scene`: builds the model, checks the time step against the
     /// stability limit, and computes every exact reference.
@@ -302,8 +616,6 @@ impl LinearRun {
         let continuum = HingedBeam::new(p)?;
         let tau1 = p.tau1();
         let dt = spec.dt_tau1 * tau1;
-        let kt = p.kt;
-        let n_check = scene.sampling.modes;
         let profile_x: Vec<f64> = scene
             .sampling
             .profile_points
@@ -314,10 +626,15 @@ impl LinearRun {
             .iter()
             .map(|&x| continuum.profile_variance(x))
             .collect();
-        let components = scene.dims - 1;
-        let steps = |t: f64| (t / dt).round() as u64;
-
-        let (model, modes, profile_discrete, two_time, max_rate) = match scene.model {
+        let setup = Setup {
+            scene,
+            spec,
+            continuum,
+            tau1,
+            dt,
+            profile_x,
+        };
+        let prepared = match scene.model {
             ModelKind::Compression => {
                 return Err(Error::invalid(
                     "model",
@@ -325,157 +642,10 @@ impl LinearRun {
                     "fem or spectral for a linear run",
                 ));
             }
-            ModelKind::Spectral => {
-                let n_modes = scene.mesh.elements;
-                let mut refs = Vec::new();
-                for n in 1..=n_check {
-                    let rate = continuum.mode_rate(n);
-                    let var = continuum.mode_variance(n);
-                    refs.push(ModeReference {
-                        n,
-                        variance_discrete: var,
-                        variance_equipartition: var,
-                        variance_continuum: var,
-                        multiplier: (-rate * dt).exp(),
-                        rate_discrete: Some(rate),
-                        rate_continuum: rate,
-                    });
-                }
-                // The simulator carries n_modes modes: its exact profile is the truncated sum.
-                let profile_discrete = profile_x
-                    .iter()
-                    .map(|&x| continuum.profile_variance_series(x, n_modes).value)
-                    .collect();
-                let mut tt = Vec::new();
-                for q in &scene.sampling.two_time {
-                    let (x, y) = (q[0] * p.length, q[1] * p.length);
-                    let (ts, es) = (steps(q[2] * tau1), steps(q[3] * tau1));
-                    let (t, eta) = (ts as f64 * dt, es as f64 * dt);
-                    tt.push(TwoTimeReference {
-                        x,
-                        y,
-                        t,
-                        eta,
-                        t_step: ts,
-                        eta_step: es,
-                        discrete: continuum
-                            .correlation_truncated(x, y, t, eta, n_modes)?
-                            .value,
-                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
-                    });
-                }
-                let max_rate = continuum.mode_rate(n_modes);
-                (
-                    Model::Spectral {
-                        beam: continuum,
-                        n_modes,
-                    },
-                    refs,
-                    profile_discrete,
-                    tt,
-                    max_rate,
-                )
-            }
-            ModelKind::Fem => {
-                let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
-                // An explicit step above its limit fails at once (λ_max by an O(n)
-                // inertia bisection), before the O(n³) eigen-decomposition.
-                if spec.integrator.stability_limit(1.0).is_some() {
-                    build_integrator(
-                        spec.integrator,
-                        &beam,
-                        spec.noise,
-                        dt,
-                        beam.max_rate()?,
-                        None,
-                    )?;
-                }
-                let gm = generalized_modes(&beam)?;
-                let max_rate = gm.rates[gm.rates.len() - 1];
-                // Fails early with the stability limit if the step is too large.
-                build_integrator(spec.integrator, &beam, spec.noise, dt, max_rate, Some(&gm))?;
-                let sigma_zeta = NoiseGenerator::new(spec.noise, &beam)?.covariance();
-                let sigma_q = modal_noise_covariance(&gm, &sigma_zeta);
-                let (m, g): (Vec<f64>, Vec<f64>) = gm
-                    .rates
-                    .iter()
-                    .map(|&r| spec.integrator.modal_form(r, dt, kt))
-                    .unzip();
-                let s = discrete_stationary_covariance(&sigma_q, &m, &g)?;
-                let mut refs = Vec::new();
-                for i in 0..n_check {
-                    let n = i + 1;
-                    let rate = gm.rates[i];
-                    refs.push(ModeReference {
-                        n,
-                        variance_discrete: s[(i, i)],
-                        variance_equipartition: kt / rate,
-                        variance_continuum: kt / continuum.mode_rate(n),
-                        multiplier: m[i],
-                        rate_discrete: (m[i] > 0.0).then(|| -m[i].ln() / dt),
-                        rate_continuum: continuum.mode_rate(n),
-                    });
-                }
-                // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
-                let probe = |x: f64| modal_probe(&beam, &gm.vectors, x);
-                let profile_discrete = profile_x
-                    .iter()
-                    .map(|&x| {
-                        let a = probe(x);
-                        (a.transpose() * &s * &a)[(0, 0)]
-                    })
-                    .collect();
-                let mut tt = Vec::new();
-                for q in &scene.sampling.two_time {
-                    let (x, y) = (q[0] * p.length, q[1] * p.length);
-                    let (ts, es) = (steps(q[2] * tau1).max(1), steps(q[3] * tau1).max(1));
-                    let (t, eta) = (ts as f64 * dt, es as f64 * dt);
-                    // From rest: S_k,ij = g_i g_j Σq_ij (1 − (m_i m_j)^k)/(1 − m_i m_j), then
-                    // ⟨q(η) q(t)ᵀ⟩ = diag(m^{η−t}) S_t.
-                    let n = gm.rates.len();
-                    let mut st = DMatrix::zeros(n, n);
-                    for i in 0..n {
-                        for j in 0..n {
-                            let mm = m[i] * m[j];
-                            let transient = if mm == 1.0 {
-                                0.0
-                            } else {
-                                1.0 - mm.powf(ts as f64)
-                            };
-                            st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * transient / (1.0 - mm)
-                                * m[i].powf((es - ts) as f64);
-                        }
-                    }
-                    let (ax, ay) = (probe(x), probe(y));
-                    tt.push(TwoTimeReference {
-                        x,
-                        y,
-                        t,
-                        eta,
-                        t_step: ts,
-                        eta_step: es,
-                        discrete: (ay.transpose() * &st * &ax)[(0, 0)],
-                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
-                    });
-                }
-                let projector = gm.projector(&beam, n_check);
-                let keep_modes = spec.integrator == IntegratorKind::ExactModal;
-                (
-                    Model::Fem {
-                        beam: Box::new(beam),
-                        modes: keep_modes.then_some(gm),
-                        projector,
-                        noise: spec.noise,
-                        integrator: spec.integrator,
-                    },
-                    refs,
-                    profile_discrete,
-                    tt,
-                    max_rate,
-                )
-            }
+            ModelKind::Spectral => setup.spectral()?,
+            ModelKind::Fem => setup.fem()?,
         };
-
+        let modes = prepared.modes;
         // Each mode is sampled about twice per relaxation time; the profile four times
         // per relaxation time of mode 1.
         let every = |rate: f64| ((0.5 / rate) / dt).floor().max(1.0) as u64;
@@ -484,23 +654,23 @@ impl LinearRun {
             .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))
             .collect();
         let profile_every = every(4.0 * modes[0].rate_discrete.unwrap_or(modes[0].rate_continuum));
-        let burn_in_steps = steps(scene.sampling.burn_in_tau1 * tau1);
+        let burn_in_steps = setup.steps(scene.sampling.burn_in_tau1 * tau1);
         Ok(LinearRun {
             spec: spec.clone(),
-            components,
+            components: scene.dims - 1,
             reference: LinearReference {
                 modes,
-                profile_x,
-                profile_discrete,
+                profile_x: setup.profile_x,
+                profile_discrete: prepared.profile_discrete,
                 profile_continuum,
-                two_time,
+                two_time: prepared.two_time,
                 dt,
-                max_rate,
+                max_rate: prepared.max_rate,
             },
             mode_every,
             profile_every,
             burn_in_steps,
-            model,
+            model: prepared.model,
         })
     }
 
@@ -569,15 +739,18 @@ impl LinearRun {
             } => Box::new(FemSampler {
                 beam,
                 projector,
-                integrator: build_integrator(
-                    *integrator,
-                    beam,
-                    *noise,
-                    self.reference.dt,
-                    self.reference.max_rate,
-                    modes.as_ref(),
-                )?,
-                states: vec![vec![0.0; beam.n_dofs()]; self.components],
+                filament: Components::at_rest(
+                    build_integrator(
+                        *integrator,
+                        beam,
+                        *noise,
+                        self.reference.dt,
+                        self.reference.max_rate,
+                        modes.as_ref(),
+                    )?,
+                    self.components,
+                    beam.n_dofs(),
+                ),
             }),
             Model::Spectral { beam, n_modes } => {
                 let mut sims = Vec::new();
@@ -603,25 +776,16 @@ impl LinearRun {
     pub fn trace(&self, rng: &mut TrajectoryRng, steps: u64, every: u64) -> Result<Vec<Vec<f64>>> {
         let mut sampler = self.sampler()?;
         let r = &self.reference;
-        let mut m = vec![0.0; self.components * r.modes.len()];
-        let mut p = vec![0.0; self.components * r.profile_x.len()];
-        let mut out = Vec::new();
-        for step in 1..=steps {
-            sampler.step(rng);
-            if !sampler.is_finite() {
-                return Err(Error::diverged(
-                    step,
-                    r.dt,
-                    format!("non-finite deflection with {}", self.spec.integrator),
-                ));
-            }
-            if step % every.max(1) == 0 {
-                sampler.modes(&mut m);
-                sampler.deflections(&r.profile_x, &mut p);
-                out.push(m.iter().chain(&p).copied().collect());
-            }
-        }
-        Ok(out)
+        let mut obs = TraceObserver {
+            profile_x: &r.profile_x,
+            m: vec![0.0; self.components * r.modes.len()],
+            p: vec![0.0; self.components * r.profile_x.len()],
+            out: Vec::new(),
+        };
+        Driver::new(r.dt, 0, steps, every).run(0, &mut *sampler, rng, &mut obs, |_| {
+            format!("non-finite deflection with {}", self.spec.integrator)
+        })?;
+        Ok(obs.out)
     }
 
     /// Simulates one trajectory from rest: burn-in (recording the two-time products on
@@ -637,83 +801,32 @@ impl LinearRun {
     ) -> Result<TrajectoryRecord> {
         let mut sampler = self.sampler()?;
         let r = &self.reference;
-        let nm = r.modes.len();
-        let c = self.components;
-        let np = r.profile_x.len();
-        let tt = &r.two_time;
-        let last_tt = tt.iter().map(|q| q.eta_step).max().unwrap_or(0);
-        let total = if sampled_steps == 0 {
+        let last_tt = r.two_time.iter().map(|q| q.eta_step).max().unwrap_or(0);
+        let burn_in = if sampled_steps == 0 {
             last_tt
         } else {
-            self.burn_in_steps.max(last_tt) + sampled_steps
+            self.burn_in_steps.max(last_tt)
         };
-        let start = total - sampled_steps;
-        let cap = |every: u64| ((sampled_steps / every) as usize).min(MAX_SAMPLES);
-        let mut rec = TrajectoryRecord {
-            modes: (0..c * nm)
-                .map(|k| Vec::with_capacity(cap(self.mode_every[k % nm])))
-                .collect(),
-            profile: vec![Vec::with_capacity(cap(self.profile_every)); c * np],
-            two_time: vec![0.0; c * tt.len()],
-            slope_squares: vec![0.0; self.n_nodes()],
-            slope_samples: 0,
-        };
-        // w(x, t) at the earlier time of each two-time point, per component.
-        let mut at_t = vec![0.0; c * tt.len()];
-        let mut buf_m = vec![0.0; c * nm];
-        let mut buf_p = vec![0.0; c * np];
-        let mut one = vec![0.0; c];
-        for step in 1..=total {
-            sampler.step(rng);
-            if !sampler.is_finite() {
-                return Err(Error::diverged(
-                    step,
+        // Every series' cadence is a multiple of the driver's.
+        let every = self
+            .mode_every
+            .iter()
+            .fold(self.profile_every, |g, &e| gcd(g, e));
+        let mut recorder = Recorder::new(self, sampled_steps);
+        Driver::new(r.dt, burn_in, sampled_steps, every).run(
+            0,
+            &mut *sampler,
+            rng,
+            &mut recorder,
+            |_| {
+                format!(
+                    "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
+                    self.spec.integrator,
                     r.dt,
-                    format!(
-                        "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
-                        self.spec.integrator,
-                        r.dt,
-                        r.max_rate * r.dt
-                    ),
-                ));
-            }
-            for (j, q) in tt.iter().enumerate() {
-                if step == q.t_step {
-                    sampler.deflections(&[q.x], &mut one);
-                    for k in 0..c {
-                        at_t[k * tt.len() + j] = one[k];
-                    }
-                }
-                if step == q.eta_step {
-                    sampler.deflections(&[q.y], &mut one);
-                    for k in 0..c {
-                        rec.two_time[k * tt.len() + j] = at_t[k * tt.len() + j] * one[k];
-                    }
-                }
-            }
-            if step <= start {
-                continue;
-            }
-            let since = step - start;
-            if self.mode_every.iter().any(|&e| since.is_multiple_of(e)) {
-                sampler.modes(&mut buf_m);
-                for (k, s) in rec.modes.iter_mut().enumerate() {
-                    if since.is_multiple_of(self.mode_every[k % nm]) && s.len() < MAX_SAMPLES {
-                        s.push(buf_m[k]);
-                    }
-                }
-            }
-            if since.is_multiple_of(self.profile_every)
-                && rec.profile.first().is_some_and(|s| s.len() < MAX_SAMPLES)
-            {
-                sampler.deflections(&r.profile_x, &mut buf_p);
-                for (s, v) in rec.profile.iter_mut().zip(&buf_p) {
-                    s.push(*v);
-                }
-                sampler.add_slope_squares(&mut rec.slope_squares);
-                rec.slope_samples += 1;
-            }
-        }
-        Ok(rec)
+                    r.max_rate * r.dt
+                )
+            },
+        )?;
+        Ok(recorder.rec)
     }
 }

@@ -33,7 +33,9 @@
 //! Each cell has its own seed (derived from the scene seed and the cell's label) and its
 //! trajectories their own streams, so results do not depend on the thread count.
 
-use crate::dynamics::{Integrator, IntegratorKind, ThetaScheme, build_integrator};
+use crate::dynamics::{
+    Components, Driver, Family, Integrator, IntegratorKind, Observer, ThetaScheme, build_integrator,
+};
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
@@ -54,7 +56,7 @@ pub const DEFAULT_ELEMENTS: [usize; 4] = [5, 10, 20, 40];
 /// (a = 2), and far beyond it.
 pub const DEFAULT_DT_LAMBDA_MAX: [f64; 7] = [0.1, 1.0, 1.9, 2.1, 10.0, 1.0e3, 1.0e5];
 /// Default integrators: every linear one.
-pub const DEFAULT_INTEGRATORS: [IntegratorKind; 4] = IntegratorKind::ALL;
+pub const DEFAULT_INTEGRATORS: [IntegratorKind; 4] = IntegratorKind::LINEAR;
 /// Burn-in length in decays of the slowest checked mode (−ln|m| per step).
 pub const BURN_IN_DECAYS: f64 = 7.0;
 /// Sampled length in decays of the slowest checked mode.
@@ -291,138 +293,142 @@ fn checked_modes(rates: &[f64], mult: &[f64], burn_in: u64, sampled: u64) -> Vec
     out
 }
 
-/// Runs one cell.
-fn run_cell(
-    opts: &StabilityOptions,
-    kind: IntegratorKind,
-    elements: usize,
-    a: f64,
-) -> Result<Cell> {
-    let scene = &opts.scene;
-    let p = scene.filament;
-    let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
-    let gm = generalized_modes(&beam)?;
-    let rates: Vec<f64> = gm.rates.iter().copied().collect();
-    let n = rates.len();
-    let lmax = rates[n - 1];
-    let dt = a / lmax;
-    let kt = p.kt;
-    let mult: Vec<f64> = rates
-        .iter()
-        .map(|&r| kind.modal_form(r, dt, kt).0)
-        .collect();
-    let seed = derive_seed(
-        scene.seed,
-        &format!("stability/{}/{elements}/{a:e}", kind.name()),
-    );
-    let mut cell = Cell {
-        integrator: kind.name().to_string(),
-        elements,
-        dt_lambda_max: a,
-        dt_tau1: dt / p.tau1(),
-        max_multiplier: mult[n - 1],
-        status: Status::Stable,
-        detail: String::new(),
-        refused: None,
-        diverged_at: None,
-        unresolved_modes: 0,
-        predicted_max_bias: 0.0,
-        modes: Vec::new(),
-    };
-    let total = opts.burn_in_steps + opts.sampled_steps;
-    let worst = mult.iter().fold(0.0f64, |w, m| w.max(m.abs()));
-    let integrator = match build_integrator(
-        kind,
-        &beam,
-        NoiseModel::Consistent,
-        dt,
-        lmax,
-        Some(&gm),
-    ) {
-        Ok(i) => i,
-        Err(e @ Error::UnstableTimeStep { .. }) => {
-            cell.status = Status::Unstable;
-            cell.refused = Some(e.to_string());
-            // Forced run, bypassing the check, to show the refusal is warranted.
-            let theta = kind.theta().ok_or_else(|| Error::Numerical {
-                routine: "stability map".into(),
-                detail: format!("{kind} refused a step but is not a theta-scheme"),
-            })?;
-            let mut forced = ThetaScheme::new(&beam, NoiseModel::Consistent, theta, dt)?;
-            let mut rng = trajectory_rng(seed, 0);
-            let mut w = vec![0.0; n];
-            for step in 1..=total {
-                forced.step(&mut w, &mut rng);
-                if !w.iter().all(|v| v.is_finite()) {
-                    cell.diverged_at = Some(step);
-                    break;
-                }
+/// The model of one cell: the beam, its generalized modes, the step and the multipliers.
+struct CellModel {
+    beam: BeamModel,
+    gm: crate::fem::modal::GeneralizedModes,
+    rates: Vec<f64>,
+    dt: f64,
+    mult: Vec<f64>,
+    seed: u64,
+}
+
+impl CellModel {
+    /// The model of the cell (`kind`, `elements`, a = Δt·λ_max) and its empty [`Cell`].
+    fn new(
+        opts: &StabilityOptions,
+        kind: IntegratorKind,
+        elements: usize,
+        a: f64,
+    ) -> Result<(CellModel, Cell)> {
+        let scene = &opts.scene;
+        let p = scene.filament;
+        let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
+        let gm = generalized_modes(&beam)?;
+        let rates: Vec<f64> = gm.rates.iter().copied().collect();
+        let n = rates.len();
+        let lmax = rates[n - 1];
+        let dt = a / lmax;
+        let kt = p.kt;
+        let mult: Vec<f64> = rates
+            .iter()
+            .map(|&r| kind.modal_form(r, dt, kt).0)
+            .collect();
+        let seed = derive_seed(
+            scene.seed,
+            &format!("stability/{}/{elements}/{a:e}", kind.name()),
+        );
+        let cell = Cell {
+            integrator: kind.name().to_string(),
+            elements,
+            dt_lambda_max: a,
+            dt_tau1: dt / p.tau1(),
+            max_multiplier: mult[n - 1],
+            status: Status::Stable,
+            detail: String::new(),
+            refused: None,
+            diverged_at: None,
+            unresolved_modes: 0,
+            predicted_max_bias: 0.0,
+            modes: Vec::new(),
+        };
+        let model = CellModel {
+            beam,
+            gm,
+            rates,
+            dt,
+            mult,
+            seed,
+        };
+        Ok((model, cell))
+    }
+
+    /// λ_max.
+    fn max_rate(&self) -> f64 {
+        self.rates[self.rates.len() - 1]
+    }
+
+    /// The integrator of the cell, built with the tool's stability check.
+    fn integrator(&self, kind: IntegratorKind) -> Result<Box<dyn Integrator>> {
+        build_integrator(
+            kind,
+            &self.beam,
+            NoiseModel::Consistent,
+            self.dt,
+            self.max_rate(),
+            Some(&self.gm),
+        )
+    }
+
+    /// The θ-scheme run from rest bypassing the stability check (trajectory 0 of the cell):
+    /// the step at which the state overflowed, or `None` if it stayed finite.
+    fn forced_run(&self, opts: &StabilityOptions, kind: IntegratorKind) -> Result<Option<u64>> {
+        let theta = match kind.family() {
+            Family::Theta(theta) => theta,
+            Family::ExactModal | Family::Metropolis => {
+                return Err(Error::Numerical {
+                    routine: "stability map".into(),
+                    detail: format!("{kind} refused a step but is not a theta-scheme"),
+                });
             }
-            cell.detail = match cell.diverged_at {
-                Some(s) => format!(
-                    "|m| = {worst:.3} >= 1: refused before running; forced, the state overflowed at step {s}"
-                ),
-                None => format!(
-                    "|m| = {worst:.3} >= 1: refused before running; forced, still finite after {total} steps (growth too slow to overflow)"
-                ),
-            };
-            return Ok(cell);
-        }
-        Err(e) => return Err(e),
-    };
-    drop(integrator);
-    let modes = checked_modes(&rates, &mult, opts.burn_in_steps, opts.sampled_steps);
-    let n_resolvable = (0..n)
-        .filter(|&i| {
-            decay(mult[i]) * opts.burn_in_steps as f64 >= BURN_IN_DECAYS
-                && decay(mult[i]) * opts.sampled_steps as f64 >= MIN_SAMPLED_DECAYS
-        })
-        .count();
-    cell.unresolved_modes = n - n_resolvable;
-    let projector = gm.projector(&beam, n);
-    let rows: Vec<Vec<f64>> = modes
-        .iter()
-        .map(|&i| projector.row(i).iter().copied().collect())
-        .collect();
-    // Per trajectory: the sampled series of each checked mode.
-    let series = (0..opts.trajectories as u64)
-        .map(|j| -> Result<Vec<Vec<f64>>> {
-            let mut integ =
-                build_integrator(kind, &beam, NoiseModel::Consistent, dt, lmax, Some(&gm))?;
-            let mut rng = trajectory_rng(seed, j);
-            let mut w = vec![0.0; n];
-            let mut out = vec![Vec::with_capacity(opts.sampled_steps as usize); rows.len()];
-            for step in 1..=total {
-                integ.step(&mut w, &mut rng);
-                if !w.iter().all(|v| v.is_finite()) {
-                    return Err(Error::diverged(
-                        step,
-                        dt,
-                        format!("{kind} at dt*lambda_max = {a:e} with {elements} elements"),
-                    ));
-                }
-                if step > opts.burn_in_steps {
-                    for (s, r) in out.iter_mut().zip(&rows) {
-                        s.push(r.iter().zip(&w).map(|(x, y)| x * y).sum());
-                    }
-                }
-            }
-            Ok(out)
-        })
-        .collect::<Vec<_>>();
-    let mut per_traj = Vec::new();
-    for s in series {
-        match s {
-            Ok(s) => per_traj.push(s),
-            Err(e @ Error::Diverged { .. }) => {
-                cell.status = Status::Unstable;
-                cell.detail = format!("predicted stable (|m| = {worst:.3}) but diverged: {e}");
-                return Ok(cell);
-            }
-            Err(e) => return Err(e),
+        };
+        let forced = ThetaScheme::new(&self.beam, NoiseModel::Consistent, theta, self.dt)?;
+        let mut system = Components::at_rest(forced, 1, self.rates.len());
+        let driver = Driver::new(self.dt, opts.burn_in_steps, opts.sampled_steps, 1);
+        let mut rng = trajectory_rng(self.seed, 0);
+        match driver.run(0, &mut system, &mut rng, &mut (), |_| String::new()) {
+            Ok(()) => Ok(None),
+            Err(Error::Diverged { step, .. }) => Ok(Some(step)),
+            Err(e) => Err(e),
         }
     }
-    for (k, &i) in modes.iter().enumerate() {
+
+    /// Per trajectory, the sampled series of the checked modes (projection `rows`), or
+    /// that trajectory's error.
+    fn series(
+        &self,
+        opts: &StabilityOptions,
+        kind: IntegratorKind,
+        rows: &[Vec<f64>],
+        (elements, a): (usize, f64),
+    ) -> Vec<Result<Vec<Vec<f64>>>> {
+        let driver = Driver::new(self.dt, opts.burn_in_steps, opts.sampled_steps, 1);
+        (0..opts.trajectories)
+            .map(|j| -> Result<Vec<Vec<f64>>> {
+                let mut system = Components::at_rest(self.integrator(kind)?, 1, self.rates.len());
+                let mut rng = trajectory_rng(self.seed, j as u64);
+                let mut obs = ModeSeries {
+                    rows,
+                    out: vec![Vec::with_capacity(opts.sampled_steps as usize); rows.len()],
+                };
+                driver.run(j, &mut system, &mut rng, &mut obs, |_| {
+                    format!("{kind} at dt*lambda_max = {a:e} with {elements} elements")
+                })?;
+                Ok(obs.out)
+            })
+            .collect()
+    }
+
+    /// The measured stationary variance of mode `i` (series `k` of each trajectory in
+    /// `per_traj`) against the exact formula of `kind`.
+    fn mode_bias(
+        &self,
+        kind: IntegratorKind,
+        kt: f64,
+        per_traj: &[Vec<Vec<f64>>],
+        (k, i): (usize, usize),
+    ) -> Result<ModeBias> {
+        let (rates, dt) = (&self.rates, self.dt);
         let parts = per_traj
             .iter()
             .map(|t| stats::variance_with_error(&t[k], Some(0.0)))
@@ -439,11 +445,10 @@ fn run_cell(
             })?;
         let zf = stats::z_test(ratio, formula, se)?;
         let zb = stats::z_test(ratio, 1.0, se)?;
-        cell.predicted_max_bias = cell.predicted_max_bias.max((formula - 1.0).abs());
-        cell.modes.push(ModeBias {
+        Ok(ModeBias {
             mode: i + 1,
             lambda_dt: rates[i] * dt,
-            multiplier: mult[i],
+            multiplier: self.mult[i],
             measured_ratio: ratio,
             std_error: se,
             formula_ratio: formula,
@@ -452,9 +457,89 @@ fn run_cell(
             z_bias: zb.statistic,
             p_bias: zb.p_value,
             formula_rejected: false,
-        });
+        })
     }
-    cell.detail = undamped_note(&cell, &mult, total);
+}
+
+/// The observer of a cell's trajectories: the projections of the state on the checked
+/// modes (`rows`) at every sampled step.
+struct ModeSeries<'r> {
+    rows: &'r [Vec<f64>],
+    out: Vec<Vec<f64>>,
+}
+
+impl<I: Integrator> Observer<Components<I>> for ModeSeries<'_> {
+    fn on_sample(&mut self, _: usize, _: u64, system: &Components<I>) {
+        let w = &system.states[0];
+        for (s, r) in self.out.iter_mut().zip(self.rows) {
+            s.push(r.iter().zip(w).map(|(x, y)| x * y).sum());
+        }
+    }
+}
+
+/// Runs one cell.
+fn run_cell(
+    opts: &StabilityOptions,
+    kind: IntegratorKind,
+    elements: usize,
+    a: f64,
+) -> Result<Cell> {
+    let (model, mut cell) = CellModel::new(opts, kind, elements, a)?;
+    let (rates, mult) = (&model.rates, &model.mult);
+    let n = rates.len();
+    let total = opts.burn_in_steps + opts.sampled_steps;
+    let worst = mult.iter().fold(0.0f64, |w, m| w.max(m.abs()));
+    match model.integrator(kind) {
+        Ok(_) => {}
+        Err(e @ Error::UnstableTimeStep { .. }) => {
+            cell.status = Status::Unstable;
+            cell.refused = Some(e.to_string());
+            // Forced run, bypassing the check, to show the refusal is warranted.
+            cell.diverged_at = model.forced_run(opts, kind)?;
+            cell.detail = match cell.diverged_at {
+                Some(s) => format!(
+                    "|m| = {worst:.3} >= 1: refused before running; forced, the state overflowed at step {s}"
+                ),
+                None => format!(
+                    "|m| = {worst:.3} >= 1: refused before running; forced, still finite after {total} steps (growth too slow to overflow)"
+                ),
+            };
+            return Ok(cell);
+        }
+        Err(e) => return Err(e),
+    }
+    let modes = checked_modes(rates, mult, opts.burn_in_steps, opts.sampled_steps);
+    let n_resolvable = (0..n)
+        .filter(|&i| {
+            decay(mult[i]) * opts.burn_in_steps as f64 >= BURN_IN_DECAYS
+                && decay(mult[i]) * opts.sampled_steps as f64 >= MIN_SAMPLED_DECAYS
+        })
+        .count();
+    cell.unresolved_modes = n - n_resolvable;
+    let projector = model.gm.projector(&model.beam, n);
+    let rows: Vec<Vec<f64>> = modes
+        .iter()
+        .map(|&i| projector.row(i).iter().copied().collect())
+        .collect();
+    let mut per_traj = Vec::new();
+    for s in model.series(opts, kind, &rows, (elements, a)) {
+        match s {
+            Ok(s) => per_traj.push(s),
+            Err(e @ Error::Diverged { .. }) => {
+                cell.status = Status::Unstable;
+                cell.detail = format!("predicted stable (|m| = {worst:.3}) but diverged: {e}");
+                return Ok(cell);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    let kt = opts.scene.filament.kt;
+    for (k, &i) in modes.iter().enumerate() {
+        let m = model.mode_bias(kind, kt, &per_traj, (k, i))?;
+        cell.predicted_max_bias = cell.predicted_max_bias.max((m.formula_ratio - 1.0).abs());
+        cell.modes.push(m);
+    }
+    cell.detail = undamped_note(&cell, mult, total);
     Ok(cell)
 }
 
