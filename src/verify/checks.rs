@@ -483,29 +483,9 @@ fn spectrum_check(
     for s in series {
         let x = *s;
         let psd = stats::welch(x, dts, seg)?;
-        let (mut lo, mut nlo, mut hi, mut nhi) = (0.0, 0, 0.0, 0);
-        // Skip the DC bin (mean removal) and the Nyquist bin.
-        let interior = 1..psd.freqs.len() - 1;
-        for ((f, d), e) in psd.freqs[interior.clone()]
-            .iter()
-            .zip(&psd.density[interior.clone()])
-            .zip(&expected[interior])
-        {
-            let ratio = d / e;
-            if *f <= corner {
-                lo += ratio;
-                nlo += 1;
-            } else {
-                hi += ratio;
-                nhi += 1;
-            }
-        }
-        if nlo > 0 {
-            low.push(lo / nlo as f64);
-        }
-        if nhi > 0 {
-            high.push(hi / nhi as f64);
-        }
+        let (lo, hi) = band_ratios(&psd.freqs, &psd.density, &expected, corner);
+        low.extend(lo);
+        high.extend(hi);
         match &mut pooled {
             None => pooled = Some(psd.density.clone()),
             Some(p) => p.iter_mut().zip(&psd.density).for_each(|(a, b)| *a += b),
@@ -535,4 +515,35 @@ fn spectrum_check(
         ));
     }
     Ok(())
+}
+
+/// The mean Welch/exact ratio of one series' spectrum over the interior bins (no DC, no
+/// Nyquist bin) at or below `corner` and above it; `None` for a band without bins.
+fn band_ratios(
+    freqs: &[f64],
+    density: &[f64],
+    expected: &[f64],
+    corner: f64,
+) -> (Option<f64>, Option<f64>) {
+    let (mut lo, mut nlo, mut hi, mut nhi) = (0.0, 0, 0.0, 0);
+    // Skip the DC bin (mean removal) and the Nyquist bin.
+    let interior = 1..freqs.len() - 1;
+    for ((f, d), e) in freqs[interior.clone()]
+        .iter()
+        .zip(&density[interior.clone()])
+        .zip(&expected[interior])
+    {
+        let ratio = d / e;
+        if *f <= corner {
+            lo += ratio;
+            nlo += 1;
+        } else {
+            hi += ratio;
+            nhi += 1;
+        }
+    }
+    (
+        (nlo > 0).then(|| lo / nlo as f64),
+        (nhi > 0).then(|| hi / nhi as f64),
+    )
 }

@@ -271,6 +271,9 @@ fn run_compression_scene(
     Ok(summary)
 }
 
+/// The largest RMS slope of a compression run: (slope in rad, x/L, strain index).
+type RmsSlope = (f64, f64, usize);
+
 /// Simulates run `k` of a compression scene at the budget and adds its checks and note
 /// to `outputs`; returns its force estimates and its largest RMS slope (slope, x/L,
 /// strain index).
@@ -282,7 +285,7 @@ fn run_compression(
     opts: &VerifyOptions,
     bar: &ProgressBar,
     outputs: &mut SceneOutputs,
-) -> Result<(ForceEstimates, Option<(f64, f64, usize)>)> {
+) -> Result<(ForceEstimates, Option<RmsSlope>)> {
     let e = run.spec.ensemble(opts.budget);
     let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
     let records = run
@@ -315,7 +318,7 @@ fn compression_run_note(
     run: &CompressionRun,
     e: &Ensemble,
     est: &ForceEstimates,
-    slope: Option<(f64, f64, usize)>,
+    slope: Option<RmsSlope>,
 ) -> String {
     format!(
         "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
