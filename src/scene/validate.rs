@@ -11,7 +11,7 @@
 //!    `validate_run`): run name (a path component: non-empty `[A-Za-z0-9_-]`, unique),
 //!    integrator and noise, the run's own checks, `dt_tau1` and the ensemble of every
 //!    budget. What differs between models (allowed integrators, largest time step,
-//!    shortest duration) is stated by [`RunRules`];
+//!    shortest duration) is stated by the private `RunRules`;
 //! 4. the Δt-halving pair of a compression scene.
 //!
 //! Every error is an [`Error::Scene`] naming the file, the key, the value and the allowed

@@ -145,7 +145,7 @@ fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
 /// `records` are the full trajectories; `two_time` holds the two-time products of all
 /// trajectories (the full ones and the extra short ones). The results come in a fixed
 /// order whatever the order of `checks`: profile; then for each mode its variance,
-/// distribution, decay-rate and spectrum checks; then two-time (see [`Step`]). A kind
+/// distribution, decay-rate and spectrum checks; then two-time (the private `Step`). A kind
 /// listed twice runs once.
 ///
 /// # Errors
