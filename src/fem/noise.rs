@@ -14,7 +14,10 @@
 
 use super::banded::BandedCholesky;
 use super::beam::{BeamModel, ElementLoad};
+use super::mesh::Mesh;
+use super::modal::{generalized_modes, modal_noise_covariance};
 use crate::error::Result;
+use crate::params::FilamentParams;
 use nalgebra::DMatrix;
 use rand::RngExt;
 use rand_distr::StandardNormal;
@@ -168,6 +171,48 @@ impl NoiseGenerator {
     }
 }
 
+/// Stationary variance of the lowest `n_modes` discrete modes relative to equipartition
+/// (`kT/λ_i` of the discrete modes) under the paper's element-uniform noise (eq. 5), on
+/// uniform meshes of each element count in `elements`.
+///
+/// Pure theory from the exact discrete model, no simulation: with the generalized modes
+/// `K φ = λ C φ` normalized to `ΦᵀCΦ = I`, the ratio of mode `i` is the diagonal entry
+/// `(ΦᵀΣ_ζΦ)_ii` of the modal noise covariance
+/// ([`super::modal::modal_noise_covariance`]) with `Σ_ζ = Σ_e (ξ/h_e) b_e b_eᵀ`. It is
+/// the ratio under the continuous-time dynamics, so for any integrator whose
+/// consistent-noise variance is exact; consistent noise (`Σ_ζ = C`) gives exactly 1.
+///
+/// Returns one row per entry of `elements`, each with `n_modes` ratios; a mode the mesh
+/// does not have (`i ≥ 2N` free DOFs) is NaN.
+///
+/// # Errors
+/// Invalid element count or filament parameters ([`Mesh::uniform`], [`BeamModel::new`]);
+/// [`crate::Error::Numerical`] if the eigensolver fails.
+pub fn element_uniform_variance_ratios(
+    params: &FilamentParams,
+    elements: &[usize],
+    n_modes: usize,
+) -> Result<Vec<Vec<f64>>> {
+    elements
+        .iter()
+        .map(|&ne| {
+            let beam = BeamModel::new(*params, Mesh::uniform(params.length, ne)?)?;
+            let gm = generalized_modes(&beam)?;
+            let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &beam)?.covariance();
+            let sq = modal_noise_covariance(&gm, &sigma_zeta);
+            Ok((0..n_modes)
+                .map(|i| {
+                    if i < gm.rates.len() {
+                        sq[(i, i)]
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect())
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,5 +226,18 @@ mod tests {
         let m: NoiseModel = serde_json::from_str("\"consistent\"").unwrap();
         assert_eq!(m, NoiseModel::Consistent);
         assert!(serde_json::from_str::<NoiseModel>("\"uniform\"").is_err());
+    }
+
+    #[test]
+    fn element_uniform_ratios_below_one_and_converging() {
+        let params = FilamentParams::default();
+        let r = element_uniform_variance_ratios(&params, &[1, 10, 40], 3).unwrap();
+        assert_eq!(r.len(), 3);
+        // One hinged element has 2 free DOFs: the third mode does not exist.
+        assert!(r[0][2].is_nan());
+        for i in 0..3 {
+            assert!(r[1][i] < 1.0 && r[1][i] > 0.5, "{:?}", r[1]);
+            assert!(1.0 - r[2][i] < 1.0 - r[1][i], "{r:?}");
+        }
     }
 }

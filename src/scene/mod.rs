@@ -1,8 +1,11 @@
 //! Scenes: one physical set-up plus its discretization, ensembles per budget and checks
 //! (`verification/*.toml`), and the preparation of its runs.
 //!
-//! - [`spec`]: the scene types ([`Scene`], [`RunSpec`], [`CompressionSpec`], …), loading
-//!   and validation.
+//! - [`spec`]: the scene types ([`Scene`], [`RunSpec`], [`CompressionSpec`], …) and
+//!   loading.
+//! - [`validate`]: the one validator of linear and compression scenes
+//!   ([`Scene::validate`]), with one per-run check shared by both and one check of every
+//!   name that becomes a path component of the outputs ([`validate::is_path_name`]).
 //! - [`linear`]: a prepared run of a linear scene ([`linear::LinearRun`]): model, exact
 //!   references and sampling plan, and the simulation of one trajectory.
 //! - [`compression`]: a prepared run of a compression scene
@@ -14,6 +17,7 @@
 pub mod compression;
 pub mod linear;
 pub mod spec;
+pub mod validate;
 
 pub use spec::{
     Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, RunSpec, Sampling, Scene,

@@ -70,162 +70,299 @@ fn thin(series: &[&[f64]], stride: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The data of one linear run the checks read, and what they produce.
+struct LinearContext<'a> {
+    /// The run (model, exact references, sampling plan).
+    run: &'a LinearRun,
+    /// The full trajectories.
+    records: &'a [TrajectoryRecord],
+    /// Two-time products of all trajectories (full and extra short ones).
+    two_time: &'a [Vec<f64>],
+    /// The check results, in the order of `summary.json`.
+    out: Vec<CheckResult>,
+    /// Estimates for tables and figures.
+    est: LinearEstimates,
+}
+
+/// The data of mode `i` the per-mode checks read, and its estimate.
+struct ModeData<'a> {
+    /// Mode index (0-based).
+    i: usize,
+    /// The mode's series, one per trajectory and component.
+    series: Vec<&'a [f64]>,
+    /// Effectively independent samples: every `stride`-th sample of each series.
+    thinned: Vec<f64>,
+    /// The thinning stride (samples).
+    stride: usize,
+    /// Time between samples of the series.
+    dt_sample: f64,
+    /// The mode's estimates, filled by the checks.
+    me: ModeEstimate,
+}
+
+/// A check run once per run.
+type RunCheck = fn(&mut LinearContext<'_>) -> Result<()>;
+/// A check run once per mode.
+type ModeCheck = fn(&mut LinearContext<'_>, &mut ModeData<'_>) -> Result<()>;
+
+/// When a linear check runs, which also fixes the order of its results in `summary.json`:
+/// the run-wide checks before the modes, then mode by mode the per-mode checks (in the
+/// order of their rank), then the run-wide checks after the modes.
+enum Step {
+    /// Once per run, before the per-mode checks.
+    BeforeModes(RunCheck),
+    /// Once per mode; the rank orders the checks within a mode.
+    PerMode(u8, ModeCheck),
+    /// Once per run, after the per-mode checks.
+    AfterModes(RunCheck),
+}
+
+/// The step of a check kind on a linear run: the one dispatch over [`CheckKind`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a compression check (refused for linear scenes by
+/// [`crate::scene::Scene::validate`], so not reached from a scene file).
+fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
+    Ok(match kind {
+        CheckKind::Profile => Step::BeforeModes(profile_check),
+        CheckKind::ModeVariance => Step::PerMode(0, mode_variance_check),
+        CheckKind::ModeDistribution => Step::PerMode(1, mode_distribution_check),
+        CheckKind::DecayRate => Step::PerMode(2, decay_rate_check),
+        CheckKind::Spectrum => Step::PerMode(3, spectrum_checks),
+        CheckKind::TwoTime => Step::AfterModes(two_time_check),
+        CheckKind::ForceStrain | CheckKind::ForceDistribution | CheckKind::DtHalving => {
+            return Err(Error::invalid(
+                format!("checks of run {}", run.spec.name),
+                format!("{kind:?}"),
+                "linear checks only (a compression check needs model = \"compression\")",
+            ));
+        }
+    })
+}
+
 /// Runs the requested checks of one linear run on the recorded trajectories.
 ///
 /// `records` are the full trajectories; `two_time` holds the two-time products of all
-/// trajectories (the full ones and the extra short ones).
+/// trajectories (the full ones and the extra short ones). The results come in a fixed
+/// order whatever the order of `checks`: profile; then for each mode its variance,
+/// distribution, decay-rate and spectrum checks; then two-time (the private `Step`). A kind
+/// listed twice runs once.
 ///
 /// # Errors
-/// Propagates estimator errors (e.g. too few samples for the budget).
+/// Propagates estimator errors (e.g. too few samples for the budget); a compression check
+/// kind is an error.
 pub fn linear_checks(
     run: &LinearRun,
     checks: &[CheckKind],
     records: &[TrajectoryRecord],
     two_time: &[Vec<f64>],
 ) -> Result<(Vec<CheckResult>, LinearEstimates)> {
-    let r = &run.reference;
-    let prefix = &run.spec.name;
-    let nm = r.modes.len();
-    let c = run.components;
-    let mut out = Vec::new();
-    let mut est = LinearEstimates::default();
-
-    // Series of mode i (0-based), one per trajectory and component.
-    let mode_series = |i: usize| -> Vec<&[f64]> {
-        records
-            .iter()
-            .flat_map(|t| (0..c).map(move |k| t.modes[k * nm + i].as_slice()))
-            .collect()
-    };
-
-    if checks.contains(&CheckKind::Profile) {
-        let np = r.profile_x.len();
-        for j in 0..np {
-            // Per series: mean of w² with an autocorrelation-aware error (integrated
-            // autocorrelation time); series are independent, so errors add in quadrature.
-            let mut parts = Vec::new();
-            for t in records {
-                for k in 0..c {
-                    let sq: Vec<f64> = t.profile[k * np + j].iter().map(|w| w * w).collect();
-                    parts.push(stats::mean_with_error(&sq)?);
-                }
-            }
-            let (mean, se) = stats::combine_independent(&parts);
-            let means: Vec<f64> = parts.iter().map(|m| m.mean).collect();
-            let between = stats::ensemble_mean(&means)?;
-            let o = stats::z_test(mean, r.profile_discrete[j], se)?;
-            let x = r.profile_x[j];
-            out.push(check(
-                format!("{prefix}/profile/x={x:.4}"),
-                "z-test",
-                (mean, r.profile_discrete[j], se),
-                &o,
-                Some(r.profile_continuum[j]),
-                format!(
-                    "<w^2(x)> over {} series (IAT error); between-series error {:.3e}",
-                    means.len(),
-                    between.std_error
-                ),
-            ));
-            est.profile.push((mean, se));
+    let (mut before, mut per_mode, mut after) = (Vec::new(), Vec::new(), Vec::new());
+    let mut seen = Vec::new();
+    for &kind in checks {
+        if seen.contains(&kind) {
+            continue;
+        }
+        seen.push(kind);
+        match linear_step(run, kind)? {
+            Step::BeforeModes(f) => before.push(f),
+            Step::PerMode(rank, f) => per_mode.push((rank, f)),
+            Step::AfterModes(f) => after.push(f),
         }
     }
+    per_mode.sort_by_key(|(rank, _)| *rank);
+    let mut ctx = LinearContext {
+        run,
+        records,
+        two_time,
+        out: Vec::new(),
+        est: LinearEstimates::default(),
+    };
+    for f in before {
+        f(&mut ctx)?;
+    }
+    for i in 0..run.reference.modes.len() {
+        let mut mode = mode_data(run, records, i);
+        for (_, f) in &per_mode {
+            f(&mut ctx, &mut mode)?;
+        }
+        ctx.est.modes.push(mode.me);
+    }
+    for f in after {
+        f(&mut ctx)?;
+    }
+    Ok((ctx.out, ctx.est))
+}
 
-    for (i, mr) in r.modes.iter().enumerate() {
-        let series = mode_series(i);
-        let mut me = ModeEstimate {
+/// The series of mode `i` (one per trajectory and component), thinned so that the lag
+/// correlation between kept samples is at most [`MAX_THINNED_CORRELATION`].
+fn mode_data<'a>(run: &LinearRun, records: &'a [TrajectoryRecord], i: usize) -> ModeData<'a> {
+    let nm = run.reference.modes.len();
+    let c = run.components;
+    let mr = &run.reference.modes[i];
+    let series: Vec<&[f64]> = records
+        .iter()
+        .flat_map(|t| (0..c).map(move |k| t.modes[k * nm + i].as_slice()))
+        .collect();
+    // Samples between effectively independent samples of this mode.
+    let rho_sample = mr.multiplier.abs().powf(run.mode_every[i] as f64);
+    let stride = if rho_sample <= MAX_THINNED_CORRELATION {
+        1
+    } else {
+        (MAX_THINNED_CORRELATION.ln() / rho_sample.ln()).ceil() as usize
+    };
+    let thinned = thin(&series, stride);
+    ModeData {
+        i,
+        series,
+        thinned,
+        stride,
+        dt_sample: run.mode_dt(i),
+        me: ModeEstimate {
             n: mr.n,
             rate: (f64::NAN, f64::NAN),
             ..Default::default()
-        };
-        let dt_sample = run.mode_dt(i);
-        // Samples between effectively independent samples of this mode.
-        let rho_sample = mr.multiplier.abs().powf(run.mode_every[i] as f64);
-        let stride = if rho_sample <= MAX_THINNED_CORRELATION {
-            1
-        } else {
-            (MAX_THINNED_CORRELATION.ln() / rho_sample.ln()).ceil() as usize
-        };
-        let thinned = thin(&series, stride);
+        },
+    }
+}
 
-        if checks.contains(&CheckKind::ModeVariance) {
-            let parts = series
-                .iter()
-                .map(|s| stats::variance_with_error(s, Some(0.0)))
-                .collect::<Result<Vec<_>>>()?;
-            let (mean, se) = stats::combine_independent(&parts);
-            me.variance = (mean, se);
-            let o = stats::z_test(mean, mr.variance_discrete, se)?;
-            out.push(check(
-                format!("{prefix}/mode-variance/n={}", mr.n),
-                "z-test",
-                (mean, mr.variance_discrete, se),
-                &o,
-                Some(mr.variance_continuum),
-                format!(
-                    "time average of q^2 over {} series, IAT error; ratio to equipartition {:.4}",
-                    series.len(),
-                    mean / mr.variance_equipartition
-                ),
-            ));
-            let o = stats::chi2_variance_test(&thinned, mr.variance_discrete, Some(0.0))?;
-            let s2 = thinned.iter().map(|q| q * q).sum::<f64>() / thinned.len() as f64;
-            out.push(check(
-                format!("{prefix}/mode-variance-chi2/n={}", mr.n),
-                "chi2-variance",
-                (
-                    s2,
-                    mr.variance_discrete,
-                    mr.variance_discrete * (2.0 / thinned.len() as f64).sqrt(),
-                ),
-                &o,
-                Some(mr.variance_continuum),
-                format!(
-                    "{} samples spaced {stride} samples apart (lag correlation <= 0.01)",
-                    thinned.len()
-                ),
-            ));
+/// [`CheckKind::Profile`]: ⟨w²(x)⟩ at every profile point against the exact discrete
+/// profile (z-test).
+fn profile_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let r = &ctx.run.reference;
+    let prefix = &ctx.run.spec.name;
+    let c = ctx.run.components;
+    let np = r.profile_x.len();
+    for j in 0..np {
+        // Per series: mean of w² with an autocorrelation-aware error (integrated
+        // autocorrelation time); series are independent, so errors add in quadrature.
+        let mut parts = Vec::new();
+        for t in ctx.records {
+            for k in 0..c {
+                let sq: Vec<f64> = t.profile[k * np + j].iter().map(|w| w * w).collect();
+                parts.push(stats::mean_with_error(&sq)?);
+            }
         }
+        let (mean, se) = stats::combine_independent(&parts);
+        let means: Vec<f64> = parts.iter().map(|m| m.mean).collect();
+        let between = stats::ensemble_mean(&means)?;
+        let o = stats::z_test(mean, r.profile_discrete[j], se)?;
+        let x = r.profile_x[j];
+        ctx.out.push(check(
+            format!("{prefix}/profile/x={x:.4}"),
+            "z-test",
+            (mean, r.profile_discrete[j], se),
+            &o,
+            Some(r.profile_continuum[j]),
+            format!(
+                "<w^2(x)> over {} series (IAT error); between-series error {:.3e}",
+                means.len(),
+                between.std_error
+            ),
+        ));
+        ctx.est.profile.push((mean, se));
+    }
+    Ok(())
+}
 
-        if checks.contains(&CheckKind::ModeDistribution) {
-            let sd = mr.variance_discrete.sqrt();
-            let o = stats::ks_normal(&thinned, 0.0, sd)?;
-            out.push(check(
-                format!("{prefix}/mode-ks/n={}", mr.n),
-                "ks",
-                (o.statistic, f64::NAN, f64::NAN),
-                &o,
-                None,
-                format!(
-                    "KS distance to N(0, {:.4e}) over {} thinned samples",
-                    mr.variance_discrete,
-                    thinned.len()
-                ),
-            ));
-            let bins = (thinned.len() / 10).clamp(4, 20);
-            let o = stats::chi2_gof_normal(&thinned, 0.0, sd, bins)?;
-            out.push(check(
-                format!("{prefix}/mode-chi2-gof/n={}", mr.n),
-                "chi2-gof",
-                (o.statistic, o.dof.unwrap_or(f64::NAN), f64::NAN),
-                &o,
-                None,
-                format!(
-                    "chi^2 over {bins} equiprobable bins, {} thinned samples",
-                    thinned.len()
-                ),
-            ));
-        }
+/// [`CheckKind::ModeVariance`]: the stationary variance of a mode against the exact
+/// discrete variance, by an autocorrelation-aware z-test and a χ² test on thinned samples.
+fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
+    let mr = &ctx.run.reference.modes[m.i];
+    let prefix = &ctx.run.spec.name;
+    let parts = m
+        .series
+        .iter()
+        .map(|s| stats::variance_with_error(s, Some(0.0)))
+        .collect::<Result<Vec<_>>>()?;
+    let (mean, se) = stats::combine_independent(&parts);
+    m.me.variance = (mean, se);
+    let o = stats::z_test(mean, mr.variance_discrete, se)?;
+    ctx.out.push(check(
+        format!("{prefix}/mode-variance/n={}", mr.n),
+        "z-test",
+        (mean, mr.variance_discrete, se),
+        &o,
+        Some(mr.variance_continuum),
+        format!(
+            "time average of q^2 over {} series, IAT error; ratio to equipartition {:.4}",
+            m.series.len(),
+            mean / mr.variance_equipartition
+        ),
+    ));
+    let thinned = &m.thinned;
+    let o = stats::chi2_variance_test(thinned, mr.variance_discrete, Some(0.0))?;
+    let s2 = thinned.iter().map(|q| q * q).sum::<f64>() / thinned.len() as f64;
+    ctx.out.push(check(
+        format!("{prefix}/mode-variance-chi2/n={}", mr.n),
+        "chi2-variance",
+        (
+            s2,
+            mr.variance_discrete,
+            mr.variance_discrete * (2.0 / thinned.len() as f64).sqrt(),
+        ),
+        &o,
+        Some(mr.variance_continuum),
+        format!(
+            "{} samples spaced {} samples apart (lag correlation <= 0.01)",
+            thinned.len(),
+            m.stride
+        ),
+    ));
+    Ok(())
+}
 
-        if checks.contains(&CheckKind::DecayRate)
-            && let Some(rate_ref) = mr.rate_discrete
-        {
-            // The series has about two samples per relaxation time.
-            match stats::decay_rate(&series, dt_sample, Some(0.0), CONFIDENCE) {
-                Ok(re) => {
-                    me.rate = (re.rate, re.std_error);
-                    let o = stats::z_test(re.rate, rate_ref, re.std_error)?;
-                    out.push(check(
+/// [`CheckKind::ModeDistribution`]: the amplitude distribution of a mode against the
+/// normal law of the exact discrete variance (KS and χ² goodness of fit, thinned samples).
+fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
+    let mr = &ctx.run.reference.modes[m.i];
+    let prefix = &ctx.run.spec.name;
+    let thinned = &m.thinned;
+    let sd = mr.variance_discrete.sqrt();
+    let o = stats::ks_normal(thinned, 0.0, sd)?;
+    ctx.out.push(check(
+        format!("{prefix}/mode-ks/n={}", mr.n),
+        "ks",
+        (o.statistic, f64::NAN, f64::NAN),
+        &o,
+        None,
+        format!(
+            "KS distance to N(0, {:.4e}) over {} thinned samples",
+            mr.variance_discrete,
+            thinned.len()
+        ),
+    ));
+    let bins = (thinned.len() / 10).clamp(4, 20);
+    let o = stats::chi2_gof_normal(thinned, 0.0, sd, bins)?;
+    ctx.out.push(check(
+        format!("{prefix}/mode-chi2-gof/n={}", mr.n),
+        "chi2-gof",
+        (o.statistic, o.dof.unwrap_or(f64::NAN), f64::NAN),
+        &o,
+        None,
+        format!(
+            "chi^2 over {bins} equiprobable bins, {} thinned samples",
+            thinned.len()
+        ),
+    ));
+    Ok(())
+}
+
+/// [`CheckKind::DecayRate`]: the autocorrelation decay rate of a mode against the exact
+/// discrete rate (z-test), if the mode has one; skipped (noted) if the data cannot
+/// resolve it.
+fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
+    let mr = &ctx.run.reference.modes[m.i];
+    let prefix = &ctx.run.spec.name;
+    let Some(rate_ref) = mr.rate_discrete else {
+        return Ok(());
+    };
+    // The series has about two samples per relaxation time.
+    match stats::decay_rate(&m.series, m.dt_sample, Some(0.0), CONFIDENCE) {
+        Ok(re) => {
+            m.me.rate = (re.rate, re.std_error);
+            let o = stats::z_test(re.rate, rate_ref, re.std_error)?;
+            ctx.out.push(check(
                 format!("{prefix}/decay-rate/n={}", mr.n),
                 "z-test",
                 (re.rate, rate_ref, re.std_error),
@@ -236,52 +373,70 @@ pub fn linear_checks(
                     re.lag, re.n_blocks, re.ci_low, re.ci_high
                 ),
             ));
-                }
-                Err(e) => est
-                    .skipped
-                    .push(format!("{prefix}/decay-rate/n={}: {e}", mr.n)),
-            }
         }
-
-        if checks.contains(&CheckKind::Spectrum)
-            && mr.multiplier > 0.0
-            && let Err(e) = spectrum_check(run, i, &series, dt_sample, &mut me, &mut out)
-        {
-            {
-                est.skipped
-                    .push(format!("{prefix}/spectrum/n={}: {e}", mr.n));
-            }
-        }
-        est.modes.push(me);
+        Err(e) => ctx
+            .est
+            .skipped
+            .push(format!("{prefix}/decay-rate/n={}: {e}", mr.n)),
     }
+    Ok(())
+}
 
-    if checks.contains(&CheckKind::TwoTime) {
-        let nt = r.two_time.len();
-        for (j, q) in r.two_time.iter().enumerate() {
-            let values: Vec<f64> = two_time
-                .iter()
-                .flat_map(|t| (0..c).map(move |k| t[k * nt + j]))
-                .collect();
-            let m = stats::ensemble_mean(&values)?;
-            let o = stats::t_test(m.mean, q.discrete, m.std_error, values.len())?;
-            est.two_time.push((m.mean, m.std_error));
-            out.push(check(
-                format!(
-                    "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
-                    q.x, q.y, q.t, q.eta
-                ),
-                "t-test",
-                (m.mean, q.discrete, m.std_error),
-                &o,
-                Some(q.continuum),
-                format!(
-                    "eq. (4) from rest, ensemble of {} independent samples",
-                    values.len()
-                ),
-            ));
-        }
+/// [`CheckKind::Spectrum`]: the Welch spectrum of a mode with a positive multiplier
+/// against its exact expectation ([`spectrum_check`]); skipped (noted) if the series are
+/// too short.
+fn spectrum_checks(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
+    let mr = &ctx.run.reference.modes[m.i];
+    if mr.multiplier > 0.0
+        && let Err(e) = spectrum_check(
+            ctx.run,
+            m.i,
+            &m.series,
+            m.dt_sample,
+            &mut m.me,
+            &mut ctx.out,
+        )
+    {
+        let prefix = &ctx.run.spec.name;
+        ctx.est
+            .skipped
+            .push(format!("{prefix}/spectrum/n={}: {e}", mr.n));
     }
-    Ok((out, est))
+    Ok(())
+}
+
+/// [`CheckKind::TwoTime`]: the two-time correlation eq. (4) from rest at every two-time
+/// point against the exact discrete value (t-test over the ensemble).
+fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let r = &ctx.run.reference;
+    let prefix = &ctx.run.spec.name;
+    let c = ctx.run.components;
+    let nt = r.two_time.len();
+    for (j, q) in r.two_time.iter().enumerate() {
+        let values: Vec<f64> = ctx
+            .two_time
+            .iter()
+            .flat_map(|t| (0..c).map(move |k| t[k * nt + j]))
+            .collect();
+        let m = stats::ensemble_mean(&values)?;
+        let o = stats::t_test(m.mean, q.discrete, m.std_error, values.len())?;
+        ctx.est.two_time.push((m.mean, m.std_error));
+        ctx.out.push(check(
+            format!(
+                "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
+                q.x, q.y, q.t, q.eta
+            ),
+            "t-test",
+            (m.mean, q.discrete, m.std_error),
+            &o,
+            Some(q.continuum),
+            format!(
+                "eq. (4) from rest, ensemble of {} independent samples",
+                values.len()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Spectrum of mode `i` against the exact expectation of the Welch estimator for the
@@ -328,29 +483,9 @@ fn spectrum_check(
     for s in series {
         let x = *s;
         let psd = stats::welch(x, dts, seg)?;
-        let (mut lo, mut nlo, mut hi, mut nhi) = (0.0, 0, 0.0, 0);
-        // Skip the DC bin (mean removal) and the Nyquist bin.
-        let interior = 1..psd.freqs.len() - 1;
-        for ((f, d), e) in psd.freqs[interior.clone()]
-            .iter()
-            .zip(&psd.density[interior.clone()])
-            .zip(&expected[interior])
-        {
-            let ratio = d / e;
-            if *f <= corner {
-                lo += ratio;
-                nlo += 1;
-            } else {
-                hi += ratio;
-                nhi += 1;
-            }
-        }
-        if nlo > 0 {
-            low.push(lo / nlo as f64);
-        }
-        if nhi > 0 {
-            high.push(hi / nhi as f64);
-        }
+        let (lo, hi) = band_ratios(&psd.freqs, &psd.density, &expected, corner);
+        low.extend(lo);
+        high.extend(hi);
         match &mut pooled {
             None => pooled = Some(psd.density.clone()),
             Some(p) => p.iter_mut().zip(&psd.density).for_each(|(a, b)| *a += b),
@@ -380,4 +515,35 @@ fn spectrum_check(
         ));
     }
     Ok(())
+}
+
+/// The mean Welch/exact ratio of one series' spectrum over the interior bins (no DC, no
+/// Nyquist bin) at or below `corner` and above it; `None` for a band without bins.
+fn band_ratios(
+    freqs: &[f64],
+    density: &[f64],
+    expected: &[f64],
+    corner: f64,
+) -> (Option<f64>, Option<f64>) {
+    let (mut lo, mut nlo, mut hi, mut nhi) = (0.0, 0, 0.0, 0);
+    // Skip the DC bin (mean removal) and the Nyquist bin.
+    let interior = 1..freqs.len() - 1;
+    for ((f, d), e) in freqs[interior.clone()]
+        .iter()
+        .zip(&density[interior.clone()])
+        .zip(&expected[interior])
+    {
+        let ratio = d / e;
+        if *f <= corner {
+            lo += ratio;
+            nlo += 1;
+        } else {
+            hi += ratio;
+            nhi += 1;
+        }
+    }
+    (
+        (nlo > 0).then(|| lo / nlo as f64),
+        (nhi > 0).then(|| hi / nhi as f64),
+    )
 }

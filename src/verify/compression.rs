@@ -2,7 +2,7 @@
 //! equilibrium theory of the same discretization, the distribution of F, and the Δt-halving
 //! check, each one small function.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::scene::CheckKind;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, ForceEstimates, ForceRecord,
@@ -13,10 +13,59 @@ use crate::verify::summary::CheckResult;
 /// Thinning of F samples for the KS test, in integrated autocorrelation times.
 const KS_THINNING_TAU: f64 = 10.0;
 
-/// The force–strain and force-distribution checks of one run.
+/// What the per-run compression checks read.
+struct CompressionInputs<'a> {
+    /// The run.
+    run: &'a CompressionRun,
+    /// The exact theory at every strain.
+    theory: &'a CompressionTheoryTable,
+    /// The force records per strain, one per trajectory.
+    records: &'a [Vec<ForceRecord>],
+    /// ⟨F⟩ per strain with its error.
+    est: &'a ForceEstimates,
+}
+
+/// A per-run compression check: appends its results.
+type CompressionCheck = fn(&CompressionInputs<'_>, &mut Vec<CheckResult>) -> Result<()>;
+
+/// The per-run check of a check kind on a compression run and its rank (the order of the
+/// results in `summary.json`): the one dispatch over [`CheckKind`]. `None` for
+/// [`CheckKind::DtHalving`], a check of the scene (two runs), which the runner makes with
+/// [`halving_check`] after all runs.
 ///
 /// # Errors
-/// Estimator errors.
+/// [`Error::InvalidParameter`] for a linear check (refused for compression scenes by
+/// [`crate::scene::Scene::validate`], so not reached from a scene file).
+fn compression_step(
+    run: &CompressionRun,
+    kind: CheckKind,
+) -> Result<Option<(u8, CompressionCheck)>> {
+    Ok(match kind {
+        CheckKind::ForceStrain => Some((0, force_strain_check)),
+        CheckKind::ForceDistribution => Some((1, force_distribution_check)),
+        // A scene-level check: see `halving_check`.
+        CheckKind::DtHalving => None,
+        CheckKind::Profile
+        | CheckKind::ModeVariance
+        | CheckKind::ModeDistribution
+        | CheckKind::DecayRate
+        | CheckKind::Spectrum
+        | CheckKind::TwoTime => {
+            return Err(Error::invalid(
+                format!("checks of run {}", run.spec.name),
+                format!("{kind:?}"),
+                "compression checks only (a linear check needs model = \"fem\" or \"spectral\")",
+            ));
+        }
+    })
+}
+
+/// The per-run checks of one compression run: force–strain, then force distribution,
+/// whatever the order of `checks` (a kind listed twice runs once; `dt-halving` is the
+/// runner's, see [`halving_check`]).
+///
+/// # Errors
+/// Estimator errors; a linear check kind.
 pub fn compression_checks(
     run: &CompressionRun,
     checks: &[CheckKind],
@@ -24,68 +73,97 @@ pub fn compression_checks(
     records: &[Vec<ForceRecord>],
     est: &ForceEstimates,
 ) -> Result<Vec<CheckResult>> {
-    let name = &run.spec.name;
-    let mut out = Vec::new();
-    if checks.contains(&CheckKind::ForceStrain) {
-        let mut z = Vec::new();
-        for (i, &(f, se)) in est.force.iter().enumerate() {
-            let o = stats::z_test(f, theory.discrete[i], se)?;
-            z.push(o.statistic);
-            out.push(CheckResult::statistical(
-                format!("{name}/force/strain_ratio={}", theory.strain_ratios[i]),
-                "z-test",
-                (f, theory.discrete[i], se),
-                Some(theory.continuum[i]),
-                o.p_value,
-                format!(
-                    "<F>/F_c0 over {} trajectories (IAT errors)",
-                    records[i].len()
-                ),
-            ));
+    let mut steps: Vec<(u8, CompressionCheck)> = Vec::new();
+    for &kind in checks {
+        if let Some((rank, f)) = compression_step(run, kind)?
+            && !steps.iter().any(|(r, _)| *r == rank)
+        {
+            steps.push((rank, f));
         }
-        let o = stats::chi2_sum_test(&z)?;
+    }
+    steps.sort_by_key(|(rank, _)| *rank);
+    let inputs = CompressionInputs {
+        run,
+        theory,
+        records,
+        est,
+    };
+    let mut out = Vec::new();
+    for (_, f) in steps {
+        f(&inputs, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// [`CheckKind::ForceStrain`]: ⟨F⟩ at every strain against the exact discrete theory
+/// (z-tests), and the sum of their squares against χ²(strains).
+fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> Result<()> {
+    let name = &x.run.spec.name;
+    let theory = x.theory;
+    let mut z = Vec::new();
+    for (i, &(f, se)) in x.est.force.iter().enumerate() {
+        let o = stats::z_test(f, theory.discrete[i], se)?;
+        z.push(o.statistic);
         out.push(CheckResult::statistical(
-            format!("{name}/force-strain-chi2"),
-            "chi2-sum",
-            (o.statistic, z.len() as f64, f64::NAN),
-            None,
+            format!("{name}/force/strain_ratio={}", theory.strain_ratios[i]),
+            "z-test",
+            (f, theory.discrete[i], se),
+            Some(theory.continuum[i]),
             o.p_value,
             format!(
-                "sum of squared z over {} strains against chi2({})",
-                z.len(),
-                z.len()
+                "<F>/F_c0 over {} trajectories (IAT errors)",
+                x.records[i].len()
             ),
         ));
     }
-    if checks.contains(&CheckKind::ForceDistribution) {
-        for (i, dist) in theory.distributions.iter().enumerate() {
-            let Some(dist) = dist else { continue };
-            // Thin each trajectory's series to effectively independent samples.
-            let mut samples = Vec::new();
-            let mut stride = 1;
-            for r in &records[i] {
-                let tau = stats::integrated_autocorrelation_time(&r.force_ratio)?.tau_int;
-                stride = stride.max((KS_THINNING_TAU * tau).ceil() as usize);
-            }
-            for r in &records[i] {
-                samples.extend(r.force_ratio.iter().step_by(stride).copied());
-            }
-            let fc0 = run.euler_load;
-            let o = stats::ks_test(&samples, |f| dist.cdf(f * fc0))?;
-            out.push(CheckResult::statistical(
-                format!("{name}/force-ks/strain_ratio={}", theory.strain_ratios[i]),
-                "ks",
-                (o.statistic, f64::NAN, f64::NAN),
-                None,
-                o.p_value,
-                format!(
-                    "{} samples thinned every {stride} (>= {KS_THINNING_TAU} IAT)",
-                    samples.len()
-                ),
-            ));
+    let o = stats::chi2_sum_test(&z)?;
+    out.push(CheckResult::statistical(
+        format!("{name}/force-strain-chi2"),
+        "chi2-sum",
+        (o.statistic, z.len() as f64, f64::NAN),
+        None,
+        o.p_value,
+        format!(
+            "sum of squared z over {} strains against chi2({})",
+            z.len(),
+            z.len()
+        ),
+    ));
+    Ok(())
+}
+
+/// [`CheckKind::ForceDistribution`]: the distribution of F at every strain with an exact
+/// law (`distribution_strain_ratios`), KS on samples thinned to [`KS_THINNING_TAU`]
+/// integrated autocorrelation times.
+fn force_distribution_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> Result<()> {
+    let name = &x.run.spec.name;
+    for (i, dist) in x.theory.distributions.iter().enumerate() {
+        let Some(dist) = dist else { continue };
+        // Thin each trajectory's series to effectively independent samples.
+        let mut samples = Vec::new();
+        let mut stride = 1;
+        for r in &x.records[i] {
+            let tau = stats::integrated_autocorrelation_time(&r.force_ratio)?.tau_int;
+            stride = stride.max((KS_THINNING_TAU * tau).ceil() as usize);
         }
+        for r in &x.records[i] {
+            samples.extend(r.force_ratio.iter().step_by(stride).copied());
+        }
+        let fc0 = x.run.euler_load;
+        let o = stats::ks_test(&samples, |f| dist.cdf(f * fc0))?;
+        out.push(CheckResult::statistical(
+            format!("{name}/force-ks/strain_ratio={}", x.theory.strain_ratios[i]),
+            "ks",
+            (o.statistic, f64::NAN, f64::NAN),
+            None,
+            o.p_value,
+            format!(
+                "{} samples thinned every {stride} (>= {KS_THINNING_TAU} IAT)",
+                samples.len()
+            ),
+        ));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The Δt-halving check: per strain z = (F_Δt − F_Δt/2)/sqrt(se² + se²), combined as

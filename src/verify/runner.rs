@@ -1,23 +1,35 @@
 //! The verification runner: runs scenes, applies the family-wise correction, writes
-//! `summary.json`, per-scene CSV tables and SVG figures, and `index.html`.
+//! `summary.json` and the per-scene CSV tables and SVG figures; it returns the
+//! [`Summary`], from which the CLI writes `index.html` ([`crate::report`]).
+//!
+//! # Outputs
+//! Under `--out`, `summary.json`, and for scene `<scene>` in `<scene>/`:
+//!
+//! - a linear scene, per run `<run>`: `<run>-modes.csv` and `.svg` (modal variance against
+//!   equipartition, when estimated), `<run>-mode-statistics.csv`, `<run>-rates.svg` (when
+//!   rates were estimated), `<run>-profile.csv`, `<run>-two-time.csv`,
+//!   `<run>-spectrum.csv` and `.svg` (when the checks produced them);
+//! - a `fem` scene with an element-uniform run: the element-count study of that noise
+//!   (theory only, [`element_uniform_variance_ratios`]), `element-uniform-vs-elements.csv`
+//!   and `.svg` and a note, written right after the outputs of the first such run;
+//! - a compression scene: `force-strain.csv` (first run), `<run>-force-strain.csv` (other
+//!   runs), `force-strain.svg`, and `fig2.svg` under `--out` with the first run of every
+//!   compression scene so far (one per dimension).
 
 use crate::dynamics::par_indexed;
 use crate::error::Result;
-use crate::fem::beam::BeamModel;
-use crate::fem::mesh::Mesh;
-use crate::fem::modal::{generalized_modes, modal_noise_covariance};
-use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
 use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::compression::{
-    CompressionRun, CompressionTheoryTable, force_estimates_diagnosed,
+    CompressionRun, CompressionTheoryTable, ForceEstimates, force_estimates_diagnosed,
 };
-use crate::scene::linear::{LinearRun, small_slope_warning};
-use crate::scene::{Budget, CheckKind, ModelKind, Scene};
+use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
+use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, Scene};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
-use crate::verify::summary::{SceneSummary, Summary};
+use crate::verify::summary::{CheckResult, SceneSummary, Summary};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -39,12 +51,14 @@ pub struct VerifyOptions {
 
 /// Element counts of the element-uniform noise study (theory only).
 const NOISE_STUDY_ELEMENTS: [usize; 6] = [5, 10, 20, 40, 80, 160];
+/// Modes of the element-uniform noise study (the columns `mode1` … `mode6`).
+const NOISE_STUDY_MODES: usize = 6;
 
 /// Runs every scene and writes the reports.
 ///
 /// # Errors
-/// Bad scene files ([`Error::Scene`]), time steps above a stability limit, diverging
-/// runs, I/O failures.
+/// Bad scene files ([`crate::Error::Scene`]), time steps above a stability limit,
+/// diverging runs, I/O failures.
 pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
     let scenes: Vec<Scene> = opts
         .scenes
@@ -52,63 +66,8 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
         .map(|p| Scene::load(p))
         .collect::<Result<_>>()?;
     // Prepare every run first so that bad input is reported before any long work.
-    let mut prepared = Vec::new();
-    for scene in &scenes {
-        prepared.push(match &scene.compression {
-            Some(comp) => {
-                let runs = scene
-                    .runs
-                    .iter()
-                    .enumerate()
-                    .map(|(i, spec)| {
-                        CompressionRun::prepare(scene, comp, spec)
-                            .map_err(|e| scene.run_error(i, "integrator", e))
-                    })
-                    .collect::<Result<_>>()?;
-                let theory = CompressionTheoryTable::new(scene, comp)
-                    .map_err(|e| scene.run_error(0, "integrator", e))?;
-                Prepared::Compression(theory, runs)
-            }
-            None => Prepared::Linear(
-                scene
-                    .runs
-                    .iter()
-                    .enumerate()
-                    .map(|(i, spec)| {
-                        LinearRun::prepare(scene, spec)
-                            .map_err(|e| scene.run_error(i, "integrator", e))
-                    })
-                    .collect::<Result<_>>()?,
-            ),
-        });
-    }
-    let total: u64 = scenes
-        .iter()
-        .map(|s| {
-            let points = s.compression.as_ref().map_or(1, |c| c.strain_ratios.len());
-            s.runs
-                .iter()
-                .map(|r| {
-                    let e = r.ensemble(opts.budget);
-                    if s.compression.is_some() {
-                        (e.trajectories * points) as u64
-                    } else {
-                        (e.trajectories + e.two_time_trajectories) as u64
-                    }
-                })
-                .sum::<u64>()
-        })
-        .sum();
-    let bar = if opts.progress {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    if let Ok(style) = ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories  {msg}",
-    ) {
-        bar.set_style(style);
-    }
+    let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
+    let bar = progress_bar(trajectory_count(&scenes, opts.budget), opts.progress);
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
     for (scene, work) in scenes.iter().zip(&prepared) {
@@ -137,6 +96,94 @@ enum Prepared {
     Compression(CompressionTheoryTable, Vec<CompressionRun>),
 }
 
+/// Prepares every run of `scene` (and the exact theory of a compression scene); errors
+/// name the scene file and the run.
+fn prepare(scene: &Scene) -> Result<Prepared> {
+    let Some(comp) = &scene.compression else {
+        let runs = scene
+            .runs
+            .iter()
+            .enumerate()
+            .map(|(i, spec)| {
+                LinearRun::prepare(scene, spec).map_err(|e| scene.run_error(i, "integrator", e))
+            })
+            .collect::<Result<_>>()?;
+        return Ok(Prepared::Linear(runs));
+    };
+    let runs = scene
+        .runs
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| {
+            CompressionRun::prepare(scene, comp, spec)
+                .map_err(|e| scene.run_error(i, "integrator", e))
+        })
+        .collect::<Result<_>>()?;
+    let theory = CompressionTheoryTable::new(scene, comp)
+        .map_err(|e| scene.run_error(0, "integrator", e))?;
+    Ok(Prepared::Compression(theory, runs))
+}
+
+/// Trajectories of all scenes at `budget` (per strain for compression scenes), for the
+/// progress bar.
+fn trajectory_count(scenes: &[Scene], budget: Budget) -> u64 {
+    scenes
+        .iter()
+        .map(|s| {
+            let points = s.compression.as_ref().map_or(1, |c| c.strain_ratios.len());
+            s.runs
+                .iter()
+                .map(|r| {
+                    let e = r.ensemble(budget);
+                    if s.compression.is_some() {
+                        (e.trajectories * points) as u64
+                    } else {
+                        (e.trajectories + e.two_time_trajectories) as u64
+                    }
+                })
+                .sum::<u64>()
+        })
+        .sum()
+}
+
+/// A progress bar over `total` trajectories on stderr, or a hidden one.
+fn progress_bar(total: u64, show: bool) -> ProgressBar {
+    let bar = if show {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories  {msg}",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// What a scene produces, each list in the order of `summary.json`.
+struct SceneOutputs {
+    /// The checks, before the family-wise correction.
+    checks: Vec<CheckResult>,
+    /// Figures written.
+    figures: Vec<PathBuf>,
+    /// Tables written.
+    tables: Vec<PathBuf>,
+    /// Notes for a reader; the first is the scene's description.
+    notes: Vec<String>,
+}
+
+impl SceneOutputs {
+    fn new(scene: &Scene) -> Self {
+        SceneOutputs {
+            checks: Vec::new(),
+            figures: Vec::new(),
+            tables: Vec::new(),
+            notes: vec![scene.description.clone()],
+        }
+    }
+}
+
 /// One dimension's simulated and theoretical force–strain curve, for the Fig. 2 figure.
 struct Curve {
     dims: usize,
@@ -144,6 +191,17 @@ struct Curve {
     simulated: Vec<(f64, f64, f64)>,
 }
 
+/// Columns of `force-strain.csv`.
+const FORCE_STRAIN_HEADER: [&str; 5] = [
+    "strain_ratio",
+    "force_ratio",
+    "std_error",
+    "theory_discrete",
+    "theory_continuum",
+];
+
+/// Runs a compression scene: every run, its checks, table and points in the scene's
+/// force–strain figure, the Δt-halving check, and `fig2.svg` (updated in `curves`).
 fn run_compression_scene(
     scene: &Scene,
     theory: &CompressionTheoryTable,
@@ -154,22 +212,150 @@ fn run_compression_scene(
 ) -> Result<SceneSummary> {
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
-    let mut checks = Vec::new();
-    let mut figures = Vec::new();
-    let mut tables = Vec::new();
-    let mut notes = vec![scene.description.clone()];
+    let mut outputs = SceneOutputs::new(scene);
     let mut estimates = Vec::new();
-    let mut largest_slope = None;
-    let points = theory.strain_ratios.len();
-    let tau1 = scene.filament.tau1();
-    let header = [
-        "strain_ratio",
-        "force_ratio",
-        "std_error",
-        "theory_discrete",
-        "theory_continuum",
-    ];
-    let mut fig = Figure::new(
+    let mut largest_slope: Option<(String, (f64, f64))> = None;
+    let mut fig = force_strain_figure(scene, theory);
+    for (k, run) in runs.iter().enumerate() {
+        let (est, slope) = run_compression(scene, theory, k, run, opts, bar, &mut outputs)?;
+        if let Some((s, x, i)) = slope
+            && largest_slope.as_ref().is_none_or(|l| s > l.1.0)
+        {
+            largest_slope = Some((
+                format!(
+                    "run {} at strain ratio {} (largest of the runs and strains)",
+                    run.spec.name, theory.strain_ratios[i]
+                ),
+                (s, x),
+            ));
+        }
+        let rows = force_strain_rows(theory, &est);
+        let path = if k == 0 {
+            dir.join("force-strain.csv")
+        } else {
+            dir.join(format!("{}-force-strain.csv", run.spec.name))
+        };
+        write_csv(&path, &FORCE_STRAIN_HEADER, &rows)?;
+        outputs.tables.push(path);
+        fig = fig.series(
+            Series::markers(
+                format!("simulated: {} (±1 s.e.)", run.spec.name),
+                rows.iter().map(|r| (r[0], r[1])).collect(),
+            )
+            .with_errors(rows.iter().map(|r| r[2]).collect()),
+        );
+        if k == 0 {
+            curves.retain(|c| c.dims != scene.dims);
+            curves.push(Curve {
+                dims: scene.dims,
+                theory: theory.curve.clone(),
+                simulated: rows.iter().map(|r| (r[0], r[1], r[2])).collect(),
+            });
+        }
+        estimates.push(est);
+    }
+    if let Some((check, note)) = scene_halving_check(scene, runs, &estimates)? {
+        outputs.checks.push(check);
+        outputs.notes.push(note);
+    }
+    let path = dir.join("force-strain.svg");
+    fig.write_svg(&path)?;
+    outputs.figures.push(path);
+    outputs.figures.push(write_fig2(&opts.out, curves)?);
+    let mut summary = finish_scene(scene, outputs, start, opts)?;
+    if let Some((what, slope)) = largest_slope {
+        summary
+            .warnings
+            .extend(small_slope_warning(&what, slope, &scene.filament));
+    }
+    Ok(summary)
+}
+
+/// The largest RMS slope of a compression run: (slope in rad, x/L, strain index).
+type RmsSlope = (f64, f64, usize);
+
+/// Simulates run `k` of a compression scene at the budget and adds its checks and note
+/// to `outputs`; returns its force estimates and its largest RMS slope (slope, x/L,
+/// strain index).
+fn run_compression(
+    scene: &Scene,
+    theory: &CompressionTheoryTable,
+    k: usize,
+    run: &CompressionRun,
+    opts: &VerifyOptions,
+    bar: &ProgressBar,
+    outputs: &mut SceneOutputs,
+) -> Result<(ForceEstimates, Option<RmsSlope>)> {
+    let e = run.spec.ensemble(opts.budget);
+    let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+    let records = run
+        .simulate_ensemble(
+            |i| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name)),
+            e.trajectories,
+            steps,
+            || bar.inc(1),
+        )
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let budget_key = format!("{}.duration_tau1", opts.budget.name());
+    let est = force_estimates_diagnosed(&records, &scene.filament)
+        .map_err(|e| scene.run_error(k, &budget_key, e))?;
+    outputs.checks.extend(
+        compression_checks(run, run.spec.checks(scene), theory, &records, &est)
+            .map_err(|e| scene.run_error(k, &budget_key, e))?,
+    );
+    let slope = run.largest_rms_slope(&records);
+    outputs
+        .notes
+        .push(compression_run_note(scene, theory, run, &e, &est, slope));
+    Ok((est, slope))
+}
+
+/// The note of a compression run: scheme, ensemble, acceptance, autocorrelation and
+/// largest slope.
+fn compression_run_note(
+    scene: &Scene,
+    theory: &CompressionTheoryTable,
+    run: &CompressionRun,
+    e: &Ensemble,
+    est: &ForceEstimates,
+    slope: Option<RmsSlope>,
+) -> String {
+    format!(
+        "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
+        run.spec.name,
+        run.spec.integrator,
+        run.spec.noise.name(),
+        run.spec.dt_tau1,
+        e.trajectories,
+        e.duration_tau1,
+        scene.compression.as_ref().map_or(0.0, |c| c.burn_in_tau1),
+        est.acceptance,
+        est.max_tau_int,
+        slope.map_or(String::new(), |(s, x, i)| format!(
+            "; largest RMS slope {s:.3} rad at x/L = {x:.2}, strain ratio {}",
+            theory.strain_ratios[i]
+        ))
+    )
+}
+
+/// The rows of `force-strain.csv` ([`FORCE_STRAIN_HEADER`]), one per strain.
+fn force_strain_rows(theory: &CompressionTheoryTable, est: &ForceEstimates) -> Vec<Vec<f64>> {
+    (0..theory.strain_ratios.len())
+        .map(|i| {
+            vec![
+                theory.strain_ratios[i],
+                est.force[i].0,
+                est.force[i].1,
+                theory.discrete[i],
+                theory.continuum[i],
+            ]
+        })
+        .collect()
+}
+
+/// The scene's force–strain figure with the exact theory; runs add their points.
+fn force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure {
+    Figure::new(
         format!(
             "{}: <F>/F_c0 against imposed strain (exact theory: lines)",
             scene.name
@@ -188,91 +374,15 @@ fn run_compression_scene(
         )
         .dashed(),
     )
-    .hline(1.0, "Euler load");
-    for (k, run) in runs.iter().enumerate() {
-        let e = run.spec.ensemble(opts.budget);
-        let steps = run.sampled_steps(e.duration_tau1 * tau1);
-        let nt = e.trajectories;
-        let records = run
-            .simulate_ensemble(
-                |i| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name)),
-                nt,
-                steps,
-                || bar.inc(1),
-            )
-            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        let budget_key = format!("{}.duration_tau1", opts.budget.name());
-        let est = force_estimates_diagnosed(&records, &scene.filament)
-            .map_err(|e| scene.run_error(k, &budget_key, e))?;
-        checks.extend(
-            compression_checks(run, run.spec.checks(scene), theory, &records, &est)
-                .map_err(|e| scene.run_error(k, &budget_key, e))?,
-        );
-        let slope = run.largest_rms_slope(&records);
-        notes.push(format!(
-            "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
-            run.spec.name,
-            run.spec.integrator,
-            run.spec.noise.name(),
-            run.spec.dt_tau1,
-            nt,
-            e.duration_tau1,
-            scene.compression.as_ref().map_or(0.0, |c| c.burn_in_tau1),
-            est.acceptance,
-            est.max_tau_int,
-            slope.map_or(String::new(), |(s, x, i)| format!(
-                "; largest RMS slope {s:.3} rad at x/L = {x:.2}, strain ratio {}",
-                theory.strain_ratios[i]
-            ))
-        ));
-        if let Some((s, x, i)) = slope
-            && largest_slope
-                .as_ref()
-                .is_none_or(|l: &(String, (f64, f64))| s > l.1.0)
-        {
-            largest_slope = Some((
-                format!(
-                    "run {} at strain ratio {} (largest of the runs and strains)",
-                    run.spec.name, theory.strain_ratios[i]
-                ),
-                (s, x),
-            ));
-        }
-        let rows: Vec<Vec<f64>> = (0..points)
-            .map(|i| {
-                vec![
-                    theory.strain_ratios[i],
-                    est.force[i].0,
-                    est.force[i].1,
-                    theory.discrete[i],
-                    theory.continuum[i],
-                ]
-            })
-            .collect();
-        let path = if k == 0 {
-            dir.join("force-strain.csv")
-        } else {
-            dir.join(format!("{}-force-strain.csv", run.spec.name))
-        };
-        write_csv(&path, &header, &rows)?;
-        tables.push(path);
-        fig = fig.series(
-            Series::markers(
-                format!("simulated: {} (±1 s.e.)", run.spec.name),
-                rows.iter().map(|r| (r[0], r[1])).collect(),
-            )
-            .with_errors(rows.iter().map(|r| r[2]).collect()),
-        );
-        if k == 0 {
-            curves.retain(|c| c.dims != scene.dims);
-            curves.push(Curve {
-                dims: scene.dims,
-                theory: theory.curve.clone(),
-                simulated: rows.iter().map(|r| (r[0], r[1], r[2])).collect(),
-            });
-        }
-        estimates.push(est);
-    }
+    .hline(1.0, "Euler load")
+}
+
+/// The Δt-halving check of a compression scene and its note, if the scene asks for it.
+fn scene_halving_check(
+    scene: &Scene,
+    runs: &[CompressionRun],
+    estimates: &[ForceEstimates],
+) -> Result<Option<(CheckResult, String)>> {
     if let Some(comp) = &scene.compression
         && let Some([a, b]) = &comp.halving
         && scene.checks.contains(&CheckKind::DtHalving)
@@ -280,22 +390,10 @@ fn run_compression_scene(
         let ia = runs.iter().position(|r| &r.spec.name == a);
         let ib = runs.iter().position(|r| &r.spec.name == b);
         if let (Some(ia), Some(ib)) = (ia, ib) {
-            let (check, note) = halving_check([a, b], &estimates[ia], &estimates[ib])?;
-            checks.push(check);
-            notes.push(note);
+            return halving_check([a, b], &estimates[ia], &estimates[ib]).map(Some);
         }
     }
-    let path = dir.join("force-strain.svg");
-    fig.write_svg(&path)?;
-    figures.push(path);
-    figures.push(write_fig2(&opts.out, curves)?);
-    let mut summary = finish_scene(scene, checks, figures, tables, notes, start, opts)?;
-    if let Some((what, slope)) = largest_slope {
-        summary
-            .warnings
-            .extend(small_slope_warning(&what, slope, &scene.filament));
-    }
-    Ok(summary)
+    Ok(None)
 }
 
 /// The paper's Fig. 2: ⟨F⟩/F_c0 against ε/ε_c0 in 2D and 3D, exact theory (discrete:
@@ -334,15 +432,20 @@ fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// The summary of a scene: the Holm correction over its checks at `opts.alpha`, and the
+/// paths of its outputs relative to `opts.out`.
 fn finish_scene(
     scene: &Scene,
-    mut checks: Vec<crate::verify::summary::CheckResult>,
-    figures: Vec<PathBuf>,
-    tables: Vec<PathBuf>,
-    notes: Vec<String>,
+    outputs: SceneOutputs,
     start: Instant,
     opts: &VerifyOptions,
 ) -> Result<SceneSummary> {
+    let SceneOutputs {
+        mut checks,
+        figures,
+        tables,
+        notes,
+    } = outputs;
     let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
     for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, opts.alpha)) {
         c.p_adjusted = Some(adj);
@@ -370,6 +473,8 @@ fn finish_scene(
     })
 }
 
+/// Runs a linear scene: every run, its checks, notes, tables and figures, and the
+/// element-uniform noise study of a `fem` scene (see the [module docs](self)).
 fn run_scene(
     scene: &Scene,
     runs: &[LinearRun],
@@ -378,70 +483,40 @@ fn run_scene(
 ) -> Result<SceneSummary> {
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
-    let mut checks = Vec::new();
-    let mut figures = Vec::new();
-    let mut tables = Vec::new();
-    let mut notes = vec![scene.description.clone()];
-    let mut largest_slope = None;
+    let mut outputs = SceneOutputs::new(scene);
+    let mut largest_slope: Option<(String, (f64, f64))> = None;
+    // The element-count study of the paper's noise: once per fem scene, after the first
+    // element-uniform run.
+    let noise_study_after = match scene.model {
+        ModelKind::Fem => runs
+            .iter()
+            .position(|r| r.spec.noise == NoiseModel::ElementUniform),
+        ModelKind::Spectral | ModelKind::Compression => None,
+    };
     for (k, run) in runs.iter().enumerate() {
         let e = run.spec.ensemble(opts.budget);
-        let seed = derive_seed(scene.seed, &run.spec.name);
-        let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
-        let records = par_indexed(e.trajectories as u64, |j| {
-            let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
-            bar.inc(1);
-            rec
-        })
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        let extra = par_indexed(e.two_time_trajectories as u64, |j| {
-            let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
-            bar.inc(1);
-            rec.map(|r| r.two_time)
-        })
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        let two_time: Vec<Vec<f64>> = records
-            .iter()
-            .map(|r| r.two_time.clone())
-            .chain(extra)
-            .collect();
+        let (records, two_time) = simulate_linear(scene, k, run, &e, bar)?;
         let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)
             .map_err(|e| scene.run_error(k, &format!("{}.duration_tau1", opts.budget.name()), e))?;
-        checks.extend(run_checks);
+        outputs.checks.extend(run_checks);
         if let Some(slope) = run.measured_rms_slope(&records)
-            && largest_slope
-                .as_ref()
-                .is_none_or(|(_, s): &(String, (f64, f64))| slope.0 > s.0)
+            && largest_slope.as_ref().is_none_or(|(_, s)| slope.0 > s.0)
         {
             largest_slope = Some((run.spec.name.clone(), slope));
         }
-        notes.extend(
+        outputs.notes.extend(
             est.skipped
                 .iter()
                 .map(|s| format!("not evaluated at this budget: {s}")),
         );
-        let name = &run.spec.name;
-        notes.push(format!(
-            "run {name}: {} with {} noise, dt = {:.4e} tau1 (lambda_max dt = {:.3e}), {} trajectories x {} tau1 after {} tau1 burn-in, mode 1 sampled every {} steps",
-            run.spec.integrator,
-            run.spec.noise.name(),
-            run.spec.dt_tau1,
-            run.reference.max_rate * run.reference.dt,
-            e.trajectories,
-            e.duration_tau1,
-            scene.sampling.burn_in_tau1,
-            run.mode_every[0]
-        ));
-        write_run_outputs(&dir, run, &est, &mut figures, &mut tables)?;
-        // The element-count study of the paper's noise: once per scene.
-        let first_element_uniform = runs
-            .iter()
-            .position(|r| r.spec.noise == NoiseModel::ElementUniform)
-            == Some(k);
-        if scene.model == ModelKind::Fem && first_element_uniform {
-            notes.push(noise_study(scene, &dir, &mut figures, &mut tables)?);
+        outputs.notes.push(linear_run_note(scene, run, &e));
+        write_run_outputs(&dir, run, &est, &mut outputs)?;
+        if noise_study_after == Some(k) {
+            let note = write_noise_study(scene, &dir, &mut outputs)?;
+            outputs.notes.push(note);
         }
     }
-    let mut summary = finish_scene(scene, checks, figures, tables, notes, start, opts)?;
+    let mut summary = finish_scene(scene, outputs, start, opts)?;
     if let Some((run, slope)) = largest_slope {
         summary.warnings.extend(small_slope_warning(
             &format!("run {run} (largest of the runs)"),
@@ -452,77 +527,150 @@ fn run_scene(
     Ok(summary)
 }
 
+/// Simulates run `k` of a linear scene with ensemble `e`: the full trajectories, and the
+/// two-time products of all trajectories (the full ones, then the extra short ones).
+fn simulate_linear(
+    scene: &Scene,
+    k: usize,
+    run: &LinearRun,
+    e: &Ensemble,
+    bar: &ProgressBar,
+) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
+    let seed = derive_seed(scene.seed, &run.spec.name);
+    let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+    let records = par_indexed(e.trajectories as u64, |j| {
+        let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
+        bar.inc(1);
+        rec
+    })
+    .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let extra = par_indexed(e.two_time_trajectories as u64, |j| {
+        let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
+        bar.inc(1);
+        rec.map(|r| r.two_time)
+    })
+    .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let two_time = records
+        .iter()
+        .map(|r| r.two_time.clone())
+        .chain(extra)
+        .collect();
+    Ok((records, two_time))
+}
+
+/// The note of a linear run: scheme, time step, ensemble and sampling.
+fn linear_run_note(scene: &Scene, run: &LinearRun, e: &Ensemble) -> String {
+    format!(
+        "run {}: {} with {} noise, dt = {:.4e} tau1 (lambda_max dt = {:.3e}), {} trajectories x {} tau1 after {} tau1 burn-in, mode 1 sampled every {} steps",
+        run.spec.name,
+        run.spec.integrator,
+        run.spec.noise.name(),
+        run.spec.dt_tau1,
+        run.reference.max_rate * run.reference.dt,
+        e.trajectories,
+        e.duration_tau1,
+        scene.sampling.burn_in_tau1,
+        run.mode_every[0]
+    )
+}
+
+/// The tables and figures of one linear run (see the [module docs](self)), in this order.
 fn write_run_outputs(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    figures: &mut Vec<PathBuf>,
-    tables: &mut Vec<PathBuf>,
+    outputs: &mut SceneOutputs,
 ) -> Result<()> {
-    let r = &run.reference;
-    let name = &run.spec.name;
-    let modes: Vec<_> = r.modes.iter().zip(&est.modes).collect();
-
     if est.modes.iter().any(|m| m.variance.1 > 0.0) {
-        let path = dir.join(format!("{name}-modes.csv"));
-        let rows: Vec<Vec<f64>> = modes
-            .iter()
-            .map(|(mr, me)| {
-                let eq = mr.variance_equipartition;
-                vec![
-                    mr.n as f64,
-                    mr.variance_discrete / eq,
-                    me.variance.0 / eq,
-                    me.variance.1 / eq,
-                ]
-            })
-            .collect();
-        write_csv(
-            &path,
-            &["mode", "predicted_ratio", "simulated_ratio", "std_error"],
-            &rows,
-        )?;
-        tables.push(path);
-        let fig = Figure::new(
-            format!("{name}: modal variance / equipartition (kT/lambda_i of the discrete modes)"),
-            "mode n",
-            "variance ratio",
-        )
-        .series(
-            Series::markers(
-                "simulated (±1 s.e.)",
-                rows.iter().map(|r| (r[0], r[2])).collect(),
-            )
-            .with_errors(rows.iter().map(|r| r[3]).collect()),
-        )
-        .series(Series::line(
-            "exact discrete reference",
-            rows.iter().map(|r| (r[0], r[1])).collect(),
-        ))
-        .series(
-            Series::line(
-                "continuum (kT/lambda_n) / equipartition",
-                modes
-                    .iter()
-                    .map(|(mr, _)| {
-                        (
-                            mr.n as f64,
-                            mr.variance_continuum / mr.variance_equipartition,
-                        )
-                    })
-                    .collect(),
-            )
-            .dashed(),
-        )
-        .hline(1.0, "equipartition");
-        let path = dir.join(format!("{name}-modes.svg"));
-        fig.write_svg(&path)?;
-        figures.push(path);
+        write_mode_variances(dir, run, est, outputs)?;
     }
+    write_mode_statistics(dir, run, est, outputs)?;
+    if !est.profile.is_empty() {
+        write_profile(dir, run, est, outputs)?;
+    }
+    if !est.two_time.is_empty() {
+        write_two_time(dir, run, est, outputs)?;
+    }
+    write_spectra(dir, run, est, outputs)
+}
 
-    let stats_path = dir.join(format!("{name}-mode-statistics.csv"));
+/// `<run>-modes.csv` and `.svg`: the modal variances relative to equipartition,
+/// simulated against the exact discrete and the continuum values.
+fn write_mode_variances(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs,
+) -> Result<()> {
+    let name = &run.spec.name;
+    let modes: Vec<_> = run.reference.modes.iter().zip(&est.modes).collect();
+    let path = dir.join(format!("{name}-modes.csv"));
     let rows: Vec<Vec<f64>> = modes
         .iter()
+        .map(|(mr, me)| {
+            let eq = mr.variance_equipartition;
+            vec![
+                mr.n as f64,
+                mr.variance_discrete / eq,
+                me.variance.0 / eq,
+                me.variance.1 / eq,
+            ]
+        })
+        .collect();
+    write_csv(
+        &path,
+        &["mode", "predicted_ratio", "simulated_ratio", "std_error"],
+        &rows,
+    )?;
+    outputs.tables.push(path);
+    let continuum = modes
+        .iter()
+        .map(|(mr, _)| {
+            (
+                mr.n as f64,
+                mr.variance_continuum / mr.variance_equipartition,
+            )
+        })
+        .collect();
+    let fig = Figure::new(
+        format!("{name}: modal variance / equipartition (kT/lambda_i of the discrete modes)"),
+        "mode n",
+        "variance ratio",
+    )
+    .series(
+        Series::markers(
+            "simulated (±1 s.e.)",
+            rows.iter().map(|r| (r[0], r[2])).collect(),
+        )
+        .with_errors(rows.iter().map(|r| r[3]).collect()),
+    )
+    .series(Series::line(
+        "exact discrete reference",
+        rows.iter().map(|r| (r[0], r[1])).collect(),
+    ))
+    .series(Series::line("continuum (kT/lambda_n) / equipartition", continuum).dashed())
+    .hline(1.0, "equipartition");
+    let path = dir.join(format!("{name}-modes.svg"));
+    fig.write_svg(&path)?;
+    outputs.figures.push(path);
+    Ok(())
+}
+
+/// `<run>-mode-statistics.csv` (variance and rate per mode, simulated, exact discrete and
+/// continuum) and, when rates were estimated, `<run>-rates.svg`.
+fn write_mode_statistics(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs,
+) -> Result<()> {
+    let name = &run.spec.name;
+    let stats_path = dir.join(format!("{name}-mode-statistics.csv"));
+    let rows: Vec<Vec<f64>> = run
+        .reference
+        .modes
+        .iter()
+        .zip(&est.modes)
         .map(|(mr, me)| {
             vec![
                 mr.n as f64,
@@ -552,8 +700,7 @@ fn write_run_outputs(
         ],
         &rows,
     )?;
-    tables.push(stats_path);
-
+    outputs.tables.push(stats_path);
     if est.modes.iter().any(|m| m.rate.0.is_finite()) {
         let fig = Figure::new(
             format!("{name}: relaxation rate / continuum rate lambda_n"),
@@ -574,123 +721,139 @@ fn write_run_outputs(
         .hline(1.0, "continuum");
         let path = dir.join(format!("{name}-rates.svg"));
         fig.write_svg(&path)?;
-        figures.push(path);
+        outputs.figures.push(path);
     }
+    Ok(())
+}
 
-    if !est.profile.is_empty() {
-        let path = dir.join(format!("{name}-profile.csv"));
-        let rows: Vec<Vec<f64>> = (0..est.profile.len())
-            .map(|j| {
-                vec![
-                    r.profile_x[j],
-                    est.profile[j].0,
-                    est.profile[j].1,
-                    r.profile_discrete[j],
-                    r.profile_continuum[j],
-                ]
-            })
-            .collect();
-        write_csv(
-            &path,
-            &["x", "variance", "std_error", "discrete", "continuum"],
-            &rows,
-        )?;
-        tables.push(path);
-    }
+/// `<run>-profile.csv`: ⟨w²(x)⟩ simulated, exact discrete and continuum.
+fn write_profile(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs,
+) -> Result<()> {
+    let r = &run.reference;
+    let path = dir.join(format!("{}-profile.csv", run.spec.name));
+    let rows: Vec<Vec<f64>> = (0..est.profile.len())
+        .map(|j| {
+            vec![
+                r.profile_x[j],
+                est.profile[j].0,
+                est.profile[j].1,
+                r.profile_discrete[j],
+                r.profile_continuum[j],
+            ]
+        })
+        .collect();
+    write_csv(
+        &path,
+        &["x", "variance", "std_error", "discrete", "continuum"],
+        &rows,
+    )?;
+    outputs.tables.push(path);
+    Ok(())
+}
 
-    if !est.two_time.is_empty() {
-        let path = dir.join(format!("{name}-two-time.csv"));
-        let rows: Vec<Vec<f64>> = r
-            .two_time
-            .iter()
-            .zip(&est.two_time)
-            .map(|(q, e)| vec![q.x, q.y, q.t, q.eta, e.0, e.1, q.discrete, q.continuum])
-            .collect();
-        write_csv(
-            &path,
-            &[
-                "x",
-                "y",
-                "t",
-                "eta",
-                "correlation",
-                "std_error",
-                "discrete",
-                "continuum",
-            ],
-            &rows,
-        )?;
-        tables.push(path);
-    }
+/// `<run>-two-time.csv`: the two-time correlation eq. (4) simulated, exact discrete and
+/// continuum.
+fn write_two_time(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs,
+) -> Result<()> {
+    let path = dir.join(format!("{}-two-time.csv", run.spec.name));
+    let rows: Vec<Vec<f64>> = run
+        .reference
+        .two_time
+        .iter()
+        .zip(&est.two_time)
+        .map(|(q, e)| vec![q.x, q.y, q.t, q.eta, e.0, e.1, q.discrete, q.continuum])
+        .collect();
+    write_csv(
+        &path,
+        &[
+            "x",
+            "y",
+            "t",
+            "eta",
+            "correlation",
+            "std_error",
+            "discrete",
+            "continuum",
+        ],
+        &rows,
+    )?;
+    outputs.tables.push(path);
+    Ok(())
+}
 
+/// `<run>-spectrum.csv` and `.svg` (modes 1, 3, 6): the pooled Welch spectra against
+/// their exact expectation, when the spectrum check computed any.
+fn write_spectra(
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs,
+) -> Result<()> {
+    let name = &run.spec.name;
     let spectra: Vec<_> = est
         .modes
         .iter()
         .filter_map(|m| m.spectrum.as_ref().map(|s| (m.n, s)))
         .collect();
-    if !spectra.is_empty() {
-        let mut rows = Vec::new();
-        let mut fig = Figure::new(
-            format!("{name}: modal power spectra (Welch) vs exact expectation"),
-            "frequency",
-            "one-sided PSD",
-        )
-        .log_x()
-        .log_y();
-        for (n, (f, p, e)) in &spectra {
-            for k in 1..f.len() {
-                rows.push(vec![*n as f64, f[k], p[k], e[k]]);
-            }
-            if [1, 3, 6].contains(n) {
-                fig = fig
-                    .series(Series::markers(
-                        format!("mode {n}: simulated"),
-                        f.iter().zip(p).skip(1).map(|(a, b)| (*a, *b)).collect(),
-                    ))
-                    .series(Series::line(
-                        format!("mode {n}: exact"),
-                        f.iter().zip(e).skip(1).map(|(a, b)| (*a, *b)).collect(),
-                    ));
-            }
-        }
-        let path = dir.join(format!("{name}-spectrum.csv"));
-        write_csv(&path, &["mode", "frequency", "psd", "expected"], &rows)?;
-        tables.push(path);
-        let path = dir.join(format!("{name}-spectrum.svg"));
-        fig.write_svg(&path)?;
-        figures.push(path);
+    if spectra.is_empty() {
+        return Ok(());
     }
+    let mut rows = Vec::new();
+    let mut fig = Figure::new(
+        format!("{name}: modal power spectra (Welch) vs exact expectation"),
+        "frequency",
+        "one-sided PSD",
+    )
+    .log_x()
+    .log_y();
+    for (n, (f, p, e)) in &spectra {
+        for k in 1..f.len() {
+            rows.push(vec![*n as f64, f[k], p[k], e[k]]);
+        }
+        if [1, 3, 6].contains(n) {
+            fig = fig
+                .series(Series::markers(
+                    format!("mode {n}: simulated"),
+                    f.iter().zip(p).skip(1).map(|(a, b)| (*a, *b)).collect(),
+                ))
+                .series(Series::line(
+                    format!("mode {n}: exact"),
+                    f.iter().zip(e).skip(1).map(|(a, b)| (*a, *b)).collect(),
+                ));
+        }
+    }
+    let path = dir.join(format!("{name}-spectrum.csv"));
+    write_csv(&path, &["mode", "frequency", "psd", "expected"], &rows)?;
+    outputs.tables.push(path);
+    let path = dir.join(format!("{name}-spectrum.svg"));
+    fig.write_svg(&path)?;
+    outputs.figures.push(path);
     Ok(())
 }
 
-/// Predicted stationary variance of the discrete modes relative to equipartition under
-/// the paper's element-uniform noise (eq. 5), `(ΦᵀΣ_ζΦ)_ii`, against element count, for
-/// any integrator whose consistent-noise variance is exact (continuous time).
-fn noise_study(
-    scene: &Scene,
-    dir: &Path,
-    figures: &mut Vec<PathBuf>,
-    tables: &mut Vec<PathBuf>,
-) -> Result<String> {
-    let n_modes = 6;
-    let mut rows = Vec::new();
-    for &ne in &NOISE_STUDY_ELEMENTS {
-        let beam = BeamModel::new(scene.filament, Mesh::uniform(scene.filament.length, ne)?)?;
-        let gm = generalized_modes(&beam)?;
-        let sq = modal_noise_covariance(
-            &gm,
-            &NoiseGenerator::new(NoiseModel::ElementUniform, &beam)?.covariance(),
-        );
-        let mut row = vec![ne as f64];
-        row.extend((0..n_modes).map(|i| {
-            if i < gm.rates.len() {
-                sq[(i, i)]
-            } else {
-                f64::NAN
-            }
-        }));
-        rows.push(row);
-    }
+/// The element-count study of the paper's element-uniform noise (eq. 5), an output of
+/// every `fem` scene with an element-uniform run (see the [module docs](self)): the
+/// stationary variance of modes 1–6 relative to equipartition on uniform meshes of
+/// [`NOISE_STUDY_ELEMENTS`] elements, from the exact discrete model alone
+/// ([`element_uniform_variance_ratios`]). Writes `element-uniform-vs-elements.csv`
+/// (`elements, mode1, …, mode6`) and `.svg` (1 − ratio against element count) and
+/// returns the note (the ratios at 10 elements and the observed order of the deficit).
+fn write_noise_study(scene: &Scene, dir: &Path, outputs: &mut SceneOutputs) -> Result<String> {
+    let ratios =
+        element_uniform_variance_ratios(&scene.filament, &NOISE_STUDY_ELEMENTS, NOISE_STUDY_MODES)?;
+    let rows: Vec<Vec<f64>> = NOISE_STUDY_ELEMENTS
+        .iter()
+        .zip(ratios)
+        .map(|(&ne, r)| std::iter::once(ne as f64).chain(r).collect())
+        .collect();
     let path = dir.join("element-uniform-vs-elements.csv");
     write_csv(
         &path,
@@ -699,7 +862,7 @@ fn noise_study(
         ],
         &rows,
     )?;
-    tables.push(path);
+    outputs.tables.push(path);
     let mut fig = Figure::new(
         "element-uniform noise (eq. 5): 1 - variance/equipartition vs element count",
         "elements",
@@ -707,7 +870,7 @@ fn noise_study(
     )
     .log_x()
     .log_y();
-    for i in 0..n_modes {
+    for i in 0..NOISE_STUDY_MODES {
         fig = fig.series(
             Series::line(
                 format!("mode {}", i + 1),
@@ -718,7 +881,7 @@ fn noise_study(
     }
     let path = dir.join("element-uniform-vs-elements.svg");
     fig.write_svg(&path)?;
-    figures.push(path);
+    outputs.figures.push(path);
     // Observed order of the deficit of mode 1 between the two finest meshes.
     let k = rows.len() - 1;
     let order = ((1.0 - rows[k - 1][1]) / (1.0 - rows[k][1])).log2();

@@ -1,0 +1,542 @@
+//! Validation of a scene: one validator for linear (`fem`, `spectral`) and compression
+//! scenes.
+//!
+//! [`Scene::validate`] runs, in order:
+//!
+//! 1. the checks of every scene: its name (the file stem, a path component of the
+//!    outputs), filament, `dims`, `checks`, mesh and burn-in;
+//! 2. the model's own tables: `[sampling]` of a linear scene, `[compression]` of a
+//!    compression scene;
+//! 3. ONE per-run check shared by both kinds of scene ([`Scene::validate`] →
+//!    `validate_run`): run name (a path component: non-empty `[A-Za-z0-9_-]`, unique),
+//!    integrator and noise, the run's own checks, `dt_tau1` and the ensemble of every
+//!    budget. What differs between models (allowed integrators, largest time step,
+//!    shortest duration) is stated by the private `RunRules`;
+//! 4. the Δt-halving pair of a compression scene.
+//!
+//! Every error is an [`Error::Scene`] naming the file, the key, the value and the allowed
+//! range (exit code 2).
+
+use super::spec::{Budget, CheckKind, CompressionSpec, ModelKind, RunSpec, Sampling, Scene};
+use crate::dynamics::IntegratorKind;
+use crate::error::{Error, Result};
+use crate::fem::noise::NoiseModel;
+use std::fmt::Display;
+
+/// Most trajectories (full or two-time) of a run at one budget.
+const MAX_TRAJECTORIES: usize = 100_000;
+
+/// The allowed checks of a linear scene, for messages.
+const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time) for model \"fem\" or \"spectral\"";
+/// The allowed checks of a compression scene, for messages.
+const COMPRESSION_CHECKS: &str =
+    "force-strain, force-distribution or dt-halving for model = \"compression\"";
+
+/// The error for `key` of `scene`'s file: "must be {allowed}, got {value}".
+fn bad(scene: &Scene, key: &str, value: &dyn Display, allowed: &str) -> Error {
+    Error::Scene {
+        file: scene.path.clone(),
+        key: key.to_string(),
+        message: format!("must be {allowed}, got {value}"),
+    }
+}
+
+/// Whether `name` is safe as one path component of the outputs: non-empty and made of
+/// `[A-Za-z0-9_-]` only (so no `/`, `..` or hidden file).
+pub fn is_path_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+}
+
+/// The one check of every name that becomes a path component under `--out` (the scene
+/// name and the run names): [`is_path_name`], else an [`Error::Scene`] naming the file,
+/// `key` and the name.
+fn check_path_name(scene: &Scene, key: &str, name: &str) -> Result<()> {
+    if is_path_name(name) {
+        Ok(())
+    } else {
+        Err(bad(
+            scene,
+            key,
+            &format!("{name:?}"),
+            "non-empty [A-Za-z0-9_-]",
+        ))
+    }
+}
+
+/// The model-specific limits of the shared per-run check.
+enum RunRules<'a> {
+    /// A linear scene (`fem` or `spectral`) and its sampling plan.
+    Linear(&'a Sampling),
+    /// A compression scene and its strains and sampling.
+    Compression(&'a CompressionSpec),
+}
+
+impl RunRules<'_> {
+    /// The integrator and noise of run `i`: linear scenes cannot use the Metropolis
+    /// scheme, compression scenes neither the exact modal one nor Metropolis with
+    /// element-uniform noise.
+    fn check_integrator(&self, scene: &Scene, i: usize, run: &RunSpec) -> Result<()> {
+        let key = |k: &str| format!("runs[{i}].{k}");
+        match self {
+            RunRules::Linear(_) => {
+                if run.integrator == IntegratorKind::MetropolisCrankNicolson {
+                    let allowed = "euler-maruyama, backward-euler, crank-nicolson or exact-modal for a linear scene (metropolis-crank-nicolson is for model = \"compression\")";
+                    return Err(bad(scene, &key("integrator"), &run.integrator, allowed));
+                }
+            }
+            RunRules::Compression(_) => {
+                if run.integrator == IntegratorKind::ExactModal {
+                    let allowed = "euler-maruyama, backward-euler, crank-nicolson or metropolis-crank-nicolson for model = \"compression\"";
+                    return Err(bad(scene, &key("integrator"), &run.integrator, allowed));
+                }
+                if run.integrator == IntegratorKind::MetropolisCrankNicolson
+                    && run.noise != NoiseModel::Consistent
+                {
+                    let allowed = "consistent for metropolis-crank-nicolson";
+                    return Err(bad(scene, &key("noise"), &run.noise.name(), allowed));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The largest `dt_tau1` and how the allowed range reads in messages.
+    fn dt_limit(&self) -> (f64, String) {
+        match self {
+            RunRules::Linear(_) => (100.0, "in (0, 100]".to_string()),
+            RunRules::Compression(c) => (
+                c.sample_every_tau1,
+                format!(
+                    "in (0, compression.sample_every_tau1 = {}]",
+                    c.sample_every_tau1
+                ),
+            ),
+        }
+    }
+
+    /// The allowed trajectory count, for messages.
+    fn trajectories_allowed(&self) -> &'static str {
+        match self {
+            RunRules::Linear(_) => "in [2, 100000]",
+            RunRules::Compression(_) => "in [2, 100000] (per strain)",
+        }
+    }
+
+    /// `None` if `duration_tau1` is valid for a run at `dt_tau1`, else the allowed range.
+    fn duration_error(&self, duration_tau1: f64, dt_tau1: f64) -> Option<String> {
+        match self {
+            RunRules::Linear(s) => {
+                if !(duration_tau1.is_finite() && duration_tau1 > 0.0 && duration_tau1 <= 1e6) {
+                    return Some("in (0, 1e6]".to_string());
+                }
+                let steps = (s.burn_in_tau1 + duration_tau1) / dt_tau1;
+                (steps > 1e10).then(|| {
+                    "such that (burn_in_tau1 + duration_tau1)/dt_tau1 <= 1e10 steps".to_string()
+                })
+            }
+            RunRules::Compression(c) => {
+                let samples = duration_tau1 / c.sample_every_tau1;
+                let ok = duration_tau1.is_finite() && samples >= 16.0 && duration_tau1 <= 1e6;
+                (!ok).then(|| {
+                    format!(
+                        "<= 1e6 and >= 16 x sample_every_tau1 = {}",
+                        16.0 * c.sample_every_tau1
+                    )
+                })
+            }
+        }
+    }
+
+    /// `None` if `n` extra two-time trajectories are valid, else the allowed range: only
+    /// linear scenes have the two-time check.
+    fn two_time_error(&self, n: usize) -> Option<&'static str> {
+        match self {
+            RunRules::Linear(_) => (n > MAX_TRAJECTORIES).then_some("in [0, 100000]"),
+            RunRules::Compression(_) => {
+                (n != 0).then_some("0 for model = \"compression\" (two-time is a linear check)")
+            }
+        }
+    }
+}
+
+impl Scene {
+    /// Validates the scene (see the [module docs](self) for the order of the checks).
+    /// [`Scene::load`] and [`Scene::parse`] call it.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the file, the key, the value and the allowed range.
+    pub fn validate(&self) -> Result<()> {
+        check_path_name(self, "name (the scene file stem)", &self.name)?;
+        self.validate_common()?;
+        self.validate_check_family("checks", &self.checks)?;
+        let rules = match (self.model, &self.compression) {
+            (ModelKind::Compression, Some(c)) => {
+                self.validate_compression_table(c)?;
+                RunRules::Compression(c)
+            }
+            (ModelKind::Compression, None) => {
+                let allowed = "a [compression] table for model = \"compression\"";
+                return Err(bad(self, "compression", &"nothing", allowed));
+            }
+            (ModelKind::Fem | ModelKind::Spectral, Some(_)) => {
+                let allowed = "absent unless model = \"compression\"";
+                return Err(bad(self, "compression", &"a [compression] table", allowed));
+            }
+            (ModelKind::Fem | ModelKind::Spectral, None) => {
+                self.validate_sampling()?;
+                RunRules::Linear(&self.sampling)
+            }
+        };
+        if self.runs.is_empty() {
+            return Err(bad(self, "runs", &"[]", "at least one [[runs]] table"));
+        }
+        for (i, run) in self.runs.iter().enumerate() {
+            self.validate_run(i, run, &rules)?;
+        }
+        match &self.compression {
+            Some(c) => self.validate_halving(c),
+            None => Ok(()),
+        }
+    }
+
+    /// The checks of every scene: filament, `dims`, `checks` non-empty, mesh, burn-in.
+    fn validate_common(&self) -> Result<()> {
+        let f = &self.filament;
+        // Bounds keep every derived quantity (tau1, lambda_max, variances) inside f64.
+        for (key, v) in [
+            ("filament.length", f.length),
+            ("filament.bending_rigidity", f.bending_rigidity),
+            ("filament.stretch_rigidity", f.stretch_rigidity),
+            ("filament.drag", f.drag),
+            ("filament.kt", f.kt),
+        ] {
+            if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
+                return Err(bad(self, key, &v, "in [1e-30, 1e30]"));
+            }
+        }
+        if self.dims != 2 && self.dims != 3 {
+            return Err(bad(self, "dims", &self.dims, "2 or 3"));
+        }
+        if self.checks.is_empty() {
+            return Err(bad(self, "checks", &"[]", "a non-empty list"));
+        }
+        if !(1..=1000).contains(&self.mesh.elements) {
+            return Err(bad(
+                self,
+                "mesh.elements",
+                &self.mesh.elements,
+                "in [1, 1000]",
+            ));
+        }
+        let g = self.mesh.grading;
+        if !(g.is_finite() && (0.01..=100.0).contains(&g)) {
+            return Err(bad(self, "mesh.grading", &g, "in [0.01, 100]"));
+        }
+        let b = self.sampling.burn_in_tau1;
+        if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
+            return Err(bad(self, "sampling.burn_in_tau1", &b, "in [0, 1e4]"));
+        }
+        Ok(())
+    }
+
+    /// Every check in `kinds` (the scene's list under `key = "checks"`, or a run's) is of
+    /// the scene's model: linear checks for `fem`/`spectral`, compression checks for
+    /// `compression`.
+    fn validate_check_family(&self, key: &str, kinds: &[CheckKind]) -> Result<()> {
+        let compression = self.model == ModelKind::Compression;
+        let allowed = if compression {
+            COMPRESSION_CHECKS
+        } else {
+            LINEAR_CHECKS
+        };
+        match kinds.iter().position(|k| k.is_compression() != compression) {
+            Some(i) => Err(bad(
+                self,
+                &format!("{key}[{i}]"),
+                &format!("{:?}", kinds[i]),
+                allowed,
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The `[sampling]` table of a linear scene: modes, profile points, two-time points,
+    /// and the points the requested checks need.
+    fn validate_sampling(&self) -> Result<()> {
+        let s = &self.sampling;
+        let max_modes = match self.model {
+            ModelKind::Fem => 2 * self.mesh.elements,
+            _ => self.mesh.elements,
+        };
+        if s.modes < 1 || s.modes > max_modes.min(50) {
+            let allowed = format!("in [1, {}]", max_modes.min(50));
+            return Err(bad(self, "sampling.modes", &s.modes, &allowed));
+        }
+        for (i, &x) in s.profile_points.iter().enumerate() {
+            if !(x.is_finite() && (0.0..=1.0).contains(&x)) {
+                let key = format!("sampling.profile_points[{i}]");
+                return Err(bad(self, &key, &x, "in [0, 1]"));
+            }
+        }
+        for (i, p) in s.two_time.iter().enumerate() {
+            self.validate_two_time_point(i, p)?;
+        }
+        let all_checks = || {
+            self.checks
+                .iter()
+                .chain(self.runs.iter().flat_map(|r| r.checks.iter().flatten()))
+        };
+        if all_checks().any(|c| *c == CheckKind::Profile) && s.profile_points.is_empty() {
+            let allowed = "non-empty when checks has \"profile\"";
+            return Err(bad(self, "sampling.profile_points", &"[]", allowed));
+        }
+        if all_checks().any(|c| *c == CheckKind::TwoTime) && s.two_time.is_empty() {
+            let allowed = "non-empty when checks has \"two-time\"";
+            return Err(bad(self, "sampling.two_time", &"[]", allowed));
+        }
+        Ok(())
+    }
+
+    /// Two-time point `i`, `(x/L, y/L, t/τ1, η/τ1)`: positions in [0, 1],
+    /// 0 < t ≤ η ≤ burn-in.
+    fn validate_two_time_point(&self, i: usize, p: &[f64; 4]) -> Result<()> {
+        for (j, name) in ["x/L", "y/L"].iter().enumerate() {
+            if !(p[j].is_finite() && (0.0..=1.0).contains(&p[j])) {
+                let key = format!("sampling.two_time[{i}][{j}] ({name})");
+                return Err(bad(self, &key, &p[j], "in [0, 1]"));
+            }
+        }
+        if !(p[3].is_finite() && p[3] > 0.0) {
+            let key = format!("sampling.two_time[{i}][3] (eta/tau1)");
+            return Err(bad(self, &key, &p[3], "finite and > 0"));
+        }
+        if !(p[2].is_finite() && p[2] > 0.0 && p[2] <= p[3]) {
+            let key = format!("sampling.two_time[{i}][2] (t/tau1)");
+            return Err(bad(
+                self,
+                &key,
+                &p[2],
+                &format!("in (0, eta/tau1 = {}]", p[3]),
+            ));
+        }
+        let burn_in = self.sampling.burn_in_tau1;
+        if p[3].is_nan() || p[3] > burn_in {
+            let key = format!("sampling.two_time[{i}][3] (eta/tau1)");
+            let allowed = format!("<= sampling.burn_in_tau1 = {burn_in}");
+            return Err(bad(self, &key, &p[3], &allowed));
+        }
+        Ok(())
+    }
+
+    /// The `[compression]` table of a compression scene: strains, uniform mesh, burn-in
+    /// and sampling interval.
+    fn validate_compression_table(&self, c: &CompressionSpec) -> Result<()> {
+        if c.strain_ratios.is_empty() {
+            return Err(bad(
+                self,
+                "compression.strain_ratios",
+                &"[]",
+                "a non-empty list",
+            ));
+        }
+        if self.mesh.grading != 1.0 {
+            // The exact discrete theory uses the closed-form spectrum of a uniform mesh.
+            let allowed = "1 (uniform) for model = \"compression\"";
+            return Err(bad(self, "mesh.grading", &self.mesh.grading, allowed));
+        }
+        for (i, &r) in c.strain_ratios.iter().enumerate() {
+            if !(r.is_finite() && (-1e3..=1e3).contains(&r)) {
+                let key = format!("compression.strain_ratios[{i}]");
+                return Err(bad(self, &key, &r, "finite, in [-1000, 1000]"));
+            }
+        }
+        for (i, r) in c.distribution_strain_ratios.iter().enumerate() {
+            if !c.strain_ratios.contains(r) {
+                let key = format!("compression.distribution_strain_ratios[{i}]");
+                return Err(bad(self, &key, r, "one of compression.strain_ratios"));
+            }
+        }
+        let b = c.burn_in_tau1;
+        if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
+            return Err(bad(self, "compression.burn_in_tau1", &b, "in [0, 1e4]"));
+        }
+        let s = c.sample_every_tau1;
+        if !(s.is_finite() && s > 0.0 && s <= 100.0) {
+            return Err(bad(
+                self,
+                "compression.sample_every_tau1",
+                &s,
+                "in (0, 100]",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The one per-run check of every scene: name, integrator and noise, own checks,
+    /// time step and the ensemble of every budget, with the model's limits `rules`.
+    fn validate_run(&self, i: usize, run: &RunSpec, rules: &RunRules) -> Result<()> {
+        let key = |k: &str| format!("runs[{i}].{k}");
+        check_path_name(self, &key("name"), &run.name)?;
+        if self.runs[..i].iter().any(|r| r.name == run.name) {
+            return Err(bad(
+                self,
+                &key("name"),
+                &run.name,
+                "unique within the scene",
+            ));
+        }
+        rules.check_integrator(self, i, run)?;
+        if let Some(checks) = &run.checks {
+            if checks.is_empty() {
+                let allowed = "a non-empty list (or leave it out)";
+                return Err(bad(self, &key("checks"), &"[]", allowed));
+            }
+            self.validate_check_family(&key("checks"), checks)?;
+            if let Some(j) = checks.iter().position(|k| *k == CheckKind::DtHalving) {
+                // The Δt-halving check compares two runs: it is a check of the scene.
+                let allowed = "force-strain or force-distribution in a run's checks (dt-halving compares two runs: list it in the scene's checks)";
+                let k = key(&format!("checks[{j}]"));
+                return Err(bad(self, &k, &"DtHalving", allowed));
+            }
+        }
+        let (dt_max, dt_allowed) = rules.dt_limit();
+        let dt = run.dt_tau1;
+        if !(dt.is_finite() && dt > 0.0 && dt <= dt_max) {
+            return Err(bad(self, &key("dt_tau1"), &dt, &dt_allowed));
+        }
+        for budget in [Budget::Quick, Budget::Standard, Budget::Full] {
+            let e = run.ensemble(budget);
+            let b = budget.name();
+            if !(2..=MAX_TRAJECTORIES).contains(&e.trajectories) {
+                let allowed = rules.trajectories_allowed();
+                let k = key(&format!("{b}.trajectories"));
+                return Err(bad(self, &k, &e.trajectories, allowed));
+            }
+            if let Some(allowed) = rules.duration_error(e.duration_tau1, dt) {
+                let k = key(&format!("{b}.duration_tau1"));
+                return Err(bad(self, &k, &e.duration_tau1, &allowed));
+            }
+            if let Some(allowed) = rules.two_time_error(e.two_time_trajectories) {
+                let k = key(&format!("{b}.two_time_trajectories"));
+                return Err(bad(self, &k, &e.two_time_trajectories, allowed));
+            }
+        }
+        Ok(())
+    }
+
+    /// The Δt-halving pair of a compression scene: two run names of the scene, required
+    /// when the scene's checks have `dt-halving`.
+    fn validate_halving(&self, c: &CompressionSpec) -> Result<()> {
+        match &c.halving {
+            Some(pair) => {
+                for (j, n) in pair.iter().enumerate() {
+                    if !self.runs.iter().any(|r| &r.name == n) {
+                        let key = format!("compression.halving[{j}]");
+                        return Err(bad(self, &key, n, "the name of a run of this scene"));
+                    }
+                }
+                Ok(())
+            }
+            None if self.checks.contains(&CheckKind::DtHalving) => {
+                let allowed = "two run names when checks has \"dt-halving\"";
+                Err(bad(self, "compression.halving", &"nothing", allowed))
+            }
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    const COMPRESSION: &str = r#"
+description = "compression scene"
+seed = 1
+dims = 2
+model = "compression"
+checks = ["force-strain"]
+
+[mesh]
+elements = 4
+
+[compression]
+strain_ratios = [0.0, 1.0]
+burn_in_tau1 = 1.0
+sample_every_tau1 = 0.05
+
+[[runs]]
+name = "NAME"
+integrator = "crank-nicolson"
+dt_tau1 = 0.01
+quick = { trajectories = 4, duration_tau1 = 10.0 }
+standard = { trajectories = 4, duration_tau1 = 10.0 }
+full = { trajectories = 4, duration_tau1 = 10.0 }
+"#;
+
+    fn message(text: &str, file: &str) -> String {
+        match Scene::parse(text, Path::new(file)) {
+            Ok(_) => String::new(),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn path_names() {
+        for good in ["a", "run-1", "A_b-2"] {
+            assert!(is_path_name(good), "{good}");
+        }
+        for bad in ["", ".", "..", "../x", "a/b", "a b", "a.b", "é"] {
+            assert!(!is_path_name(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn compression_scene_is_valid() {
+        assert_eq!(message(&COMPRESSION.replace("NAME", "cn"), "ok.toml"), "");
+    }
+
+    #[test]
+    fn compression_run_name_outside_out_is_refused() {
+        let m = message(&COMPRESSION.replace("NAME", "../x"), "dir/comp.toml");
+        assert!(m.starts_with("dir/comp.toml: key `runs[0].name`"), "{m}");
+        assert!(
+            m.contains("must be non-empty [A-Za-z0-9_-], got \"../x\""),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn scene_name_outside_out_is_refused() {
+        let m = message(&COMPRESSION.replace("NAME", "cn"), "dir/...toml");
+        assert!(m.contains("key `name (the scene file stem)`"), "{m}");
+        assert!(m.contains("got \"..\""), "{m}");
+    }
+
+    #[test]
+    fn run_checks_of_the_other_model_are_refused() {
+        let text = COMPRESSION.replace("NAME", "cn").replace(
+            "dt_tau1 = 0.01",
+            "dt_tau1 = 0.01\nchecks = [\"force-strain\", \"profile\"]",
+        );
+        let m = message(&text, "c.toml");
+        assert!(m.contains("key `runs[0].checks[1]`"), "{m}");
+        assert!(m.contains("got Profile"), "{m}");
+    }
+
+    #[test]
+    fn compression_run_checks_must_not_be_empty() {
+        let text = COMPRESSION
+            .replace("NAME", "cn")
+            .replace("dt_tau1 = 0.01", "dt_tau1 = 0.01\nchecks = []");
+        let m = message(&text, "c.toml");
+        assert!(
+            m.contains("key `runs[0].checks`: must be a non-empty list"),
+            "{m}"
+        );
+    }
+}
