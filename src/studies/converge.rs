@@ -47,7 +47,7 @@ use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -75,8 +75,28 @@ pub const DEFAULT_EM_FRACTIONS: [f64; 4] = [0.9, 0.5, 0.25, 0.125];
 /// Allowed element counts (the references use a dense eigen-decomposition).
 pub const ELEMENTS_RANGE: (usize, usize) = (2, 200);
 
+/// Reads a number of a study's JSON summary back (`#[serde(deserialize_with)]`): the
+/// JSON writer stores a non-finite `f64` as `null`, read back as NaN.
+///
+/// # Errors
+/// The deserializer's, for anything but a number or `null`.
+pub fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// [`nan_if_null`] for an optional pair of numbers (a confidence interval).
+///
+/// # Errors
+/// The deserializer's, for anything but `null` or a pair of numbers or `null`s.
+pub fn pair_nan_if_null<'de, D: Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<Option<(f64, f64)>, D::Error> {
+    let pair = Option::<(Option<f64>, Option<f64>)>::deserialize(d)?;
+    Ok(pair.map(|(a, b)| (a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN))))
+}
+
 /// The refined parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Over {
     /// Element count; h = L/elements.
@@ -104,17 +124,20 @@ impl Over {
 }
 
 /// A least-squares fit of ln error = ln C + p ln h.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OrderFit {
     /// The fitted order p.
+    #[serde(deserialize_with = "nan_if_null")]
     pub order: f64,
     /// Its standard error (residual scale, n − 2 degrees of freedom); `None` with two
     /// points.
     pub std_error: Option<f64>,
     /// The [`CONFIDENCE`] interval (Student's t, n − 2 degrees of freedom); `None` with
     /// two points.
+    #[serde(deserialize_with = "pair_nan_if_null")]
     pub ci: Option<(f64, f64)>,
     /// The fitted prefactor C.
+    #[serde(deserialize_with = "nan_if_null")]
     pub prefactor: f64,
     /// Number of points used.
     pub points: usize,
@@ -216,7 +239,7 @@ pub struct PointReference {
 }
 
 /// The expected order of the error of one observable, and why.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Expected {
     /// The order, if the theory predicts a power law; `None` if the discretization is
     /// exact for this observable or no single order applies.
@@ -577,26 +600,33 @@ pub fn study_ensemble(opts: &ConvergeOptions, spec: &RunSpec) -> Result<Ensemble
 }
 
 /// One row of the table: one value and one observable.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     /// The value (element count or Δt/τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub value: f64,
     /// h.
+    #[serde(deserialize_with = "nan_if_null")]
     pub h: f64,
     /// Observable name.
     pub observable: String,
     /// Ensemble estimate.
+    #[serde(deserialize_with = "nan_if_null")]
     pub estimate: f64,
     /// Its standard error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// Exact discrete reference, if one is known (none for the time-step bias of the
     /// nonlinear θ-schemes).
     pub discrete: Option<f64>,
     /// Limit reference (continuum, or Δt → 0 of this mesh).
+    #[serde(deserialize_with = "nan_if_null")]
     pub limit: f64,
     /// |estimate − limit|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub total_error: f64,
     /// Its standard error (that of the estimate).
+    #[serde(deserialize_with = "nan_if_null")]
     pub total_error_se: f64,
     /// |discrete − limit|, if the discrete reference is known.
     pub exact_error: Option<f64>,
@@ -639,7 +669,7 @@ impl Row {
 }
 
 /// The fitted and expected orders of one observable.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ObservableSummary {
     /// Observable name.
     pub observable: String,
@@ -667,15 +697,18 @@ pub struct ObservableSummary {
 /// trajectories: ⟨w²(L/2)⟩ is dominated by mode 1). A small p-value says the simulation
 /// disagrees with its own discretization's exact value (an integrator, sampling or
 /// burn-in problem, not discretization error). Σz² is reported as a summary.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DiscreteConsistency {
     /// Σz² (descriptive: the rows are not all independent).
+    #[serde(deserialize_with = "nan_if_null")]
     pub chi2: f64,
     /// Rows compared.
     pub rows: usize,
     /// Bonferroni-adjusted p-value of the largest |z|: min(1, rows × p).
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_value: f64,
     /// The largest |z|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_abs_z: f64,
     /// Where the largest |z| is: "observable at value".
     pub worst: String,
@@ -709,9 +742,10 @@ pub fn discrete_consistency(rows: &[Row]) -> Option<DiscreteConsistency> {
 /// A value of the study that gave no rows: its run went unstable (diverged), or its
 /// estimates could not be formed (too short for the correlation time). Recorded, not
 /// fatal: the study goes on with the other values.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FailedValue {
     /// The value (element count or Δt/τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub value: f64,
     /// `"unstable"` (a non-finite state) or `"estimate"` (the estimators failed).
     pub kind: String,
@@ -740,7 +774,7 @@ impl FailedValue {
 }
 
 /// The JSON summary of a study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergeSummary {
     /// Scene name.
     pub scene: String,
@@ -761,6 +795,7 @@ pub struct ConvergeSummary {
     /// Trajectories × duration per value.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Fixed parameters of the study (the other of elements / dt).
     pub fixed: String,
@@ -781,6 +816,7 @@ pub struct ConvergeSummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 

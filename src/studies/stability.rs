@@ -43,8 +43,9 @@ use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
 use crate::stats;
+use crate::studies::converge::nan_if_null;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -90,7 +91,7 @@ pub struct StabilityOptions {
 }
 
 /// The classification of a cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Status {
     /// Stable; no stationary bias resolved.
@@ -113,44 +114,56 @@ impl Status {
 }
 
 /// The measured stationary variance of one mode against the exact formula.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModeBias {
     /// Mode number (1-based, ascending rate).
     pub mode: usize,
     /// λ_i Δt.
+    #[serde(deserialize_with = "nan_if_null")]
     pub lambda_dt: f64,
     /// One-step multiplier m_i of the mode.
+    #[serde(deserialize_with = "nan_if_null")]
     pub multiplier: f64,
     /// Measured variance / (kT/λ_i).
+    #[serde(deserialize_with = "nan_if_null")]
     pub measured_ratio: f64,
     /// Its standard error (autocorrelation-aware, trajectories in quadrature).
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// The exact discrete-time ratio of the integrator.
+    #[serde(deserialize_with = "nan_if_null")]
     pub formula_ratio: f64,
     /// z of measured against the formula.
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_formula: f64,
     /// Two-sided p-value of that z.
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_formula: f64,
     /// z of measured against 1 (no bias).
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_bias: f64,
     /// Two-sided p-value of that z.
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_bias: f64,
     /// Whether Holm over the whole map rejects the formula for this mode.
     pub formula_rejected: bool,
 }
 
 /// One cell of the map.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cell {
     /// Integrator.
     pub integrator: String,
     /// Element count.
     pub elements: usize,
     /// a = Δt·λ_max.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_lambda_max: f64,
     /// Δt/τ1.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_tau1: f64,
     /// Multiplier of the fastest mode.
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_multiplier: f64,
     /// Classification.
     pub status: Status,
@@ -163,19 +176,21 @@ pub struct Cell {
     /// Modes not checked because the run cannot resolve them.
     pub unresolved_modes: usize,
     /// Largest |measured − formula| bias predicted among the checked modes, |ratio − 1|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub predicted_max_bias: f64,
     /// The checked modes.
     pub modes: Vec<ModeBias>,
 }
 
 /// The JSON summary of a stability study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StabilitySummary {
     /// Scene name.
     pub scene: String,
     /// Noise model (consistent).
     pub noise: String,
     /// Family-wise level.
+    #[serde(deserialize_with = "nan_if_null")]
     pub alpha: f64,
     /// Trajectories per cell.
     pub trajectories: usize,
@@ -195,6 +210,7 @@ pub struct StabilitySummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 

@@ -30,7 +30,8 @@ use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::linear::LinearRun;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
-use serde::Serialize;
+use crate::studies::converge::nan_if_null;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -77,50 +78,62 @@ pub struct WorkPrecisionOptions {
 }
 
 /// One method at one time step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WpPoint {
     /// Integrator.
     pub integrator: String,
     /// Noise model.
     pub noise: String,
     /// Δt/τ1.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_tau1: f64,
     /// Trajectories.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Steps per trajectory (burn-in + sampled).
     pub steps_per_trajectory: u64,
     /// Measured wall time of the ensemble (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
     /// Estimate of ⟨w²(L/2)⟩.
+    #[serde(deserialize_with = "nan_if_null")]
     pub estimate: f64,
     /// Its standard error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// Exact discrete value (this mesh, noise, integrator and Δt).
+    #[serde(deserialize_with = "nan_if_null")]
     pub discrete: f64,
     /// Continuum value.
+    #[serde(deserialize_with = "nan_if_null")]
     pub continuum: f64,
     /// |estimate − continuum|/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_error: f64,
     /// std_error/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_std_error: f64,
     /// |discrete − continuum|/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_bias: f64,
     /// (estimate − discrete)/std_error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_discrete: f64,
     /// Projected wall time to reach the tolerance (s), if the bias allows it.
     pub seconds_to_tolerance: Option<f64>,
 }
 
 /// The cheapest way a method reaches the tolerance.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MethodSummary {
     /// Integrator.
     pub integrator: String,
     /// Noise model.
     pub noise: String,
     /// Smallest relative bias over the time steps studied.
+    #[serde(deserialize_with = "nan_if_null")]
     pub min_rel_bias: f64,
     /// Projected wall time to reach the tolerance (s), if any time step can.
     pub seconds_to_tolerance: Option<f64>,
@@ -133,7 +146,7 @@ pub struct MethodSummary {
 }
 
 /// The JSON summary of a work–precision study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorkPrecisionSummary {
     /// Scene name.
     pub scene: String,
@@ -142,19 +155,24 @@ pub struct WorkPrecisionSummary {
     /// The observable.
     pub observable: String,
     /// Its continuum value.
+    #[serde(deserialize_with = "nan_if_null")]
     pub continuum: f64,
     /// The tolerance of the table (relative error).
+    #[serde(deserialize_with = "nan_if_null")]
     pub tolerance: f64,
     /// Trajectories per point.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1), stable integrators.
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Sampled duration per trajectory (τ1), euler-maruyama.
+    #[serde(deserialize_with = "nan_if_null")]
     pub em_duration_tau1: f64,
     /// Threads of the rayon pool.
     pub threads: usize,
     /// Median relative standard error of the points (the sampling floor of this
     /// ensemble).
+    #[serde(deserialize_with = "nan_if_null")]
     pub sampling_floor: f64,
     /// All points.
     pub points: Vec<WpPoint>,
@@ -165,6 +183,7 @@ pub struct WorkPrecisionSummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 
