@@ -935,18 +935,12 @@ fn linear_study(
     opts: &ConvergeOptions,
     ensemble: Ensemble,
 ) -> Result<Study> {
-    let spec = scene.runs[run].clone();
+    let spec = &scene.runs[run];
     let over = opts.over;
-    let mut values = match &opts.values {
-        Some(v) => v.clone(),
-        None => default_values(scene, run, over)?,
-    };
-    validate_values(over, &values)?;
-    // Largest h first.
-    values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
+    let values = linear_values(scene, run, opts)?;
     let names = observable_names();
     let limit_dt = match over {
-        Over::Dt => Some(semi_discrete_limit(scene, &spec)?),
+        Over::Dt => Some(semi_discrete_limit(scene, spec)?),
         Over::Elements => None,
     };
     // Prepare everything first, so that bad input fails before any simulation.
@@ -960,16 +954,7 @@ fn linear_study(
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
-        let seed = derive_seed(
-            s.seed,
-            &format!("{}/converge/{}={v}", spec.name, over.name()),
-        );
-        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-        let simulated = par_indexed(ensemble.trajectories as u64, |j| {
-            lr.simulate(&mut trajectory_rng(seed, j), steps)
-        })
-        .and_then(|records| Ok((estimates(lr, &records)?, records)));
-        let (est, records) = match simulated {
+        let (est, records) = match simulate_value(s, lr, &spec.name, over, v, ensemble) {
             Ok(r) => r,
             Err(e) => {
                 failed.push(FailedValue::record(v, e)?);
@@ -981,17 +966,7 @@ fn linear_study(
         {
             largest_slope = Some((v, slope));
         }
-        for (k, name) in names.iter().enumerate() {
-            rows.push(Row::new(
-                v,
-                refp.h,
-                name,
-                est[k],
-                Some(refp.discrete[k]),
-                refp.limit[k],
-                refp.rounding_rel * refp.limit[k].abs(),
-            ));
-        }
+        rows.extend(value_rows(&names, &refp, &est));
         if opts.progress {
             eprintln!(
                 "converge {} {}: {}={v}: {} trajectories x {} tau1, {:.1} s",
@@ -1011,8 +986,81 @@ fn linear_study(
         Over::Dt => scene.mesh.elements.is_multiple_of(2),
     };
     let expected = (0..names.len())
-        .map(|k| expected_order(over, &spec, k, node_at_mid))
+        .map(|k| expected_order(over, spec, k, node_at_mid))
         .collect();
+    let (notes, warnings) = slope_notes(scene, over, largest_slope);
+    let (limit_reference, fixed) = linear_texts(scene, spec, over);
+    Ok(Study {
+        values,
+        names,
+        expected,
+        rows,
+        limit_reference,
+        fixed,
+        failed,
+        notes,
+        warnings,
+    })
+}
+
+/// The values of a linear study (the options' or the defaults), validated, largest h
+/// first.
+fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Vec<f64>> {
+    let over = opts.over;
+    let mut values = match &opts.values {
+        Some(v) => v.clone(),
+        None => default_values(scene, run, over)?,
+    };
+    validate_values(over, &values)?;
+    values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
+    Ok(values)
+}
+
+/// Simulates the ensemble of one value (`s`, `lr` prepared for it; one PCG stream per
+/// trajectory, seeded from the run's name and the value) and forms the estimates of
+/// the observables; the records are returned for the slope diagnostics.
+fn simulate_value(
+    s: &Scene,
+    lr: &LinearRun,
+    run_name: &str,
+    over: Over,
+    v: f64,
+    ensemble: Ensemble,
+) -> Result<(Vec<(f64, f64)>, Vec<TrajectoryRecord>)> {
+    let seed = derive_seed(s.seed, &format!("{run_name}/converge/{}={v}", over.name()));
+    let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+    let records = par_indexed(ensemble.trajectories as u64, |j| {
+        lr.simulate(&mut trajectory_rng(seed, j), steps)
+    })?;
+    Ok((estimates(lr, &records)?, records))
+}
+
+/// The rows of one value: one per observable, from its estimates and exact references.
+fn value_rows(names: &[String], refp: &PointReference, est: &[(f64, f64)]) -> Vec<Row> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            Row::new(
+                refp.value,
+                refp.h,
+                name,
+                est[k],
+                Some(refp.discrete[k]),
+                refp.limit[k],
+                refp.rounding_rel * refp.limit[k].abs(),
+            )
+        })
+        .collect()
+}
+
+/// The note on the largest measured RMS slope of the study (at value `v`) and the
+/// small-slope warning it may call for.
+fn slope_notes(
+    scene: &Scene,
+    over: Over,
+    largest_slope: Option<(f64, (f64, f64))>,
+) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut warnings = Vec::new();
     if let Some((v, slope)) = largest_slope {
@@ -1028,26 +1076,25 @@ fn linear_study(
             &scene.filament,
         ));
     }
-    Ok(Study {
-        values,
-        names,
-        expected,
-        rows,
-        limit_reference: match over {
-            Over::Elements => "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)".to_string(),
-            Over::Dt => format!(
+    (notes, warnings)
+}
+
+/// What the errors of a linear study are measured against, and its fixed parameter.
+fn linear_texts(scene: &Scene, spec: &RunSpec, over: Over) -> (String, String) {
+    match over {
+        Over::Elements => (
+            "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)"
+                .to_string(),
+            format!("dt_tau1 = {:e}", spec.dt_tau1),
+        ),
+        Over::Dt => (
+            format!(
                 "dt -> 0 limit of this mesh ({} elements) and noise model: S_ij = 2kT Sigma_q,ij/(lambda_i + lambda_j)",
                 scene.mesh.elements
             ),
-        },
-        fixed: match over {
-            Over::Elements => format!("dt_tau1 = {:e}", spec.dt_tau1),
-            Over::Dt => format!("elements = {}", scene.mesh.elements),
-        },
-        failed,
-        notes,
-        warnings,
-    })
+            format!("elements = {}", scene.mesh.elements),
+        ),
+    }
 }
 
 /// Summarizes `study`, writes its CSV, SVG and JSON and rebuilds nothing else (the CLI
