@@ -13,6 +13,7 @@ use langevin_fem::studies::converge::{
 };
 use std::path::{Path, PathBuf};
 
+/// Command-line arguments of `langevin-fem converge`.
 #[derive(Debug, Args)]
 pub struct ConvergeArgs {
     /// Scene: a name from the scene directory or a path to a .toml file (finite-element

@@ -306,3 +306,38 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
     h.push_str("</body></html>\n");
     write_atomic(&dir.join("index.html"), h.as_bytes())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// Non-finite numbers, written as `null`, read back as NaN (or `None`) and render as
+    /// "–"; the summary serializes back to the same JSON.
+    #[test]
+    fn null_numbers_read_back_and_render() {
+        let text = json!({
+            "scene": "s", "elements": 10, "observable": "w2(L/2)", "continuum": null,
+            "tolerance": 0.01, "trajectories": 2, "duration_tau1": 50.0,
+            "em_duration_tau1": 4.0, "threads": 1, "sampling_floor": null, "points": [],
+            "methods": [{
+                "integrator": "exact-modal", "noise": "consistent", "min_rel_bias": null,
+                "seconds_to_tolerance": null, "best_dt_tau1": null, "relative_cost": null,
+                "note": "n"
+            }],
+            "inconsistent_points": 0, "files": ["a.svg", "a.csv"], "wall_seconds": 1.5
+        });
+        let v: WorkPrecisionSummary = serde_json::from_value(text.clone()).unwrap();
+        assert!(v.continuum.is_nan() && v.methods[0].min_rel_bias.is_nan());
+        assert_eq!(serde_json::to_value(&v).unwrap(), text);
+        let mut h = String::new();
+        work_precision_section(&mut h, &v);
+        assert!(h.contains("sampling floor (median relative s.e.) –."));
+        assert!(h.contains("<td class=\"num\">–</td><td class=\"detail\">n</td>"));
+        let f: OrderFit = serde_json::from_value(
+            json!({"order": 2.0, "std_error": null, "ci": [null, 2.5], "prefactor": 1.0, "points": 3}),
+        )
+        .unwrap();
+        assert_eq!(fit(Some(&f)), "2.00 [NaN, 2.50] (3 pts)");
+    }
+}

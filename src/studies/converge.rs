@@ -1016,6 +1016,9 @@ fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Ve
     Ok(values)
 }
 
+/// An estimate and its standard error.
+type Estimate = (f64, f64);
+
 /// Simulates the ensemble of one value (`s`, `lr` prepared for it; one PCG stream per
 /// trajectory, seeded from the run's name and the value) and forms the estimates of
 /// the observables; the records are returned for the slope diagnostics.
@@ -1026,7 +1029,7 @@ fn simulate_value(
     over: Over,
     v: f64,
     ensemble: Ensemble,
-) -> Result<(Vec<(f64, f64)>, Vec<TrajectoryRecord>)> {
+) -> Result<(Vec<Estimate>, Vec<TrajectoryRecord>)> {
     let seed = derive_seed(s.seed, &format!("{run_name}/converge/{}={v}", over.name()));
     let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
     let records = par_indexed(ensemble.trajectories as u64, |j| {
@@ -1036,7 +1039,7 @@ fn simulate_value(
 }
 
 /// The rows of one value: one per observable, from its estimates and exact references.
-fn value_rows(names: &[String], refp: &PointReference, est: &[(f64, f64)]) -> Vec<Row> {
+fn value_rows(names: &[String], refp: &PointReference, est: &[Estimate]) -> Vec<Row> {
     names
         .iter()
         .enumerate()

@@ -388,18 +388,7 @@ pub(super) fn study(
         let (est, records) = match simulate_value(s, cr, &spec.name, over, v, ensemble) {
             Ok(r) => r,
             Err(e) => {
-                let f = FailedValue::record(v, e)?;
-                if opts.progress {
-                    eprintln!(
-                        "converge {} {}: {}={v}: {}: {}",
-                        scene.name,
-                        spec.name,
-                        over.name(),
-                        f.kind,
-                        f.error
-                    );
-                }
-                failed.push(f);
+                failed.push(record_failure(scene, spec, opts, v, e)?);
                 continue;
             }
         };
@@ -452,6 +441,31 @@ pub(super) fn study(
         notes,
         warnings,
     })
+}
+
+/// Records the failure of value `v` ([`FailedValue::record`]), with a progress line.
+///
+/// # Errors
+/// `e` itself unless it is a divergence or an estimator failure.
+fn record_failure(
+    scene: &Scene,
+    spec: &RunSpec,
+    opts: &ConvergeOptions,
+    v: f64,
+    e: Error,
+) -> Result<FailedValue> {
+    let f = FailedValue::record(v, e)?;
+    if opts.progress {
+        eprintln!(
+            "converge {} {}: {}={v}: {}: {}",
+            scene.name,
+            spec.name,
+            opts.over.name(),
+            f.kind,
+            f.error
+        );
+    }
+    Ok(f)
 }
 
 /// The strains and values of a study (the options' or the defaults), validated; the
