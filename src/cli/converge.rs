@@ -8,9 +8,12 @@ use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_convergence_index;
 use langevin_fem::scene::Budget;
-use langevin_fem::studies::converge::{ConvergeOptions, Over, run_convergence};
-use std::path::PathBuf;
+use langevin_fem::studies::converge::{
+    ConvergeOptions, ConvergeSummary, ObservableSummary, OrderFit, Over, run_convergence,
+};
+use std::path::{Path, PathBuf};
 
+/// Command-line arguments of `langevin-fem converge`.
 #[derive(Debug, Args)]
 pub struct ConvergeArgs {
     /// Scene: a name from the scene directory or a path to a .toml file (finite-element
@@ -67,6 +70,8 @@ enum BudgetArg {
     Full,
 }
 
+// TODO(integrator-kind): parse with `IntegratorKind::from_str` and list
+// `IntegratorKind::ALL` (all five kinds) once they exist, instead of this list.
 /// The integrators a study may switch a run to.
 const INTEGRATORS: [IntegratorKind; 5] = [
     IntegratorKind::EulerMaruyama,
@@ -80,6 +85,21 @@ const INTEGRATORS: [IntegratorKind; 5] = [
 /// index page of the output directory; exit code 0, or 3 if every value failed (diverged
 /// or too short for its correlation time).
 pub fn run(args: ConvergeArgs) -> Result<i32> {
+    let out = args.out.clone();
+    let s = run_convergence(&options(args)?)?;
+    write_convergence_index(&out)?;
+    print_summary(&s, &out);
+    // Every value failed: nothing was measured (exit 3, as for a failed run).
+    if s.rows.is_empty() && !s.failed.is_empty() {
+        eprintln!("error: every value of the study failed (see above); no rows were written");
+        return Ok(3);
+    }
+    Ok(0)
+}
+
+/// The study's options from the command line (the scene resolved last, after the
+/// flags are parsed).
+fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
     let over = match args.over {
         OverArg::Elements => Over::Elements,
         OverArg::Dt => Over::Dt,
@@ -102,22 +122,10 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
     let integrator = args
         .integrator
         .as_deref()
-        .map(|name| {
-            INTEGRATORS
-                .into_iter()
-                .find(|k| k.name() == name.trim())
-                .ok_or_else(|| {
-                    let names: Vec<&str> = INTEGRATORS.iter().map(|k| k.name()).collect();
-                    Error::invalid(
-                        "--integrator",
-                        name.trim(),
-                        format!("one of: {}", names.join(", ")),
-                    )
-                })
-        })
+        .map(parse_integrator)
         .transpose()?;
     let scene = resolve_scene(&args.scene, &args.scene_dir)?;
-    let s = run_convergence(&ConvergeOptions {
+    Ok(ConvergeOptions {
         scene,
         run: args.run,
         over,
@@ -127,10 +135,67 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
         budget,
         trajectories: args.trajectories,
         duration_tau1: args.duration_tau1,
-        out: args.out.clone(),
+        out: args.out,
         progress: true,
-    })?;
-    write_convergence_index(&args.out)?;
+    })
+}
+
+/// The integrator named by `--integrator`.
+fn parse_integrator(name: &str) -> Result<IntegratorKind> {
+    INTEGRATORS
+        .into_iter()
+        .find(|k| k.name() == name.trim())
+        .ok_or_else(|| {
+            let names: Vec<&str> = INTEGRATORS.iter().map(|k| k.name()).collect();
+            Error::invalid(
+                "--integrator",
+                name.trim(),
+                format!("one of: {}", names.join(", ")),
+            )
+        })
+}
+
+/// A fitted order with its interval, for the terminal.
+fn fmt_fit(f: &Option<OrderFit>) -> String {
+    match f {
+        None => "no fit (fewer than 2 points)".to_string(),
+        Some(f) => match f.ci {
+            Some((lo, hi)) => {
+                format!("{:.2} [{lo:.2}, {hi:.2}] ({} points)", f.order, f.points)
+            }
+            None => format!("{:.2} (2 points, no CI)", f.order),
+        },
+    }
+}
+
+/// One observable's fitted orders, expected order, note and reason on stderr.
+fn print_observable(o: &ObservableSummary) {
+    let expected = match (o.expected.order, o.expected.exact) {
+        (Some(p), _) => format!("{p}"),
+        (None, true) => "exact (zero error)".to_string(),
+        (None, false) => "no single order".to_string(),
+    };
+    eprintln!(
+        "  {:<8} observed {}; exact-error order {}; expected {}; sampling floor at {:?}",
+        o.observable,
+        fmt_fit(&o.observed),
+        if o.exact.is_none() && !o.exact_at_rounding.is_empty() {
+            format!("- (exact at {:?})", o.exact_at_rounding)
+        } else {
+            fmt_fit(&o.exact)
+        },
+        expected,
+        o.floor_values
+    );
+    if !o.note.is_empty() {
+        eprintln!("           {}", o.note);
+    }
+    eprintln!("           expected: {}", o.expected.why);
+}
+
+/// The study's summary on stderr: what was refined, the observables, the consistency
+/// with the exact discrete references, the failed values, notes, warnings and files.
+fn print_summary(s: &ConvergeSummary, out: &Path) {
     eprintln!(
         "{} / {} ({} with {} noise), over {} (h = {}), {}; errors against the {}",
         s.scene,
@@ -143,36 +208,7 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
         s.limit_reference
     );
     for o in &s.observables {
-        let fmt = |f: &Option<langevin_fem::studies::converge::OrderFit>| match f {
-            None => "no fit (fewer than 2 points)".to_string(),
-            Some(f) => match f.ci {
-                Some((lo, hi)) => {
-                    format!("{:.2} [{lo:.2}, {hi:.2}] ({} points)", f.order, f.points)
-                }
-                None => format!("{:.2} (2 points, no CI)", f.order),
-            },
-        };
-        let expected = match (o.expected.order, o.expected.exact) {
-            (Some(p), _) => format!("{p}"),
-            (None, true) => "exact (zero error)".to_string(),
-            (None, false) => "no single order".to_string(),
-        };
-        eprintln!(
-            "  {:<8} observed {}; exact-error order {}; expected {}; sampling floor at {:?}",
-            o.observable,
-            fmt(&o.observed),
-            if o.exact.is_none() && !o.exact_at_rounding.is_empty() {
-                format!("- (exact at {:?})", o.exact_at_rounding)
-            } else {
-                fmt(&o.exact)
-            },
-            expected,
-            o.floor_values
-        );
-        if !o.note.is_empty() {
-            eprintln!("           {}", o.note);
-        }
-        eprintln!("           expected: {}", o.expected.why);
+        print_observable(o);
     }
     if let Some(c) = &s.discrete_consistency {
         eprintln!(
@@ -198,13 +234,7 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
     eprintln!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),
-        args.out.display(),
+        out.display(),
         s.wall_seconds
     );
-    // Every value failed: nothing was measured (exit 3, as for a failed run).
-    if s.rows.is_empty() && !s.failed.is_empty() {
-        eprintln!("error: every value of the study failed (see above); no rows were written");
-        return Ok(3);
-    }
-    Ok(0)
 }

@@ -11,6 +11,7 @@ use langevin_fem::studies::stability::{
 };
 use std::path::PathBuf;
 
+/// Command-line arguments of `langevin-fem stability`.
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
     /// Linear finite-element scene supplying the filament and the seed (name or .toml

@@ -12,6 +12,7 @@ use langevin_fem::studies::work_precision::{
 };
 use std::path::PathBuf;
 
+/// Command-line arguments of `langevin-fem work-precision`.
 #[derive(Debug, Args)]
 pub struct WorkPrecisionArgs {
     /// Linear finite-element scene (name or .toml path): filament, mesh, seed, burn-in.

@@ -6,30 +6,44 @@
 use super::html::{CSS, esc, url_path};
 use crate::error::{Error, Result};
 use crate::output::write_atomic;
-use serde_json::Value;
+use crate::studies::converge::{ConvergeSummary, OrderFit};
+use crate::studies::stability::{Cell, StabilitySummary, Status};
+use crate::studies::work_precision::WorkPrecisionSummary;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
 use std::fmt::Write as _;
 use std::path::Path;
 
-fn num(v: &Value) -> String {
-    match v.as_f64() {
-        Some(x) if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e4) => format!("{x:.3e}"),
-        Some(x) => format!("{x:.4}"),
-        None => "–".to_string(),
+/// A number as the JSON summary spells it (`200.0`, `1e-5`; `null` if non-finite).
+fn json<T: Serialize>(x: &T) -> String {
+    serde_json::to_string(x).unwrap_or_default()
+}
+
+/// A number for a table: 4 decimals, or 3 significant exponent digits if very small or
+/// large; "–" if non-finite (`null` in the summary).
+fn num(x: f64) -> String {
+    if !x.is_finite() {
+        "–".to_string()
+    } else if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e4) {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.4}")
     }
 }
 
-fn fit(v: &Value) -> String {
-    if v.is_null() {
-        return "–".to_string();
-    }
-    match (v["order"].as_f64(), v["ci"].as_array()) {
-        (Some(p), Some(ci)) if ci.len() == 2 => format!(
-            "{p:.2} [{:.2}, {:.2}] ({} pts)",
-            ci[0].as_f64().unwrap_or(f64::NAN),
-            ci[1].as_f64().unwrap_or(f64::NAN),
-            v["points"]
-        ),
-        (Some(p), _) => format!("{p:.2} (2 pts, no CI)"),
+/// [`num`] of an optional number ("–" if absent).
+fn num_opt(x: Option<f64>) -> String {
+    x.map_or_else(|| "–".to_string(), num)
+}
+
+/// A fitted order with its interval and number of points, "–" if none (or its order is
+/// non-finite).
+fn fit(f: Option<&OrderFit>) -> String {
+    match f {
+        Some(f) if f.order.is_finite() => match f.ci {
+            Some((lo, hi)) => format!("{:.2} [{lo:.2}, {hi:.2}] ({} pts)", f.order, f.points),
+            None => format!("{:.2} (2 pts, no CI)", f.order),
+        },
         _ => "–".to_string(),
     }
 }
@@ -43,11 +57,8 @@ fn figure(h: &mut String, file: &str) {
     );
 }
 
-fn files(h: &mut String, v: &Value) {
-    let list: Vec<&str> = v["files"]
-        .as_array()
-        .map(|a| a.iter().filter_map(Value::as_str).collect())
-        .unwrap_or_default();
+/// The figures (SVG) of a summary, then links to its data files.
+fn files(h: &mut String, list: &[String]) {
     h.push_str("<div class=\"figures\">\n");
     for f in list.iter().filter(|f| f.ends_with(".svg")) {
         figure(h, f);
@@ -59,150 +70,171 @@ fn files(h: &mut String, v: &Value) {
     h.push_str("</p>\n");
 }
 
-fn convergence_section(h: &mut String, v: &Value) {
+/// The heading, the table of observables and the consistency line of one study.
+fn convergence_section(h: &mut String, v: &ConvergeSummary) {
     let _ = writeln!(
         h,
         "<h3>{} / {} ({} noise, {}) over {}</h3>\n<p class=\"meta\">h = {}; {}; errors against the {}; budget {}: {} trajectories x {} tau1 per value; {:.1} s.</p>",
-        esc(v["scene"].as_str().unwrap_or("")),
-        esc(v["run"].as_str().unwrap_or("")),
-        esc(v["noise"].as_str().unwrap_or("")),
-        esc(v["integrator"].as_str().unwrap_or("")),
-        esc(v["over"].as_str().unwrap_or("")),
-        esc(v["h"].as_str().unwrap_or("")),
-        esc(v["fixed"].as_str().unwrap_or("")),
-        esc(v["limit_reference"].as_str().unwrap_or("")),
-        esc(v["budget"].as_str().unwrap_or("")),
-        v["trajectories"],
-        v["duration_tau1"],
-        v["wall_seconds"].as_f64().unwrap_or(0.0)
+        esc(&v.scene),
+        esc(&v.run),
+        esc(&v.noise),
+        esc(&v.integrator),
+        esc(v.over.name()),
+        esc(&v.h),
+        esc(&v.fixed),
+        esc(&v.limit_reference),
+        esc(&v.budget),
+        v.trajectories,
+        json(&v.duration_tau1),
+        v.wall_seconds
     );
     h.push_str("<table><tr><th>observable</th><th>expected order</th><th>observed order (95 % CI)</th><th>agrees</th><th>exact-error order</th><th>sampling floor at</th><th>why / note</th></tr>\n");
-    for o in v["observables"].as_array().into_iter().flatten() {
-        let e = &o["expected"];
-        let expected = match (e["order"].as_f64(), e["exact"].as_bool()) {
+    for o in &v.observables {
+        let e = &o.expected;
+        let expected = match (e.order, e.exact) {
             (Some(p), _) => format!("{p}"),
-            (None, Some(true)) => "exact (zero error)".to_string(),
-            _ => "no single order".to_string(),
+            (None, true) => "exact (zero error)".to_string(),
+            (None, false) => "no single order".to_string(),
         };
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td>{}<td class=\"num\">{}</td><td>{}</td><td class=\"detail\">{} {}</td></tr>",
-            esc(o["observable"].as_str().unwrap_or("")),
+            esc(&o.observable),
             esc(&expected),
-            esc(&fit(&o["observed"])),
-            match o["agrees"].as_bool() {
+            esc(&fit(o.observed.as_ref())),
+            match o.agrees {
                 Some(true) => "<td class=\"pass\">yes</td>",
                 Some(false) => "<td class=\"warn\">no (see note)</td>",
                 None => "<td>–</td>",
             },
-            esc(&fit(&o["exact"])),
-            esc(&o["floor_values"].to_string()),
-            esc(e["why"].as_str().unwrap_or("")),
-            esc(o["note"].as_str().unwrap_or(""))
+            esc(&fit(o.exact.as_ref())),
+            esc(&json(&o.floor_values)),
+            esc(&e.why),
+            esc(&o.note)
         );
     }
     h.push_str("</table>\n");
-    let c = &v["discrete_consistency"];
-    if !c.is_null() {
-        let p = c["p_value"].as_f64().unwrap_or(f64::NAN);
+    if let Some(c) = &v.discrete_consistency {
         let _ = writeln!(
             h,
             "<p class=\"meta\">Simulation against the exact discrete reference of each value: largest |z| = {} ({}) over {} rows, <span class=\"{}\">Bonferroni p = {}</span> (below 0.01: the simulation disagrees with its own discretization); Σz² = {}.</p>",
-            num(&c["max_abs_z"]),
-            esc(c["worst"].as_str().unwrap_or("")),
-            c["rows"],
-            if p < 0.01 { "fail" } else { "pass" },
-            num(&c["p_value"]),
-            num(&c["chi2"])
+            num(c.max_abs_z),
+            esc(&c.worst),
+            c.rows,
+            if c.p_value < 0.01 { "fail" } else { "pass" },
+            num(c.p_value),
+            num(c.chi2)
         );
     }
-    let list = |h: &mut String, key: &str, class: &str, label: &str| {
-        for n in v[key].as_array().into_iter().flatten() {
-            let text = match n {
-                Value::String(t) => t.clone(),
-                other => format!(
-                    "{} at {} = {}: {}",
-                    other["kind"].as_str().unwrap_or(""),
-                    v["over"].as_str().unwrap_or(""),
-                    other["value"],
-                    other["error"].as_str().unwrap_or("")
-                ),
-            };
-            let _ = writeln!(h, "<p class=\"{class}\">{label}{}</p>", esc(&text));
+    let list = |h: &mut String, texts: &[String], class: &str, label: &str| {
+        for text in texts {
+            let _ = writeln!(h, "<p class=\"{class}\">{label}{}</p>", esc(text));
         }
     };
-    list(h, "failed", "fail", "no rows: ");
-    list(h, "warnings", "warn", "warning: ");
-    list(h, "notes", "meta", "");
-    files(h, v);
+    let failed: Vec<String> = v
+        .failed
+        .iter()
+        .map(|f| {
+            format!(
+                "{} at {} = {}: {}",
+                f.kind,
+                v.over.name(),
+                json(&f.value),
+                f.error
+            )
+        })
+        .collect();
+    list(h, &failed, "fail", "no rows: ");
+    list(h, &v.warnings, "warn", "warning: ");
+    list(h, &v.notes, "meta", "");
+    files(h, &v.files);
 }
 
-fn work_precision_section(h: &mut String, v: &Value) {
+/// The work–precision heading and its table of methods.
+fn work_precision_section(h: &mut String, v: &WorkPrecisionSummary) {
     let _ = writeln!(
         h,
         "<h2>Work–precision ({})</h2>\n<p class=\"meta\">Error in &lt;w²(L/2)&gt; against the continuum, {} elements, {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {}. Projected wall time to reach a relative error of {} with 95 % confidence (bias + 2 s.e.), from the measured cost and standard error (s.e. ∝ T<sup>-1/2</sup>); {} points disagree with their exact discrete value by more than 3 s.e.</p>",
-        esc(v["scene"].as_str().unwrap_or("")),
-        v["elements"],
-        v["trajectories"],
-        v["duration_tau1"],
-        v["em_duration_tau1"],
-        v["threads"],
-        num(&v["sampling_floor"]),
-        num(&v["tolerance"]),
-        v["inconsistent_points"]
+        esc(&v.scene),
+        v.elements,
+        v.trajectories,
+        json(&v.duration_tau1),
+        json(&v.em_duration_tau1),
+        v.threads,
+        num(v.sampling_floor),
+        num(v.tolerance),
+        v.inconsistent_points
     );
     h.push_str("<table><tr><th>integrator</th><th>noise</th><th>projected time (s)</th><th>best dt/tau1</th><th>cost vs fastest</th><th>smallest exact bias</th><th>note</th></tr>\n");
-    for m in v["methods"].as_array().into_iter().flatten() {
+    for m in &v.methods {
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"detail\">{}</td></tr>",
-            esc(m["integrator"].as_str().unwrap_or("")),
-            esc(m["noise"].as_str().unwrap_or("")),
-            num(&m["seconds_to_tolerance"]),
-            num(&m["best_dt_tau1"]),
-            num(&m["relative_cost"]),
-            num(&m["min_rel_bias"]),
-            esc(m["note"].as_str().unwrap_or(""))
+            esc(&m.integrator),
+            esc(&m.noise),
+            num_opt(m.seconds_to_tolerance),
+            num_opt(m.best_dt_tau1),
+            num_opt(m.relative_cost),
+            num(m.min_rel_bias),
+            esc(&m.note)
         );
     }
     h.push_str("</table>\n");
-    files(h, v);
+    files(h, &v.files);
 }
 
-fn stability_section(h: &mut String, v: &Value) {
+/// Pushes `x` onto `list` unless it is already there (first-seen order).
+fn push_new<T: PartialEq>(list: &mut Vec<T>, x: T) {
+    if !list.contains(&x) {
+        list.push(x);
+    }
+}
+
+/// One table cell of the stability map: its status, with its detail on hover.
+fn stability_cell(h: &mut String, c: Option<&Cell>) {
+    let Some(c) = c else {
+        h.push_str("<td></td>");
+        return;
+    };
+    let class = match c.status {
+        Status::Stable => "pass",
+        Status::Unstable => "fail",
+        Status::Biased => "warn",
+    };
+    let _ = write!(
+        h,
+        "<td class=\"{class}\" title=\"{}\">{}</td>",
+        esc(&c.detail),
+        esc(c.status.name())
+    );
+}
+
+/// The stability heading and the map: one row per integrator and element count, one
+/// column per dt·λ_max.
+fn stability_section(h: &mut String, v: &StabilitySummary) {
     let _ = writeln!(
         h,
         "<h2>Stability map ({})</h2>\n<p class=\"meta\">Consistent noise, {} trajectories x {} steps after {} burn-in steps per cell. <b>unstable</b>: |m| ≥ 1, refused before running and, forced, overflowing; <b>biased</b>: the stationary variance of a checked mode differs from kT/λ beyond its error (Holm over the map, α = {}); <b>stable</b>: no bias resolved. Exact per-mode formulas: {} of {} comparisons rejected; stability predictions {}.</p>",
-        esc(v["scene"].as_str().unwrap_or("")),
-        v["trajectories"],
-        v["sampled_steps"],
-        v["burn_in_steps"],
-        v["alpha"],
-        v["formula_rejections"],
-        v["formula_tests"],
-        if v["stability_as_predicted"].as_bool() == Some(true) {
+        esc(&v.scene),
+        v.trajectories,
+        v.sampled_steps,
+        v.burn_in_steps,
+        json(&v.alpha),
+        v.formula_rejections,
+        v.formula_tests,
+        if v.stability_as_predicted {
             "all held"
         } else {
             "did NOT all hold"
         }
     );
-    let cells: Vec<&Value> = v["cells"].as_array().into_iter().flatten().collect();
     let mut integrators: Vec<&str> = Vec::new();
     let mut steps: Vec<f64> = Vec::new();
-    let mut elements: Vec<u64> = Vec::new();
-    for c in &cells {
-        let i = c["integrator"].as_str().unwrap_or("");
-        if !integrators.contains(&i) {
-            integrators.push(i);
-        }
-        let a = c["dt_lambda_max"].as_f64().unwrap_or(f64::NAN);
-        if !steps.contains(&a) {
-            steps.push(a);
-        }
-        let e = c["elements"].as_u64().unwrap_or(0);
-        if !elements.contains(&e) {
-            elements.push(e);
-        }
+    let mut elements: Vec<usize> = Vec::new();
+    for c in &v.cells {
+        push_new(&mut integrators, c.integrator.as_str());
+        push_new(&mut steps, c.dt_lambda_max);
+        push_new(&mut elements, c.elements);
     }
     h.push_str("<table><tr><th>integrator</th><th>elements</th>");
     for a in &steps {
@@ -213,34 +245,23 @@ fn stability_section(h: &mut String, v: &Value) {
         for e in &elements {
             let _ = write!(h, "<tr><td>{}</td><td class=\"num\">{e}</td>", esc(i));
             for a in &steps {
-                let c = cells.iter().find(|c| {
-                    c["integrator"].as_str() == Some(i)
-                        && c["elements"].as_u64() == Some(*e)
-                        && c["dt_lambda_max"].as_f64() == Some(*a)
-                });
-                match c {
-                    Some(c) => {
-                        let s = c["status"].as_str().unwrap_or("");
-                        let class = match s {
-                            "stable" => "pass",
-                            "unstable" => "fail",
-                            _ => "warn",
-                        };
-                        let _ = write!(
-                            h,
-                            "<td class=\"{class}\" title=\"{}\">{}</td>",
-                            esc(c["detail"].as_str().unwrap_or("")),
-                            esc(s)
-                        );
-                    }
-                    None => h.push_str("<td></td>"),
-                }
+                let c = v
+                    .cells
+                    .iter()
+                    .find(|c| c.integrator == *i && c.elements == *e && c.dt_lambda_max == *a);
+                stability_cell(h, c);
             }
             h.push_str("</tr>\n");
         }
     }
     h.push_str("</table>\n<p class=\"meta\">Hover a cell for its detail (measured variance ratio, z, unresolved modes); all of it is in stability-cells.csv and stationary-bias.csv.</p>\n");
-    files(h, v);
+    files(h, &v.files);
+}
+
+/// The summary `name` in `dir`, if it exists and reads as a `T`.
+fn read<T: DeserializeOwned>(dir: &Path, name: &str) -> Option<T> {
+    let text = std::fs::read_to_string(dir.join(name)).ok()?;
+    serde_json::from_str(&text).ok()
 }
 
 /// Rebuilds `index.html` in `dir` from the JSON summaries there (convergence studies
@@ -257,10 +278,6 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
         .filter(|n| n.ends_with(".json"))
         .collect();
     names.sort();
-    let read = |n: &str| -> Option<Value> {
-        let text = std::fs::read_to_string(dir.join(n)).ok()?;
-        serde_json::from_str(&text).ok()
-    };
     let mut h = String::new();
     let _ = writeln!(
         h,
@@ -269,17 +286,16 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
     if dir.join("extreme").join("index.html").exists() {
         h.push_str("<h2>Extreme scenes</h2>\n<p>Very stiff, floppy (small-slope warning), 1000-element and huge-EA scenes: <a href=\"extreme/index.html\">extreme/index.html</a>.</p>\n");
     }
-    if let Some(v) = read("stability.json") {
+    if let Some(v) = read::<StabilitySummary>(dir, "stability.json") {
         stability_section(&mut h, &v);
     }
-    if let Some(v) = read("work-precision.json") {
+    if let Some(v) = read::<WorkPrecisionSummary>(dir, "work-precision.json") {
         work_precision_section(&mut h, &v);
     }
-    let studies: Vec<Value> = names
+    let studies: Vec<ConvergeSummary> = names
         .iter()
         .filter(|n| n.ends_with("-elements.json") || n.ends_with("-dt.json"))
-        .filter_map(|n| read(n))
-        .filter(|v| v.get("over").is_some())
+        .filter_map(|n| read(dir, n))
         .collect();
     if !studies.is_empty() {
         h.push_str("<h2>Convergence over element count and time step</h2>\n");
@@ -289,4 +305,39 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
     }
     h.push_str("</body></html>\n");
     write_atomic(&dir.join("index.html"), h.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// Non-finite numbers, written as `null`, read back as NaN (or `None`) and render as
+    /// "–"; the summary serializes back to the same JSON.
+    #[test]
+    fn null_numbers_read_back_and_render() {
+        let text = json!({
+            "scene": "s", "elements": 10, "observable": "w2(L/2)", "continuum": null,
+            "tolerance": 0.01, "trajectories": 2, "duration_tau1": 50.0,
+            "em_duration_tau1": 4.0, "threads": 1, "sampling_floor": null, "points": [],
+            "methods": [{
+                "integrator": "exact-modal", "noise": "consistent", "min_rel_bias": null,
+                "seconds_to_tolerance": null, "best_dt_tau1": null, "relative_cost": null,
+                "note": "n"
+            }],
+            "inconsistent_points": 0, "files": ["a.svg", "a.csv"], "wall_seconds": 1.5
+        });
+        let v: WorkPrecisionSummary = serde_json::from_value(text.clone()).unwrap();
+        assert!(v.continuum.is_nan() && v.methods[0].min_rel_bias.is_nan());
+        assert_eq!(serde_json::to_value(&v).unwrap(), text);
+        let mut h = String::new();
+        work_precision_section(&mut h, &v);
+        assert!(h.contains("sampling floor (median relative s.e.) –."));
+        assert!(h.contains("<td class=\"num\">–</td><td class=\"detail\">n</td>"));
+        let f: OrderFit = serde_json::from_value(
+            json!({"order": 2.0, "std_error": null, "ci": [null, 2.5], "prefactor": 1.0, "points": 3}),
+        )
+        .unwrap();
+        assert_eq!(fit(Some(&f)), "2.00 [NaN, 2.50] (3 pts)");
+    }
 }

@@ -47,7 +47,7 @@ use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -75,8 +75,28 @@ pub const DEFAULT_EM_FRACTIONS: [f64; 4] = [0.9, 0.5, 0.25, 0.125];
 /// Allowed element counts (the references use a dense eigen-decomposition).
 pub const ELEMENTS_RANGE: (usize, usize) = (2, 200);
 
+/// Reads a number of a study's JSON summary back (`#[serde(deserialize_with)]`): the
+/// JSON writer stores a non-finite `f64` as `null`, read back as NaN.
+///
+/// # Errors
+/// The deserializer's, for anything but a number or `null`.
+pub fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// [`nan_if_null`] for an optional pair of numbers (a confidence interval).
+///
+/// # Errors
+/// The deserializer's, for anything but `null` or a pair of numbers or `null`s.
+pub fn pair_nan_if_null<'de, D: Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<Option<(f64, f64)>, D::Error> {
+    let pair = Option::<(Option<f64>, Option<f64>)>::deserialize(d)?;
+    Ok(pair.map(|(a, b)| (a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN))))
+}
+
 /// The refined parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Over {
     /// Element count; h = L/elements.
@@ -104,17 +124,20 @@ impl Over {
 }
 
 /// A least-squares fit of ln error = ln C + p ln h.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OrderFit {
     /// The fitted order p.
+    #[serde(deserialize_with = "nan_if_null")]
     pub order: f64,
     /// Its standard error (residual scale, n − 2 degrees of freedom); `None` with two
     /// points.
     pub std_error: Option<f64>,
     /// The [`CONFIDENCE`] interval (Student's t, n − 2 degrees of freedom); `None` with
     /// two points.
+    #[serde(deserialize_with = "pair_nan_if_null")]
     pub ci: Option<(f64, f64)>,
     /// The fitted prefactor C.
+    #[serde(deserialize_with = "nan_if_null")]
     pub prefactor: f64,
     /// Number of points used.
     pub points: usize,
@@ -216,7 +239,7 @@ pub struct PointReference {
 }
 
 /// The expected order of the error of one observable, and why.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Expected {
     /// The order, if the theory predicts a power law; `None` if the discretization is
     /// exact for this observable or no single order applies.
@@ -577,26 +600,33 @@ pub fn study_ensemble(opts: &ConvergeOptions, spec: &RunSpec) -> Result<Ensemble
 }
 
 /// One row of the table: one value and one observable.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     /// The value (element count or Δt/τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub value: f64,
     /// h.
+    #[serde(deserialize_with = "nan_if_null")]
     pub h: f64,
     /// Observable name.
     pub observable: String,
     /// Ensemble estimate.
+    #[serde(deserialize_with = "nan_if_null")]
     pub estimate: f64,
     /// Its standard error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// Exact discrete reference, if one is known (none for the time-step bias of the
     /// nonlinear θ-schemes).
     pub discrete: Option<f64>,
     /// Limit reference (continuum, or Δt → 0 of this mesh).
+    #[serde(deserialize_with = "nan_if_null")]
     pub limit: f64,
     /// |estimate − limit|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub total_error: f64,
     /// Its standard error (that of the estimate).
+    #[serde(deserialize_with = "nan_if_null")]
     pub total_error_se: f64,
     /// |discrete − limit|, if the discrete reference is known.
     pub exact_error: Option<f64>,
@@ -639,7 +669,7 @@ impl Row {
 }
 
 /// The fitted and expected orders of one observable.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ObservableSummary {
     /// Observable name.
     pub observable: String,
@@ -667,15 +697,18 @@ pub struct ObservableSummary {
 /// trajectories: ⟨w²(L/2)⟩ is dominated by mode 1). A small p-value says the simulation
 /// disagrees with its own discretization's exact value (an integrator, sampling or
 /// burn-in problem, not discretization error). Σz² is reported as a summary.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DiscreteConsistency {
     /// Σz² (descriptive: the rows are not all independent).
+    #[serde(deserialize_with = "nan_if_null")]
     pub chi2: f64,
     /// Rows compared.
     pub rows: usize,
     /// Bonferroni-adjusted p-value of the largest |z|: min(1, rows × p).
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_value: f64,
     /// The largest |z|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_abs_z: f64,
     /// Where the largest |z| is: "observable at value".
     pub worst: String,
@@ -709,9 +742,10 @@ pub fn discrete_consistency(rows: &[Row]) -> Option<DiscreteConsistency> {
 /// A value of the study that gave no rows: its run went unstable (diverged), or its
 /// estimates could not be formed (too short for the correlation time). Recorded, not
 /// fatal: the study goes on with the other values.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FailedValue {
     /// The value (element count or Δt/τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub value: f64,
     /// `"unstable"` (a non-finite state) or `"estimate"` (the estimators failed).
     pub kind: String,
@@ -740,7 +774,7 @@ impl FailedValue {
 }
 
 /// The JSON summary of a study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergeSummary {
     /// Scene name.
     pub scene: String,
@@ -761,6 +795,7 @@ pub struct ConvergeSummary {
     /// Trajectories × duration per value.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Fixed parameters of the study (the other of elements / dt).
     pub fixed: String,
@@ -781,6 +816,7 @@ pub struct ConvergeSummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 
@@ -899,18 +935,12 @@ fn linear_study(
     opts: &ConvergeOptions,
     ensemble: Ensemble,
 ) -> Result<Study> {
-    let spec = scene.runs[run].clone();
+    let spec = &scene.runs[run];
     let over = opts.over;
-    let mut values = match &opts.values {
-        Some(v) => v.clone(),
-        None => default_values(scene, run, over)?,
-    };
-    validate_values(over, &values)?;
-    // Largest h first.
-    values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
+    let values = linear_values(scene, run, opts)?;
     let names = observable_names();
     let limit_dt = match over {
-        Over::Dt => Some(semi_discrete_limit(scene, &spec)?),
+        Over::Dt => Some(semi_discrete_limit(scene, spec)?),
         Over::Elements => None,
     };
     // Prepare everything first, so that bad input fails before any simulation.
@@ -924,16 +954,7 @@ fn linear_study(
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
-        let seed = derive_seed(
-            s.seed,
-            &format!("{}/converge/{}={v}", spec.name, over.name()),
-        );
-        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-        let simulated = par_indexed(ensemble.trajectories as u64, |j| {
-            lr.simulate(&mut trajectory_rng(seed, j), steps)
-        })
-        .and_then(|records| Ok((estimates(lr, &records)?, records)));
-        let (est, records) = match simulated {
+        let (est, records) = match simulate_value(s, lr, &spec.name, over, v, ensemble) {
             Ok(r) => r,
             Err(e) => {
                 failed.push(FailedValue::record(v, e)?);
@@ -945,17 +966,7 @@ fn linear_study(
         {
             largest_slope = Some((v, slope));
         }
-        for (k, name) in names.iter().enumerate() {
-            rows.push(Row::new(
-                v,
-                refp.h,
-                name,
-                est[k],
-                Some(refp.discrete[k]),
-                refp.limit[k],
-                refp.rounding_rel * refp.limit[k].abs(),
-            ));
-        }
+        rows.extend(value_rows(&names, &refp, &est));
         if opts.progress {
             eprintln!(
                 "converge {} {}: {}={v}: {} trajectories x {} tau1, {:.1} s",
@@ -975,8 +986,84 @@ fn linear_study(
         Over::Dt => scene.mesh.elements.is_multiple_of(2),
     };
     let expected = (0..names.len())
-        .map(|k| expected_order(over, &spec, k, node_at_mid))
+        .map(|k| expected_order(over, spec, k, node_at_mid))
         .collect();
+    let (notes, warnings) = slope_notes(scene, over, largest_slope);
+    let (limit_reference, fixed) = linear_texts(scene, spec, over);
+    Ok(Study {
+        values,
+        names,
+        expected,
+        rows,
+        limit_reference,
+        fixed,
+        failed,
+        notes,
+        warnings,
+    })
+}
+
+/// The values of a linear study (the options' or the defaults), validated, largest h
+/// first.
+fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Vec<f64>> {
+    let over = opts.over;
+    let mut values = match &opts.values {
+        Some(v) => v.clone(),
+        None => default_values(scene, run, over)?,
+    };
+    validate_values(over, &values)?;
+    values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
+    Ok(values)
+}
+
+/// An estimate and its standard error.
+type Estimate = (f64, f64);
+
+/// Simulates the ensemble of one value (`s`, `lr` prepared for it; one PCG stream per
+/// trajectory, seeded from the run's name and the value) and forms the estimates of
+/// the observables; the records are returned for the slope diagnostics.
+fn simulate_value(
+    s: &Scene,
+    lr: &LinearRun,
+    run_name: &str,
+    over: Over,
+    v: f64,
+    ensemble: Ensemble,
+) -> Result<(Vec<Estimate>, Vec<TrajectoryRecord>)> {
+    let seed = derive_seed(s.seed, &format!("{run_name}/converge/{}={v}", over.name()));
+    let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+    let records = par_indexed(ensemble.trajectories as u64, |j| {
+        lr.simulate(&mut trajectory_rng(seed, j), steps)
+    })?;
+    Ok((estimates(lr, &records)?, records))
+}
+
+/// The rows of one value: one per observable, from its estimates and exact references.
+fn value_rows(names: &[String], refp: &PointReference, est: &[Estimate]) -> Vec<Row> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            Row::new(
+                refp.value,
+                refp.h,
+                name,
+                est[k],
+                Some(refp.discrete[k]),
+                refp.limit[k],
+                refp.rounding_rel * refp.limit[k].abs(),
+            )
+        })
+        .collect()
+}
+
+/// The note on the largest measured RMS slope of the study (at value `v`) and the
+/// small-slope warning it may call for.
+fn slope_notes(
+    scene: &Scene,
+    over: Over,
+    largest_slope: Option<(f64, (f64, f64))>,
+) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut warnings = Vec::new();
     if let Some((v, slope)) = largest_slope {
@@ -992,26 +1079,25 @@ fn linear_study(
             &scene.filament,
         ));
     }
-    Ok(Study {
-        values,
-        names,
-        expected,
-        rows,
-        limit_reference: match over {
-            Over::Elements => "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)".to_string(),
-            Over::Dt => format!(
+    (notes, warnings)
+}
+
+/// What the errors of a linear study are measured against, and its fixed parameter.
+fn linear_texts(scene: &Scene, spec: &RunSpec, over: Over) -> (String, String) {
+    match over {
+        Over::Elements => (
+            "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)"
+                .to_string(),
+            format!("dt_tau1 = {:e}", spec.dt_tau1),
+        ),
+        Over::Dt => (
+            format!(
                 "dt -> 0 limit of this mesh ({} elements) and noise model: S_ij = 2kT Sigma_q,ij/(lambda_i + lambda_j)",
                 scene.mesh.elements
             ),
-        },
-        fixed: match over {
-            Over::Elements => format!("dt_tau1 = {:e}", spec.dt_tau1),
-            Over::Dt => format!("elements = {}", scene.mesh.elements),
-        },
-        failed,
-        notes,
-        warnings,
-    })
+            format!("elements = {}", scene.mesh.elements),
+        ),
+    }
 }
 
 /// Summarizes `study`, writes its CSV, SVG and JSON and rebuilds nothing else (the CLI

@@ -45,8 +45,9 @@ use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
 use crate::stats;
+use crate::studies::converge::nan_if_null;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -92,7 +93,7 @@ pub struct StabilityOptions {
 }
 
 /// The classification of a cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Status {
     /// Stable; no stationary bias resolved.
@@ -115,44 +116,56 @@ impl Status {
 }
 
 /// The measured stationary variance of one mode against the exact formula.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModeBias {
     /// Mode number (1-based, ascending rate).
     pub mode: usize,
     /// λ_i Δt.
+    #[serde(deserialize_with = "nan_if_null")]
     pub lambda_dt: f64,
     /// One-step multiplier m_i of the mode.
+    #[serde(deserialize_with = "nan_if_null")]
     pub multiplier: f64,
     /// Measured variance / (kT/λ_i).
+    #[serde(deserialize_with = "nan_if_null")]
     pub measured_ratio: f64,
     /// Its standard error (autocorrelation-aware, trajectories in quadrature).
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// The exact discrete-time ratio of the integrator.
+    #[serde(deserialize_with = "nan_if_null")]
     pub formula_ratio: f64,
     /// z of measured against the formula.
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_formula: f64,
     /// Two-sided p-value of that z.
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_formula: f64,
     /// z of measured against 1 (no bias).
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_bias: f64,
     /// Two-sided p-value of that z.
+    #[serde(deserialize_with = "nan_if_null")]
     pub p_bias: f64,
     /// Whether Holm over the whole map rejects the formula for this mode.
     pub formula_rejected: bool,
 }
 
 /// One cell of the map.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cell {
     /// Integrator.
     pub integrator: String,
     /// Element count.
     pub elements: usize,
     /// a = Δt·λ_max.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_lambda_max: f64,
     /// Δt/τ1.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_tau1: f64,
     /// Multiplier of the fastest mode.
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_multiplier: f64,
     /// Classification.
     pub status: Status,
@@ -165,19 +178,21 @@ pub struct Cell {
     /// Modes not checked because the run cannot resolve them.
     pub unresolved_modes: usize,
     /// Largest |measured − formula| bias predicted among the checked modes, |ratio − 1|.
+    #[serde(deserialize_with = "nan_if_null")]
     pub predicted_max_bias: f64,
     /// The checked modes.
     pub modes: Vec<ModeBias>,
 }
 
 /// The JSON summary of a stability study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StabilitySummary {
     /// Scene name.
     pub scene: String,
     /// Noise model (consistent).
     pub noise: String,
     /// Family-wise level.
+    #[serde(deserialize_with = "nan_if_null")]
     pub alpha: f64,
     /// Trajectories per cell.
     pub trajectories: usize,
@@ -197,6 +212,7 @@ pub struct StabilitySummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 
@@ -604,6 +620,35 @@ fn classify(cell: &mut Cell, biased: bool) {
 pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let start = Instant::now();
     validate(opts)?;
+    let mut cells = run_cells(opts)?;
+    classify_cells(&mut cells, opts.alpha);
+    let (formula_tests, formula_rejections) = judge_formulas(&mut cells, opts.alpha);
+    let stability_as_predicted = cells.iter().all(|c| match c.status {
+        Status::Unstable => c.refused.is_some() && c.diverged_at.is_some(),
+        _ => c.refused.is_none(),
+    });
+    let files = write_outputs(opts, &cells)?;
+    let summary = StabilitySummary {
+        scene: opts.scene.name.clone(),
+        noise: NoiseModel::Consistent.name().to_string(),
+        alpha: opts.alpha,
+        trajectories: opts.trajectories,
+        burn_in_steps: opts.burn_in_steps,
+        sampled_steps: opts.sampled_steps,
+        formula_tests,
+        formula_rejections,
+        stability_as_predicted,
+        cells,
+        files,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    write_json(&opts.out.join("stability.json"), &summary)?;
+    Ok(summary)
+}
+
+/// Runs every cell of the map (rayon over cells), integrator-major, then elements,
+/// then a.
+fn run_cells(opts: &StabilityOptions) -> Result<Vec<Cell>> {
     let mut jobs = Vec::new();
     for &k in &opts.integrators {
         for &e in &opts.elements {
@@ -612,8 +657,7 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
             }
         }
     }
-    let mut cells = jobs
-        .par_iter()
+    jobs.par_iter()
         .map(|&(k, e, a)| {
             let t0 = Instant::now();
             let c = run_cell(opts, k, e, a);
@@ -628,15 +672,18 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
             }
             c
         })
-        .collect::<Result<Vec<_>>>()?;
-    // Holm over every bias test of the map: a cell is biased if any of its modes is
-    // rejected.
+        .collect()
+}
+
+/// Holm at `alpha` over every bias test of the map: a simulated cell is biased if any of
+/// its modes is rejected; classifies the simulated cells.
+fn classify_cells(cells: &mut [Cell], alpha: f64) {
     let p_bias: Vec<f64> = cells
         .iter()
         .filter(|c| c.status != Status::Unstable)
         .flat_map(|c| c.modes.iter().map(|m| m.p_bias))
         .collect();
-    let bias_decisions = stats::holm(&p_bias, opts.alpha);
+    let bias_decisions = stats::holm(&p_bias, alpha);
     let mut it = bias_decisions.iter();
     for c in cells.iter_mut().filter(|c| c.status != Status::Unstable) {
         let mut biased = false;
@@ -645,30 +692,58 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
         }
         classify(c, biased);
     }
-    // Holm over every formula comparison of the map.
+}
+
+/// Holm at `alpha` over every formula comparison of the map, marking the rejected
+/// modes; returns the number of comparisons and of rejections.
+fn judge_formulas(cells: &mut [Cell], alpha: f64) -> (usize, usize) {
     let p: Vec<f64> = cells
         .iter()
         .flat_map(|c| c.modes.iter().map(|m| m.p_formula))
         .collect();
-    let decisions = stats::holm(&p, opts.alpha);
+    let decisions = stats::holm(&p, alpha);
     let mut it = decisions.iter();
-    for c in &mut cells {
+    for c in cells.iter_mut() {
         for m in &mut c.modes {
             m.formula_rejected = it.next().is_some_and(|d| d.1);
         }
     }
-    let formula_rejections = decisions.iter().filter(|d| d.1).count();
-    let stability_as_predicted = cells.iter().all(|c| match c.status {
-        Status::Unstable => c.refused.is_some() && c.diverged_at.is_some(),
-        _ => c.refused.is_none(),
-    });
+    (p.len(), decisions.iter().filter(|d| d.1).count())
+}
 
+/// Writes the CSV tables and the figures in `opts.out`; returns the files written, with
+/// `stability.json` (written last, by the caller).
+fn write_outputs(opts: &StabilityOptions, cells: &[Cell]) -> Result<Vec<String>> {
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let mut files = Vec::new();
+    write_atomic(
+        &opts.out.join("stability-cells.csv"),
+        cells_csv(cells).as_bytes(),
+    )?;
+    files.push("stability-cells.csv".to_string());
+    write_atomic(
+        &opts.out.join("stationary-bias.csv"),
+        modes_csv(cells).as_bytes(),
+    )?;
+    files.push("stationary-bias.csv".to_string());
+    for &k in &opts.integrators {
+        let name = format!("stability-map-{}.svg", k.name());
+        map_figure(&opts.scene.name, k, cells).write_svg(&opts.out.join(&name))?;
+        files.push(name);
+    }
+    bias_figure(&opts.scene.name, &opts.integrators, cells)
+        .write_svg(&opts.out.join("stationary-bias.svg"))?;
+    files.push("stationary-bias.svg".to_string());
+    files.push("stability.json".to_string());
+    Ok(files)
+}
+
+/// `stability-cells.csv`: one line per cell.
+fn cells_csv(cells: &[Cell]) -> String {
     let mut csv = String::from(
         "integrator,elements,dt_lambda_max,dt_tau1,max_multiplier,status,checked_modes,unresolved_modes,predicted_max_bias,diverged_at,detail\n",
     );
-    for c in &cells {
+    for c in cells {
         csv.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
             c.integrator,
@@ -684,12 +759,15 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
             c.detail.replace('"', "'")
         ));
     }
-    write_atomic(&opts.out.join("stability-cells.csv"), csv.as_bytes())?;
-    files.push("stability-cells.csv".to_string());
+    csv
+}
+
+/// `stationary-bias.csv`: one line per checked mode of every cell.
+fn modes_csv(cells: &[Cell]) -> String {
     let mut csv = String::from(
         "integrator,elements,dt_lambda_max,mode,lambda_dt,multiplier,measured_ratio,std_error,formula_ratio,z_formula,p_formula,formula_rejected,z_bias,p_bias\n",
     );
-    for c in &cells {
+    for c in cells {
         for m in &c.modes {
             csv.push_str(&format!(
                 "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
@@ -710,33 +788,7 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
             ));
         }
     }
-    write_atomic(&opts.out.join("stationary-bias.csv"), csv.as_bytes())?;
-    files.push("stationary-bias.csv".to_string());
-    for &k in &opts.integrators {
-        let name = format!("stability-map-{}.svg", k.name());
-        map_figure(&opts.scene.name, k, &cells).write_svg(&opts.out.join(&name))?;
-        files.push(name);
-    }
-    bias_figure(&opts.scene.name, &opts.integrators, &cells)
-        .write_svg(&opts.out.join("stationary-bias.svg"))?;
-    files.push("stationary-bias.svg".to_string());
-    files.push("stability.json".to_string());
-    let summary = StabilitySummary {
-        scene: opts.scene.name.clone(),
-        noise: NoiseModel::Consistent.name().to_string(),
-        alpha: opts.alpha,
-        trajectories: opts.trajectories,
-        burn_in_steps: opts.burn_in_steps,
-        sampled_steps: opts.sampled_steps,
-        formula_tests: p.len(),
-        formula_rejections,
-        stability_as_predicted,
-        cells,
-        files,
-        wall_seconds: start.elapsed().as_secs_f64(),
-    };
-    write_json(&opts.out.join("stability.json"), &summary)?;
-    Ok(summary)
+    csv
 }
 
 fn map_figure(scene: &str, kind: IntegratorKind, cells: &[Cell]) -> Figure {

@@ -30,8 +30,9 @@ use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::linear::LinearRun;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
-use serde::Serialize;
-use std::path::PathBuf;
+use crate::studies::converge::nan_if_null;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Default methods: the paper's explicit scheme with both noise models, backward Euler,
@@ -77,50 +78,62 @@ pub struct WorkPrecisionOptions {
 }
 
 /// One method at one time step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WpPoint {
     /// Integrator.
     pub integrator: String,
     /// Noise model.
     pub noise: String,
     /// Δt/τ1.
+    #[serde(deserialize_with = "nan_if_null")]
     pub dt_tau1: f64,
     /// Trajectories.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1).
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Steps per trajectory (burn-in + sampled).
     pub steps_per_trajectory: u64,
     /// Measured wall time of the ensemble (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
     /// Estimate of ⟨w²(L/2)⟩.
+    #[serde(deserialize_with = "nan_if_null")]
     pub estimate: f64,
     /// Its standard error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub std_error: f64,
     /// Exact discrete value (this mesh, noise, integrator and Δt).
+    #[serde(deserialize_with = "nan_if_null")]
     pub discrete: f64,
     /// Continuum value.
+    #[serde(deserialize_with = "nan_if_null")]
     pub continuum: f64,
     /// |estimate − continuum|/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_error: f64,
     /// std_error/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_std_error: f64,
     /// |discrete − continuum|/continuum.
+    #[serde(deserialize_with = "nan_if_null")]
     pub rel_bias: f64,
     /// (estimate − discrete)/std_error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub z_discrete: f64,
     /// Projected wall time to reach the tolerance (s), if the bias allows it.
     pub seconds_to_tolerance: Option<f64>,
 }
 
 /// The cheapest way a method reaches the tolerance.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MethodSummary {
     /// Integrator.
     pub integrator: String,
     /// Noise model.
     pub noise: String,
     /// Smallest relative bias over the time steps studied.
+    #[serde(deserialize_with = "nan_if_null")]
     pub min_rel_bias: f64,
     /// Projected wall time to reach the tolerance (s), if any time step can.
     pub seconds_to_tolerance: Option<f64>,
@@ -133,7 +146,7 @@ pub struct MethodSummary {
 }
 
 /// The JSON summary of a work–precision study.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorkPrecisionSummary {
     /// Scene name.
     pub scene: String,
@@ -142,19 +155,24 @@ pub struct WorkPrecisionSummary {
     /// The observable.
     pub observable: String,
     /// Its continuum value.
+    #[serde(deserialize_with = "nan_if_null")]
     pub continuum: f64,
     /// The tolerance of the table (relative error).
+    #[serde(deserialize_with = "nan_if_null")]
     pub tolerance: f64,
     /// Trajectories per point.
     pub trajectories: usize,
     /// Sampled duration per trajectory (τ1), stable integrators.
+    #[serde(deserialize_with = "nan_if_null")]
     pub duration_tau1: f64,
     /// Sampled duration per trajectory (τ1), euler-maruyama.
+    #[serde(deserialize_with = "nan_if_null")]
     pub em_duration_tau1: f64,
     /// Threads of the rayon pool.
     pub threads: usize,
     /// Median relative standard error of the points (the sampling floor of this
     /// ensemble).
+    #[serde(deserialize_with = "nan_if_null")]
     pub sampling_floor: f64,
     /// All points.
     pub points: Vec<WpPoint>,
@@ -165,6 +183,7 @@ pub struct WorkPrecisionSummary {
     /// Files written (relative to the output directory).
     pub files: Vec<String>,
     /// Wall time (s).
+    #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
 }
 
@@ -255,6 +274,9 @@ fn point_scene(
     s
 }
 
+/// A method at one time step, prepared: the method, Δt/τ1, its scene and its run.
+type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
+
 /// Runs the study and writes `work-precision.{csv,json,svg}` and
 /// `work-precision-projected.svg` in `opts.out`.
 ///
@@ -264,103 +286,18 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     let start = Instant::now();
     validate(opts)?;
     // Prepare every point first, so that bad input fails before any simulation.
-    let mut prepared = Vec::new();
-    for &method in &opts.methods {
-        let dts: Vec<f64> = if method.0 == IntegratorKind::EulerMaruyama {
-            let s = point_scene(opts, method, 1.0);
-            let beam =
-                crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
-            let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
-            opts.em_fractions.iter().map(|f| f * limit).collect()
-        } else {
-            opts.dt_tau1.clone()
-        };
-        for dt in dts {
-            let s = point_scene(opts, method, dt);
-            let lr = LinearRun::prepare(&s, &s.runs[0])?;
-            prepared.push((method, dt, s, lr));
-        }
-    }
-    let mut points = Vec::new();
-    for (method, dt, s, lr) in &prepared {
-        let seed = derive_seed(
-            s.seed,
-            &format!(
-                "work-precision/{}/{}/{dt:e}",
-                method.0.name(),
-                method.1.name()
-            ),
-        );
-        let duration = s.runs[0].quick.duration_tau1;
-        let steps = lr.sampled_steps(duration * s.filament.tau1());
-        let t0 = Instant::now();
-        let records = crate::dynamics::par_indexed(opts.trajectories as u64, |j| {
-            lr.simulate(&mut trajectory_rng(seed, j), steps)
-        })?;
-        let wall = t0.elapsed().as_secs_f64();
-        let (est, se) = lr.profile_square_estimate(&records, 0)?;
-        let cont = lr.reference.profile_continuum[0];
-        let disc = lr.reference.profile_discrete[0];
-        let mut p = WpPoint {
-            integrator: method.0.name().to_string(),
-            noise: method.1.name().to_string(),
-            dt_tau1: *dt,
-            trajectories: opts.trajectories,
-            duration_tau1: duration,
-            steps_per_trajectory: lr.burn_in_steps + steps,
-            wall_seconds: wall,
-            estimate: est,
-            std_error: se,
-            discrete: disc,
-            continuum: cont,
-            rel_error: (est - cont).abs() / cont,
-            rel_std_error: se / cont,
-            rel_bias: (disc - cont).abs() / cont,
-            z_discrete: (est - disc) / se,
-            seconds_to_tolerance: None,
-        };
-        p.seconds_to_tolerance = projected_seconds(&p, opts.tolerance);
-        if opts.progress {
-            eprintln!(
-                "work-precision {} {} dt/tau1={dt:.3e}: error {:.2e} +- {:.1e} (bias {:.1e}), {:.2} s",
-                p.integrator, p.noise, p.rel_error, p.rel_std_error, p.rel_bias, wall
-            );
-        }
-        points.push(p);
-    }
+    let prepared = prepare_points(opts)?;
+    let points = prepared
+        .iter()
+        .map(|p| run_point(opts, p))
+        .collect::<Result<Vec<_>>>()?;
     let methods = summarize(opts, &points);
     let mut ses: Vec<f64> = points.iter().map(|p| p.rel_std_error).collect();
     ses.sort_by(f64::total_cmp);
     let sampling_floor = ses.get(ses.len() / 2).copied().unwrap_or(f64::NAN);
 
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
-    let mut csv = String::from(
-        "integrator,noise,dt_tau1,trajectories,duration_tau1,steps_per_trajectory,wall_seconds,estimate,std_error,discrete,continuum,rel_error,rel_std_error,rel_bias,z_discrete,seconds_to_tolerance\n",
-    );
-    for p in &points {
-        csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.integrator,
-            p.noise,
-            p.dt_tau1,
-            p.trajectories,
-            p.duration_tau1,
-            p.steps_per_trajectory,
-            p.wall_seconds,
-            p.estimate,
-            p.std_error,
-            p.discrete,
-            p.continuum,
-            p.rel_error,
-            p.rel_std_error,
-            p.rel_bias,
-            p.z_discrete,
-            p.seconds_to_tolerance
-                .map(|t| t.to_string())
-                .unwrap_or_default()
-        ));
-    }
-    write_atomic(&opts.out.join("work-precision.csv"), csv.as_bytes())?;
+    write_points_csv(&opts.out.join("work-precision.csv"), &points)?;
     measured_figure(opts, &points, sampling_floor)
         .write_svg(&opts.out.join("work-precision.svg"))?;
     projected_figure(opts, &points).write_svg(&opts.out.join("work-precision-projected.svg"))?;
@@ -391,6 +328,109 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     };
     write_json(&opts.out.join("work-precision.json"), &summary)?;
     Ok(summary)
+}
+
+/// Every method at each of its time steps (the options' Δt/τ1, or for euler-maruyama
+/// the fractions of its stability limit), prepared.
+fn prepare_points(opts: &WorkPrecisionOptions) -> Result<Vec<PreparedPoint>> {
+    let mut prepared = Vec::new();
+    for &method in &opts.methods {
+        let dts: Vec<f64> = if method.0 == IntegratorKind::EulerMaruyama {
+            let s = point_scene(opts, method, 1.0);
+            let beam =
+                crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
+            let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
+            opts.em_fractions.iter().map(|f| f * limit).collect()
+        } else {
+            opts.dt_tau1.clone()
+        };
+        for dt in dts {
+            let s = point_scene(opts, method, dt);
+            let lr = LinearRun::prepare(&s, &s.runs[0])?;
+            prepared.push((method, dt, s, lr));
+        }
+    }
+    Ok(prepared)
+}
+
+/// Simulates one point's ensemble, timing it, and measures its errors and projected
+/// cost.
+fn run_point(opts: &WorkPrecisionOptions, (method, dt, s, lr): &PreparedPoint) -> Result<WpPoint> {
+    let seed = derive_seed(
+        s.seed,
+        &format!(
+            "work-precision/{}/{}/{dt:e}",
+            method.0.name(),
+            method.1.name()
+        ),
+    );
+    let duration = s.runs[0].quick.duration_tau1;
+    let steps = lr.sampled_steps(duration * s.filament.tau1());
+    let t0 = Instant::now();
+    let records = crate::dynamics::par_indexed(opts.trajectories as u64, |j| {
+        lr.simulate(&mut trajectory_rng(seed, j), steps)
+    })?;
+    let wall = t0.elapsed().as_secs_f64();
+    let (est, se) = lr.profile_square_estimate(&records, 0)?;
+    let cont = lr.reference.profile_continuum[0];
+    let disc = lr.reference.profile_discrete[0];
+    let mut p = WpPoint {
+        integrator: method.0.name().to_string(),
+        noise: method.1.name().to_string(),
+        dt_tau1: *dt,
+        trajectories: opts.trajectories,
+        duration_tau1: duration,
+        steps_per_trajectory: lr.burn_in_steps + steps,
+        wall_seconds: wall,
+        estimate: est,
+        std_error: se,
+        discrete: disc,
+        continuum: cont,
+        rel_error: (est - cont).abs() / cont,
+        rel_std_error: se / cont,
+        rel_bias: (disc - cont).abs() / cont,
+        z_discrete: (est - disc) / se,
+        seconds_to_tolerance: None,
+    };
+    p.seconds_to_tolerance = projected_seconds(&p, opts.tolerance);
+    if opts.progress {
+        eprintln!(
+            "work-precision {} {} dt/tau1={dt:.3e}: error {:.2e} +- {:.1e} (bias {:.1e}), {:.2} s",
+            p.integrator, p.noise, p.rel_error, p.rel_std_error, p.rel_bias, wall
+        );
+    }
+    Ok(p)
+}
+
+/// Writes the points as CSV (one line per point).
+fn write_points_csv(path: &Path, points: &[WpPoint]) -> Result<()> {
+    let mut csv = String::from(
+        "integrator,noise,dt_tau1,trajectories,duration_tau1,steps_per_trajectory,wall_seconds,estimate,std_error,discrete,continuum,rel_error,rel_std_error,rel_bias,z_discrete,seconds_to_tolerance\n",
+    );
+    for p in points {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            p.integrator,
+            p.noise,
+            p.dt_tau1,
+            p.trajectories,
+            p.duration_tau1,
+            p.steps_per_trajectory,
+            p.wall_seconds,
+            p.estimate,
+            p.std_error,
+            p.discrete,
+            p.continuum,
+            p.rel_error,
+            p.rel_std_error,
+            p.rel_bias,
+            p.z_discrete,
+            p.seconds_to_tolerance
+                .map(|t| t.to_string())
+                .unwrap_or_default()
+        ));
+    }
+    write_atomic(path, csv.as_bytes())
 }
 
 fn method_points(points: &[WpPoint], (k, n): (IntegratorKind, NoiseModel)) -> Vec<&WpPoint> {

@@ -33,9 +33,11 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
 use crate::rng::derive_seed;
-use crate::scene::compression::{CONTINUUM_MODES, CompressionRun, force_estimates_diagnosed};
+use crate::scene::compression::{
+    CONTINUUM_MODES, CompressionRun, ForceEstimates, ForceRecord, force_estimates_diagnosed,
+};
 use crate::scene::linear::small_slope_warning;
-use crate::scene::{Ensemble, Scene};
+use crate::scene::{CompressionSpec, Ensemble, RunSpec, Scene};
 use crate::theory::compression::{
     CompressionTheory, Dims, StoredLengthLaw, buckling_load_discrete,
 };
@@ -355,22 +357,8 @@ pub(super) fn study(
     ensemble: Ensemble,
 ) -> Result<Study> {
     let over = opts.over;
-    let spec = scene.runs[run].clone();
-    let strains = opts
-        .strain_ratios
-        .clone()
-        .unwrap_or_else(|| DEFAULT_STRAIN_RATIOS.to_vec());
-    validate_strains(&strains)?;
-    let mut values = match &opts.values {
-        Some(v) => v.clone(),
-        None => default_values(scene, run, over),
-    };
-    validate_values(over, &values)?;
-    // Largest h first.
-    values.sort_by(|a, b| match over {
-        Over::Elements => a.total_cmp(b),
-        Over::Dt => b.total_cmp(a),
-    });
+    let spec = &scene.runs[run];
+    let (strains, values) = strains_and_values(scene, run, opts)?;
     // Everything that can be refused is checked before any simulation.
     let prepared = values
         .iter()
@@ -391,56 +379,28 @@ pub(super) fn study(
             "a compression scene with a [compression] table",
         ));
     };
-    let tau1 = scene.filament.tau1();
     let mut rows = Vec::new();
     let mut failed = Vec::new();
     let mut notes = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     for (((s, cr), point), &v) in prepared.iter().zip(&points).zip(&values) {
         let t0 = Instant::now();
-        let steps = cr.sampled_steps(ensemble.duration_tau1 * tau1);
-        let label = format!("{}/converge/{}={v}", spec.name, over.name());
-        let simulated = cr
-            .simulate_ensemble(
-                |i| derive_seed(s.seed, &format!("{label}/{i}")),
-                ensemble.trajectories,
-                steps,
-                || {},
-            )
-            .and_then(|records| Ok((force_estimates_diagnosed(&records, &s.filament)?, records)));
-        let (est, records) = match simulated {
+        let (est, records) = match simulate_value(s, cr, &spec.name, over, v, ensemble) {
             Ok(r) => r,
             Err(e) => {
-                let f = FailedValue::record(v, e)?;
-                if opts.progress {
-                    eprintln!(
-                        "converge {} {}: {}={v}: {}: {}",
-                        scene.name,
-                        spec.name,
-                        over.name(),
-                        f.kind,
-                        f.error
-                    );
-                }
-                failed.push(f);
+                failed.push(record_failure(scene, spec, opts, v, e)?);
                 continue;
             }
         };
         let slope = cr.largest_rms_slope(&records);
-        notes.push(format!(
-            "{}={v}: {}largest integrated autocorrelation time of F {:.1} samples (every {} tau1){}",
-            over.name(),
-            if exact_stationary(spec.integrator) {
-                format!("acceptance {:.4}, ", est.acceptance)
-            } else {
-                String::new()
-            },
-            est.max_tau_int,
-            comp.sample_every_tau1,
-            slope.map_or(String::new(), |(sl, x, i)| format!(
-                ", largest RMS slope {sl:.3} rad at x/L = {x:.2} (strain ratio {})",
-                strains[i]
-            ))
+        notes.push(value_note(
+            over,
+            v,
+            spec.integrator,
+            &est,
+            &comp,
+            slope,
+            &strains,
         ));
         if let Some((sl, x, i)) = slope
             && largest_slope.as_ref().is_none_or(|l| sl > l.1.0)
@@ -450,17 +410,7 @@ pub(super) fn study(
                 (sl, x),
             ));
         }
-        for (k, name) in names.iter().enumerate() {
-            rows.push(Row::new(
-                v,
-                point.h,
-                name,
-                est.force[k],
-                point.discrete.as_ref().map(|d| d[k]),
-                point.limit[k],
-                THEORY_ROUNDING,
-            ));
-        }
+        rows.extend(point_rows(&names, point, &est));
         if opts.progress {
             eprintln!(
                 "converge {} {} ({}): {}={v}: {} strains x {} trajectories x {} tau1, {:.1} s",
@@ -479,36 +429,165 @@ pub(super) fn study(
         .and_then(|(what, slope)| small_slope_warning(&what, slope, &scene.filament))
         .into_iter()
         .collect();
-    let p = scene.filament;
+    let (limit_reference, fixed) = texts(scene, spec, over, &comp);
     Ok(Study {
         values,
         names,
         expected,
         rows,
-        limit_reference: match over {
-            Over::Elements => format!(
+        limit_reference,
+        fixed,
+        failed,
+        notes,
+        warnings,
+    })
+}
+
+/// Records the failure of value `v` ([`FailedValue::record`]), with a progress line.
+///
+/// # Errors
+/// `e` itself unless it is a divergence or an estimator failure.
+fn record_failure(
+    scene: &Scene,
+    spec: &RunSpec,
+    opts: &ConvergeOptions,
+    v: f64,
+    e: Error,
+) -> Result<FailedValue> {
+    let f = FailedValue::record(v, e)?;
+    if opts.progress {
+        eprintln!(
+            "converge {} {}: {}={v}: {}: {}",
+            scene.name,
+            spec.name,
+            opts.over.name(),
+            f.kind,
+            f.error
+        );
+    }
+    Ok(f)
+}
+
+/// The strains and values of a study (the options' or the defaults), validated; the
+/// values largest h first.
+fn strains_and_values(
+    scene: &Scene,
+    run: usize,
+    opts: &ConvergeOptions,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let over = opts.over;
+    let strains = opts
+        .strain_ratios
+        .clone()
+        .unwrap_or_else(|| DEFAULT_STRAIN_RATIOS.to_vec());
+    validate_strains(&strains)?;
+    let mut values = match &opts.values {
+        Some(v) => v.clone(),
+        None => default_values(scene, run, over),
+    };
+    validate_values(over, &values)?;
+    values.sort_by(|a, b| match over {
+        Over::Elements => a.total_cmp(b),
+        Over::Dt => b.total_cmp(a),
+    });
+    Ok((strains, values))
+}
+
+/// Simulates the ensemble of one value (`s`, `cr` prepared for it; one seed per
+/// trajectory, from the run's name and the value) and forms the force estimates; the
+/// records are returned for the slope diagnostics.
+fn simulate_value(
+    s: &Scene,
+    cr: &CompressionRun,
+    run_name: &str,
+    over: Over,
+    v: f64,
+    ensemble: Ensemble,
+) -> Result<(ForceEstimates, Vec<Vec<ForceRecord>>)> {
+    let steps = cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+    let label = format!("{run_name}/converge/{}={v}", over.name());
+    let records = cr.simulate_ensemble(
+        |i| derive_seed(s.seed, &format!("{label}/{i}")),
+        ensemble.trajectories,
+        steps,
+        || {},
+    )?;
+    Ok((force_estimates_diagnosed(&records, &s.filament)?, records))
+}
+
+/// The note of one value: acceptance (Metropolis), correlation time of F and largest RMS
+/// slope.
+fn value_note(
+    over: Over,
+    v: f64,
+    integrator: IntegratorKind,
+    est: &ForceEstimates,
+    comp: &CompressionSpec,
+    slope: Option<(f64, f64, usize)>,
+    strains: &[f64],
+) -> String {
+    format!(
+        "{}={v}: {}largest integrated autocorrelation time of F {:.1} samples (every {} tau1){}",
+        over.name(),
+        if exact_stationary(integrator) {
+            format!("acceptance {:.4}, ", est.acceptance)
+        } else {
+            String::new()
+        },
+        est.max_tau_int,
+        comp.sample_every_tau1,
+        slope.map_or(String::new(), |(sl, x, i)| format!(
+            ", largest RMS slope {sl:.3} rad at x/L = {x:.2} (strain ratio {})",
+            strains[i]
+        ))
+    )
+}
+
+/// The rows of one value: one per strain, from its estimates and exact references.
+fn point_rows(names: &[String], point: &CompressionPoint, est: &ForceEstimates) -> Vec<Row> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            Row::new(
+                point.value,
+                point.h,
+                name,
+                est.force[k],
+                point.discrete.as_ref().map(|d| d[k]),
+                point.limit[k],
+                THEORY_ROUNDING,
+            )
+        })
+        .collect()
+}
+
+/// What the errors of a compression study are measured against, and its fixed
+/// parameters.
+fn texts(scene: &Scene, spec: &RunSpec, over: Over, comp: &CompressionSpec) -> (String, String) {
+    let p = scene.filament;
+    match over {
+        Over::Elements => (
+            format!(
                 "continuum exact equilibrium theory of <F>/F_c0 ({}D, EI/(kT L) = {}, EA L/kT = {:e}; {CONTINUUM_MODES} modes plus exact tail cumulants); the exact discrete reference is the same theory for each mesh",
                 scene.dims,
                 p.bending_rigidity / (p.kt * p.length),
                 p.stretch_rigidity * p.length / p.kt
             ),
-            Over::Dt => format!(
-                "exact equilibrium theory of <F>/F_c0 of this mesh ({} elements, the dt -> 0 law)",
-                scene.mesh.elements
-            ),
-        },
-        fixed: match over {
-            Over::Elements => format!(
+            format!(
                 "dt_tau1 = {:e}, burn-in {} tau1 per strain",
                 spec.dt_tau1, comp.burn_in_tau1
             ),
-            Over::Dt => format!(
+        ),
+        Over::Dt => (
+            format!(
+                "exact equilibrium theory of <F>/F_c0 of this mesh ({} elements, the dt -> 0 law)",
+                scene.mesh.elements
+            ),
+            format!(
                 "elements = {}, burn-in {} tau1 per strain",
                 scene.mesh.elements, comp.burn_in_tau1
             ),
-        },
-        failed,
-        notes,
-        warnings,
-    })
+        ),
+    }
 }
