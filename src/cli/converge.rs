@@ -70,17 +70,6 @@ enum BudgetArg {
     Full,
 }
 
-// TODO(integrator-kind): parse with `IntegratorKind::from_str` and list
-// `IntegratorKind::ALL` (all five kinds) once they exist, instead of this list.
-/// The integrators a study may switch a run to.
-const INTEGRATORS: [IntegratorKind; 5] = [
-    IntegratorKind::EulerMaruyama,
-    IntegratorKind::BackwardEuler,
-    IntegratorKind::CrankNicolson,
-    IntegratorKind::ExactModal,
-    IntegratorKind::MetropolisCrankNicolson,
-];
-
 /// Runs the study, prints a summary of the fitted orders on stderr and rebuilds the
 /// index page of the output directory; exit code 0, or 3 if every value failed (diverged
 /// or too short for its correlation time).
@@ -142,11 +131,11 @@ fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
 
 /// The integrator named by `--integrator`.
 fn parse_integrator(name: &str) -> Result<IntegratorKind> {
-    INTEGRATORS
+    IntegratorKind::ALL
         .into_iter()
         .find(|k| k.name() == name.trim())
         .ok_or_else(|| {
-            let names: Vec<&str> = INTEGRATORS.iter().map(|k| k.name()).collect();
+            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
             Error::invalid(
                 "--integrator",
                 name.trim(),

@@ -64,7 +64,7 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
                         Error::invalid(
                             "--integrators",
                             s.trim(),
-                            "euler-maruyama, backward-euler, crank-nicolson or exact-modal",
+                            IntegratorKind::list(&IntegratorKind::LINEAR),
                         )
                     })
             })

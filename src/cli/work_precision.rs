@@ -53,19 +53,23 @@ pub struct WorkPrecisionArgs {
 }
 
 fn parse_method(text: &str) -> Result<(IntegratorKind, NoiseModel)> {
-    let allowed = "INTEGRATOR/NOISE with INTEGRATOR one of euler-maruyama, backward-euler, crank-nicolson, exact-modal and NOISE one of consistent, element-uniform";
+    let integrators: Vec<&str> = IntegratorKind::LINEAR.iter().map(|k| k.name()).collect();
+    let allowed = format!(
+        "INTEGRATOR/NOISE with INTEGRATOR one of {} and NOISE one of consistent, element-uniform",
+        integrators.join(", ")
+    );
     let (i, n) = text
         .trim()
         .split_once('/')
-        .ok_or_else(|| Error::invalid("--methods", text.trim(), allowed))?;
+        .ok_or_else(|| Error::invalid("--methods", text.trim(), &allowed))?;
     let kind = IntegratorKind::LINEAR
         .into_iter()
         .find(|k| k.name() == i)
-        .ok_or_else(|| Error::invalid("--methods", text.trim(), allowed))?;
+        .ok_or_else(|| Error::invalid("--methods", text.trim(), &allowed))?;
     let noise = [NoiseModel::Consistent, NoiseModel::ElementUniform]
         .into_iter()
         .find(|m| m.name() == n)
-        .ok_or_else(|| Error::invalid("--methods", text.trim(), allowed))?;
+        .ok_or_else(|| Error::invalid("--methods", text.trim(), &allowed))?;
     Ok((kind, noise))
 }
 

@@ -5,8 +5,8 @@
 //! ```
 //!
 //! (the finite-element form of eq. 2 with the noise of eq. 1 or eq. 5). Over a step Δt the
-//! nodal force is `F = sqrt(2kT/Δt) ζ` with `ζ` drawn by a [`NoiseGenerator`]
-//! ([`crate::fem::noise::NoiseGenerator`]).
+//! nodal force is `F = sqrt(2kT/Δt) ζ` with `ζ` drawn by a
+//! [`NoiseGenerator`](crate::fem::noise::NoiseGenerator).
 //!
 //! Every integrator here is linear and, in the generalized eigenbasis of (K, C)
 //! (`K φ_i = λ_i C φ_i`, `ΦᵀCΦ = I`), diagonal: modal amplitude `q_i = φ_iᵀ C w` obeys

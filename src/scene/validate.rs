@@ -83,14 +83,20 @@ impl RunRules<'_> {
         match self {
             RunRules::Linear(_) => {
                 if run.integrator == IntegratorKind::MetropolisCrankNicolson {
-                    let allowed = "euler-maruyama, backward-euler, crank-nicolson or exact-modal for a linear scene (metropolis-crank-nicolson is for model = \"compression\")";
-                    return Err(bad(scene, &key("integrator"), &run.integrator, allowed));
+                    let allowed = format!(
+                        "{} for a linear scene (metropolis-crank-nicolson is for model = \"compression\")",
+                        IntegratorKind::list(&IntegratorKind::LINEAR)
+                    );
+                    return Err(bad(scene, &key("integrator"), &run.integrator, &allowed));
                 }
             }
             RunRules::Compression(_) => {
                 if run.integrator == IntegratorKind::ExactModal {
-                    let allowed = "euler-maruyama, backward-euler, crank-nicolson or metropolis-crank-nicolson for model = \"compression\"";
-                    return Err(bad(scene, &key("integrator"), &run.integrator, allowed));
+                    let allowed = format!(
+                        "{} for model = \"compression\"",
+                        IntegratorKind::list(&IntegratorKind::NONLINEAR)
+                    );
+                    return Err(bad(scene, &key("integrator"), &run.integrator, &allowed));
                 }
                 if run.integrator == IntegratorKind::MetropolisCrankNicolson
                     && run.noise != NoiseModel::Consistent
@@ -269,7 +275,7 @@ impl Scene {
         let s = &self.sampling;
         let max_modes = match self.model {
             ModelKind::Fem => 2 * self.mesh.elements,
-            _ => self.mesh.elements,
+            ModelKind::Spectral | ModelKind::Compression => self.mesh.elements,
         };
         if s.modes < 1 || s.modes > max_modes.min(50) {
             let allowed = format!("in [1, {}]", max_modes.min(50));

@@ -474,19 +474,18 @@ fn reference_point(
 pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>> {
     Ok(match over {
         Over::Elements => DEFAULT_ELEMENTS.iter().map(|&n| n as f64).collect(),
-        Over::Dt => match scene.runs[run].integrator.theta() {
-            Some(theta) if theta < 0.5 => {
-                let p = scene.filament;
-                let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
-                let limit = scene.runs[run]
-                    .integrator
-                    .stability_limit(beam.max_rate()?)
-                    .unwrap_or(f64::INFINITY)
-                    / p.tau1();
-                DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect()
-            }
-            _ => DEFAULT_DT_TAU1.to_vec(),
-        },
+        // Schemes with a stability limit (the explicit ones): fractions of that limit.
+        Over::Dt if scene.runs[run].integrator.stability_limit(1.0).is_some() => {
+            let p = scene.filament;
+            let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
+            let limit = scene.runs[run]
+                .integrator
+                .stability_limit(beam.max_rate()?)
+                .unwrap_or(f64::INFINITY)
+                / p.tau1();
+            DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect()
+        }
+        Over::Dt => DEFAULT_DT_TAU1.to_vec(),
     })
 }
 
@@ -914,7 +913,7 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let ensemble = study_ensemble(opts, &spec)?;
     let study = match scene.model {
         ModelKind::Compression => compression::study(&scene, run, opts, ensemble)?,
-        _ => {
+        ModelKind::Fem | ModelKind::Spectral => {
             if opts.strain_ratios.is_some() {
                 return Err(Error::invalid(
                     "--strain-ratios",

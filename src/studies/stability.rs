@@ -244,7 +244,10 @@ fn validate(opts: &StabilityOptions) -> Result<()> {
             return Err(Error::invalid(
                 "--integrators",
                 k,
-                "euler-maruyama, backward-euler, crank-nicolson or exact-modal (on the linear filament metropolis-crank-nicolson is crank-nicolson)",
+                format!(
+                    "{} (on the linear filament metropolis-crank-nicolson is crank-nicolson)",
+                    IntegratorKind::list(&IntegratorKind::LINEAR)
+                ),
             ));
         }
     }

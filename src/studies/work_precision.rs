@@ -207,7 +207,10 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
             return Err(Error::invalid(
                 "--methods",
                 k,
-                "integrators euler-maruyama, backward-euler, crank-nicolson or exact-modal",
+                format!(
+                    "integrators {}",
+                    IntegratorKind::list(&IntegratorKind::LINEAR)
+                ),
             ));
         }
     }

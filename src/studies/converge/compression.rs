@@ -238,7 +238,9 @@ pub fn expected_over_dt(integrator: IntegratorKind) -> Expected {
         IntegratorKind::BackwardEuler => {
             "; backward Euler's bending part adds its own O(lambda dt) bias and freezes the fast modes"
         }
-        _ => "",
+        IntegratorKind::EulerMaruyama
+        | IntegratorKind::ExactModal
+        | IntegratorKind::MetropolisCrankNicolson => "",
     };
     Expected {
         order: Some(1.0),
