@@ -8,13 +8,14 @@
 #   make golden            re-run golden snapshots, accept changes, show the diff
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
 #   make converge          convergence studies (orders in h and dt), reports/convergence/
+#   make bench-peers       Fig. 2 against a plain NumPy implementation: CPU times and ratio
 
 CARGO  ?= cargo
 BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge
+.PHONY: all build verify test check bench golden clean fig2 converge bench-peers
 
 all: build
 
@@ -97,3 +98,36 @@ converge: build
 	else cat $(CONVERGE_OUT)/extreme/compression-stiff-ea-explicit-2d.log; exit 1; fi
 	$(BIN) work-precision --scene hinged-linear-2d --out $(CONVERGE_OUT)
 	$(BIN) stability --scene hinged-linear-2d --out $(CONVERGE_OUT)
+
+# Fig. 2 (both dimensions, full budget: s.e. <= 0.01 F_c0 at every strain) by langevin-fem
+# and by the plain NumPy peer benches/peers/fig2_numpy.py (256 vectorized trajectories,
+# exact bending modes, the stretching force explicit, stopped at the same target standard
+# error), each timed by benches/peers/cpu_time.py (user + sys CPU of the child, all
+# threads); prints both CPU and wall times and the ratio numpy / langevin-fem. NumPy runs
+# in benches/peers/.venv with its default threads; OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE
+# (set on some machines for old OpenBLAS builds) are unset for that command alone, and the
+# script prints the BLAS kernel it runs. The NumPy results are compared with the exact
+# theory of the same 10-element filament (deviation in standard errors per strain).
+# Not like for like: langevin-fem's time includes the whole verify scene (the dt-halving
+# run at dt/2, the force-distribution checks, the report) and its fixed per-scene budget
+# (the same ensemble at every strain) ends below the target at most strains; the NumPy
+# peer stops each strain at the target and does nothing else.
+PEERS_OUT    ?= $(OUT)/bench-peers
+PEERS_VENV   ?= benches/peers/.venv
+PEERS_NUMPY  ?= 2.4.6
+PEERS_RATIOS  = 0,0.5,1,1.5,2,2.5,3,4,5,6,8,10
+bench-peers: build
+	test -x $(PEERS_VENV)/bin/python || python3 -m venv $(PEERS_VENV)
+	$(PEERS_VENV)/bin/python -m pip install -q numpy==$(PEERS_NUMPY) threadpoolctl==3.8.0
+	mkdir -p $(PEERS_OUT)
+	rm -f $(PEERS_OUT)/cpu.jsonl
+	$(BIN) theory compression --dims 2 --strain-ratio $(PEERS_RATIOS) --elements 10 --persistence-ratio 100 --stretch-ratio 1e6 > $(PEERS_OUT)/theory-2d.json
+	$(BIN) theory compression --dims 3 --strain-ratio $(PEERS_RATIOS) --elements 10 --persistence-ratio 100 --stretch-ratio 1e6 > $(PEERS_OUT)/theory-3d.json
+	@echo "load before: $$(uptime)"
+	python3 benches/peers/cpu_time.py run --label langevin-fem --record $(PEERS_OUT)/cpu.jsonl -- \
+		$(BIN) verify --scene compression-2d --scene compression-3d --budget full --out $(PEERS_OUT)
+	python3 benches/peers/cpu_time.py run --label numpy --record $(PEERS_OUT)/cpu.jsonl -- \
+		env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE $(PEERS_VENV)/bin/python benches/peers/fig2_numpy.py \
+		--theory $(PEERS_OUT)/theory-2d.json --theory $(PEERS_OUT)/theory-3d.json
+	@echo "load after: $$(uptime)"
+	@python3 benches/peers/cpu_time.py compare $(PEERS_OUT)/cpu.jsonl
