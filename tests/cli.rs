@@ -774,7 +774,7 @@ fn run_bad_scene(scene: &BadScene, out: &TempDir) -> (Vec<String>, Output) {
 /// `summary.json`, and an error message containing each `# expect:` substring (the key,
 /// and the allowed range or the reason) and — unless the file documents a `# bug:` in
 /// its message — the file name. All files are run and all failures reported together.
-/// Reference: `Scene::validate` in `src/verify/scene.rs`, `src/error.rs`.
+/// Reference: `Scene::validate` in `src/scene/validate.rs`, `src/error.rs`.
 /// Tolerance: exact substrings.
 #[test]
 fn bad_scenes_are_rejected_with_exit_2() {
@@ -956,7 +956,7 @@ fn run_time_input_errors_name_the_scene_file_and_key() {
 /// What: a missing top-level key is reported under its own name or `-`, not under the
 /// key on the first line of the file. Today a file starting with `description = …` and
 /// lacking `seed` gives "key `description`: missing field `seed`".
-/// Reference: `key_at` in `src/verify/scene.rs` (`-` for errors without a key).
+/// Reference: `key_at` in `src/scene/spec.rs` (`-` for errors without a key).
 /// Tolerance: exact substrings.
 #[test]
 

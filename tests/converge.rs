@@ -1,5 +1,5 @@
-//! Tests of the convergence studies (`langevin-fem converge`, `src/verify/converge.rs`
-//! and `src/verify/converge/compression.rs`): the order fit on synthetic data, the exact
+//! Tests of the convergence studies (`langevin-fem converge`, `src/studies/converge.rs`
+//! and `src/studies/converge/compression.rs`): the order fit on synthetic data, the exact
 //! discretization-error orders of the finite elements and of the compression theory from
 //! the references alone (no simulation), a small simulated compression study that must
 //! see the O(h) error and the explicit-stretching bias but no Metropolis bias, and the

@@ -250,8 +250,9 @@ impl std::fmt::Display for IntegratorKind {
 mod tests {
     use super::*;
 
-    /// The θ-scheme stationary-variance ratios of physics.md §3: EM 1/(1 − a/2), BE
-    /// 1/(1 + a/2), CN and exact 1, for several a (exact algebra, tolerance 1e-12).
+    /// The θ-scheme stationary-variance ratios (the integrators' exact discrete-time
+    /// formulas): EM 1/(1 − a/2), BE 1/(1 + a/2), CN and exact 1, for several a (exact
+    /// algebra, tolerance 1e-12).
     #[test]
     fn stationary_variance_ratios_match_closed_forms() {
         for &a in &[1e-3, 0.1, 0.5, 1.0, 1.9] {

@@ -1,5 +1,5 @@
 //! Exact equilibrium force–strain relation of a thermally fluctuating, compressed,
-//! hinged filament (the paper's Fig. 2; `physics.md` §4).
+//! hinged filament (the paper's Fig. 2).
 //!
 //! # The model (the contract shared with the simulator)
 //!
