@@ -10,7 +10,8 @@
 //! scheme needs the same simulated time for the same error bar (its correlation times are
 //! the physical ones), which flatters it: it is a lower bound.
 //!
-//! Run: `cargo bench --bench fig2_cost`.
+//! Run: `cargo bench --bench fig2_cost`; `cargo bench --bench fig2_cost -- metropolis`
+//! times only the scenes' Metropolis step (median of 7 runs of 100 000 steps each).
 
 use langevin_fem::dynamics::{Driver, IntegratorKind, NonlinearState, Observer};
 use langevin_fem::fem::beam::BeamModel;
@@ -71,25 +72,54 @@ fn ns_per_step(model: &CompressedFilament, kind: IntegratorKind, dt: f64, steps:
     timer.elapsed.as_nanos() as f64 / steps as f64
 }
 
+/// The model of a compression scene at ε = 3 ε_c0, with the scene's primary run.
+fn scene_model(root: &Path, name: &str) -> (Scene, CompressedFilament) {
+    let scene = Scene::load(&root.join(format!("{name}.toml"))).expect("scene");
+    let p = scene.filament;
+    let beam = BeamModel::new(
+        p,
+        Mesh::uniform(p.length, scene.mesh.elements).expect("mesh"),
+    )
+    .expect("beam");
+    let model = CompressedFilament::new(beam, scene.dims, 3.0 * p.euler_strain()).expect("model");
+    (scene, model)
+}
+
+/// The Metropolis step alone at each scene: median ns/step of 7 runs.
+fn metropolis_only(root: &Path) {
+    println!("| scene | elements | dt / tau1 | Metropolis ns/step (median of 7) | min | max |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    for name in ["compression-2d", "compression-3d"] {
+        let (scene, model) = scene_model(root, name);
+        let run = &scene.runs[0];
+        let dt = run.dt_tau1 * scene.filament.tau1();
+        let mut t: Vec<f64> = (0..7)
+            .map(|_| ns_per_step(&model, run.integrator, dt, 100_000))
+            .collect();
+        t.sort_by(f64::total_cmp);
+        println!(
+            "| {name} | {} | {:.2e} | {:.0} | {:.0} | {:.0} |",
+            scene.mesh.elements, run.dt_tau1, t[3], t[0], t[6]
+        );
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification");
+    if std::env::args().any(|a| a == "metropolis") {
+        metropolis_only(&root);
+        return;
+    }
     println!(
         "| scene | explicit dt / tau1 | explicit ns/step | scene dt / tau1 | scene ns/step | simulated tau1 (full budget) | scene steps | explicit steps | explicit wall (extrapolated, 1 core) |"
     );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for name in ["compression-2d", "compression-3d"] {
-        let scene = Scene::load(&root.join(format!("{name}.toml"))).expect("scene");
+        let (scene, model) = scene_model(&root, name);
         let comp = scene.compression.as_ref().expect("compression scene");
         let p = scene.filament;
         let tau1 = p.tau1();
-        let beam = BeamModel::new(
-            p,
-            Mesh::uniform(p.length, scene.mesh.elements).expect("mesh"),
-        )
-        .expect("beam");
-        let limit = 2.0 / beam.max_rate().expect("max rate");
-        let model =
-            CompressedFilament::new(beam, scene.dims, 3.0 * p.euler_strain()).expect("model");
+        let limit = 2.0 / model.beam().max_rate().expect("max rate");
         let run = &scene.runs[0];
         let e = run.ensemble(Budget::Full);
         let simulated = comp.strain_ratios.len() as f64

@@ -56,7 +56,7 @@ struct ThetaBuffers {
 /// compressive force `F(w)`, the products `C w`, `K w`, `G w` per component, and the
 /// Cholesky factor of `A_w = C + ½Δt H_w`, `H_w = K − F(w) G`, with `ln det A_w` (`None`
 /// if `A_w` is not positive definite: no proposal is made from, or accepted into, such a
-/// state).
+/// state). The buffers are allocated once and overwritten by each evaluation.
 #[derive(Debug, Clone)]
 struct MhEvaluation {
     state: Vec<Vec<f64>>,
@@ -65,7 +65,48 @@ struct MhEvaluation {
     cw: Vec<Vec<f64>>,
     kw: Vec<Vec<f64>>,
     gw: Vec<Vec<f64>>,
-    lhs: Option<(BandedCholesky, f64)>,
+    /// `A_w`.
+    a: SymBanded,
+    /// The Cholesky factor of `A_w` (meaningful only if `log_det` is `Some`).
+    chol: BandedCholesky,
+    /// `ln det A_w`, `None` if `A_w` is not positive definite.
+    log_det: Option<f64>,
+}
+
+impl MhEvaluation {
+    /// Buffers for `nc` components of `n` DOFs; `base` (`C + ½ΔtK`) gives the shape of
+    /// `A_w`. Not yet an evaluation of any state.
+    fn new(base: &SymBanded, nc: usize, n: usize) -> Result<Self> {
+        Ok(MhEvaluation {
+            state: vec![vec![0.0; n]; nc],
+            energy: 0.0,
+            force: 0.0,
+            cw: vec![vec![0.0; n]; nc],
+            kw: vec![vec![0.0; n]; nc],
+            gw: vec![vec![0.0; n]; nc],
+            a: base.clone(),
+            chol: base.cholesky()?,
+            log_det: None,
+        })
+    }
+
+    /// The Cholesky factor of `A_w` and `ln det A_w`, `None` if `A_w` is not positive
+    /// definite.
+    fn lhs(&self) -> Option<(&BandedCholesky, f64)> {
+        self.log_det.map(|ld| (&self.chol, ld))
+    }
+}
+
+/// The Metropolis chain's work space: the evaluated current state, the proposal
+/// (swapped with the current state on acceptance) and the reverse noise.
+#[derive(Debug, Clone)]
+struct MhBuffers {
+    current: MhEvaluation,
+    /// Whether `current` holds the evaluation of `current.state` (false before the first
+    /// step).
+    evaluated: bool,
+    proposal: MhEvaluation,
+    reverse: Vec<Vec<f64>>,
 }
 
 /// One step of a stochastic time integrator for the nonlinear filament: the same shape as
@@ -92,8 +133,8 @@ pub struct NonlinearIntegrator<'m> {
     theta_buffers: ThetaBuffers,
     /// Metropolis: `C + ½ΔtK`, to which `−½Δt F(w) G` is added per state.
     mh_base: SymBanded,
-    /// Metropolis: the evaluated current state of the chain.
-    mh_current: Option<MhEvaluation>,
+    /// Metropolis: the chain's work space (`None` for the θ-schemes).
+    mh: Option<MhBuffers>,
     scratch: [Vec<f64>; 3],
     /// Proposals made (Metropolis only).
     pub proposed: u64,
@@ -152,6 +193,16 @@ impl<'m> NonlinearIntegrator<'m> {
         let (k, c) = (beam.stiffness(), beam.damping());
         let n = beam.n_dofs();
         let nc = model.components();
+        let mh_base = SymBanded::linear_combination(1.0, c, 0.5 * dt, k)?;
+        let mh = match scheme {
+            Scheme::Metropolis => Some(MhBuffers {
+                current: MhEvaluation::new(&mh_base, nc, n)?,
+                evaluated: false,
+                proposal: MhEvaluation::new(&mh_base, nc, n)?,
+                reverse: vec![vec![0.0; n]; nc],
+            }),
+            Scheme::Theta(_) => None,
+        };
         Ok(NonlinearIntegrator {
             model,
             scheme,
@@ -164,9 +215,12 @@ impl<'m> NonlinearIntegrator<'m> {
             damping: c.cholesky()?,
             noise: NoiseGenerator::new(noise, beam)?,
             zeta: vec![vec![0.0; n]; nc],
-            theta_buffers: ThetaBuffers::default(),
-            mh_base: SymBanded::linear_combination(1.0, c, 0.5 * dt, k)?,
-            mh_current: None,
+            theta_buffers: ThetaBuffers {
+                explicit: vec![vec![0.0; n]; nc],
+                kw: vec![vec![0.0; n]; nc],
+            },
+            mh_base,
+            mh,
             scratch: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             proposed: 0,
             accepted: 0,
@@ -197,8 +251,8 @@ impl<'m> NonlinearIntegrator<'m> {
         let beam = model.beam();
         let p = beam.params();
         let nc = w.len();
-        out.explicit.resize(nc, vec![0.0; beam.n_dofs()]);
-        out.kw.resize(nc, vec![0.0; beam.n_dofs()]);
+        resize_state(&mut out.explicit, nc, beam.n_dofs());
+        resize_state(&mut out.kw, nc, beam.n_dofs());
         let mut two_l_s = 0.0;
         // First pass: G w into explicit (temporarily), K w into kw.
         for (c, wc) in w.iter().enumerate() {
@@ -256,23 +310,18 @@ impl<'m> NonlinearIntegrator<'m> {
         self.theta_buffers = buf;
     }
 
-    /// Evaluates a state of the Metropolis chain ([`MhEvaluation`]).
-    fn evaluate_mh(&self, w: &[Vec<f64>]) -> MhEvaluation {
+    /// Evaluates the state `e.state` of the Metropolis chain into `e` ([`MhEvaluation`]).
+    fn evaluate_mh(&self, e: &mut MhEvaluation) {
         let model = self.model;
         let beam = model.beam();
         let p = beam.params();
         let n = beam.n_dofs();
-        let mut e = MhEvaluation {
-            state: w.to_vec(),
-            energy: 0.0,
-            force: 0.0,
-            cw: vec![vec![0.0; n]; w.len()],
-            kw: vec![vec![0.0; n]; w.len()],
-            gw: vec![vec![0.0; n]; w.len()],
-            lhs: None,
-        };
+        let nc = e.state.len();
+        resize_state(&mut e.cw, nc, n);
+        resize_state(&mut e.kw, nc, n);
+        resize_state(&mut e.gw, nc, n);
         let (mut two_l_s, mut bend) = (0.0, 0.0);
-        for (c, wc) in w.iter().enumerate() {
+        for (c, wc) in e.state.iter().enumerate() {
             beam.damping().mul_vec(wc, &mut e.cw[c]);
             beam.stiffness().mul_vec(wc, &mut e.kw[c]);
             beam.geometric().mul_vec(wc, &mut e.gw[c]);
@@ -283,109 +332,114 @@ impl<'m> NonlinearIntegrator<'m> {
         e.force = model.compressive_force(s);
         let d = s - model.strain();
         e.energy = bend + 0.5 * p.stretch_rigidity * p.length * d * d;
-        e.lhs = SymBanded::linear_combination(
-            1.0,
-            &self.mh_base,
-            -0.5 * self.dt * e.force,
-            beam.geometric(),
-        )
-        .and_then(|a| a.cholesky())
-        .ok()
-        .map(|l| {
-            let log_det = l.log_det();
-            (l, log_det)
-        });
-        e
+        let factored =
+            e.a.linear_combination_into(
+                1.0,
+                &self.mh_base,
+                -0.5 * self.dt * e.force,
+                beam.geometric(),
+            )
+            .is_ok()
+                && e.chol.try_factor_from(&e.a);
+        e.log_det = factored.then(|| e.chol.log_det());
     }
 
-    /// The Metropolis proposal from `cur` with noise `zeta` (covariance C per component):
-    /// `A_w w' = B_w w + sqrt(2kTΔt) ζ`, `B_w = C − ½Δt H_w`. `None` if `A_w` is not
-    /// positive definite.
-    fn propose(&self, cur: &MhEvaluation, zeta: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-        let (lhs, _) = cur.lhs.as_ref()?;
+    /// The Metropolis proposal from `cur` with noise `zeta` (covariance C per component)
+    /// into `next`: `A_w w' = B_w w + sqrt(2kTΔt) ζ`, `B_w = C − ½Δt H_w`. `false` (and
+    /// `next` untouched) if `A_w` is not positive definite.
+    fn propose(&self, cur: &MhEvaluation, zeta: &[Vec<f64>], next: &mut Vec<Vec<f64>>) -> bool {
+        let Some((lhs, _)) = cur.lhs() else {
+            return false;
+        };
         let h = 0.5 * self.dt;
-        Some(
-            (0..cur.state.len())
-                .map(|c| {
-                    let mut next: Vec<f64> = (0..cur.cw[c].len())
-                        .map(|i| {
-                            cur.cw[c][i] - h * (cur.kw[c][i] - cur.force * cur.gw[c][i])
-                                + self.scale * zeta[c][i]
-                        })
-                        .collect();
-                    lhs.solve_in_place(&mut next);
-                    next
-                })
-                .collect(),
-        )
+        resize_state(next, cur.state.len(), cur.cw.first().map_or(0, Vec::len));
+        for (c, nc) in next.iter_mut().enumerate() {
+            for (i, v) in nc.iter_mut().enumerate() {
+                *v = cur.cw[c][i] - h * (cur.kw[c][i] - cur.force * cur.gw[c][i])
+                    + self.scale * zeta[c][i];
+            }
+            lhs.solve_in_place(nc);
+        }
+        true
     }
 
-    /// The noise of the reverse move `prop → cur`: `ζ_r = (A_{w'} w − B_{w'} w')/sqrt(2kTΔt)`.
-    fn reverse_noise(&self, cur: &MhEvaluation, prop: &MhEvaluation) -> Vec<Vec<f64>> {
+    /// The noise of the reverse move `prop → cur` into `out`:
+    /// `ζ_r = (A_{w'} w − B_{w'} w')/sqrt(2kTΔt)`.
+    fn reverse_noise(&self, cur: &MhEvaluation, prop: &MhEvaluation, out: &mut Vec<Vec<f64>>) {
         let h = 0.5 * self.dt;
         let f = prop.force;
-        (0..cur.state.len())
-            .map(|c| {
-                (0..cur.cw[c].len())
-                    .map(|i| {
-                        let a_w = cur.cw[c][i] + h * (cur.kw[c][i] - f * cur.gw[c][i]);
-                        let b_wp = prop.cw[c][i] - h * (prop.kw[c][i] - f * prop.gw[c][i]);
-                        (a_w - b_wp) / self.scale
-                    })
-                    .collect()
-            })
-            .collect()
+        resize_state(out, cur.state.len(), cur.cw.first().map_or(0, Vec::len));
+        for (c, oc) in out.iter_mut().enumerate() {
+            for (i, v) in oc.iter_mut().enumerate() {
+                let a_w = cur.cw[c][i] + h * (cur.kw[c][i] - f * cur.gw[c][i]);
+                let b_wp = prop.cw[c][i] - h * (prop.kw[c][i] - f * prop.gw[c][i]);
+                *v = (a_w - b_wp) / self.scale;
+            }
+        }
     }
 
     /// `ln α` of the move `cur → prop` made with noise `zeta`:
     /// `−(U' − U)/kT + d (ln det A_{w'} − ln det A_w) − ½|ζ_r|²_{C⁻¹} + ½|ζ|²_{C⁻¹}`
-    /// (d transverse components). `−∞` if `A_{w'}` is not positive definite.
+    /// (d transverse components), with `reverse` the buffer for ζ_r. `−∞` if `A_{w'}` is
+    /// not positive definite.
     fn log_acceptance(
         &mut self,
         cur: &MhEvaluation,
         prop: &MhEvaluation,
         zeta: &[Vec<f64>],
+        reverse: &mut Vec<Vec<f64>>,
     ) -> f64 {
-        let (Some((_, ld)), Some((_, ld_p))) = (&cur.lhs, &prop.lhs) else {
+        let (Some(ld), Some(ld_p)) = (cur.log_det, prop.log_det) else {
             return f64::NEG_INFINITY;
         };
         let forward = self.noise_norm(zeta);
-        let rev = self.reverse_noise(cur, prop);
-        let backward = self.noise_norm(&rev);
+        self.reverse_noise(cur, prop, reverse);
+        let backward = self.noise_norm(reverse);
         -(prop.energy - cur.energy) / self.kt + cur.state.len() as f64 * (ld_p - ld)
             - 0.5 * backward
             + 0.5 * forward
     }
 
-    /// One Metropolis-adjusted step (see [`NonlinearIntegrator`]).
+    /// One Metropolis-adjusted step (see [`NonlinearIntegrator`]). Allocation-free: the
+    /// evaluations of the current state and of the proposal live in preallocated buffers,
+    /// swapped on acceptance.
     fn step_metropolis(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng) {
-        let cur = match self.mh_current.take() {
-            Some(e) if e.state.as_slice() == &*w => e,
-            _ => self.evaluate_mh(w),
-        };
+        let mut mh = self
+            .mh
+            .take()
+            .expect("the Metropolis integrator has its buffers");
+        if !(mh.evaluated && mh.current.state.as_slice() == &*w) {
+            copy_state(&mut mh.current.state, w);
+            self.evaluate_mh(&mut mh.current);
+            mh.evaluated = true;
+        }
         for z in &mut self.zeta {
             self.noise.draw(rng, z);
         }
         let u: f64 = rng.random();
         self.proposed += 1;
         let zeta = std::mem::take(&mut self.zeta);
-        let next = self
-            .propose(&cur, &zeta)
-            .filter(|n| n.iter().flatten().all(|v| v.is_finite()));
-        let mut keep = cur;
-        if let Some(next) = next {
-            let prop = self.evaluate_mh(&next);
-            let log_alpha = self.log_acceptance(&keep, &prop, &zeta);
+        let MhBuffers {
+            current,
+            proposal,
+            reverse,
+            ..
+        } = &mut mh;
+        let proposed = self.propose(current, &zeta, &mut proposal.state)
+            && proposal.state.iter().flatten().all(|v| v.is_finite());
+        if proposed {
+            self.evaluate_mh(proposal);
+            let log_alpha = self.log_acceptance(current, proposal, &zeta, reverse);
             if log_alpha >= 0.0 || u < log_alpha.exp() {
-                for (wc, nc) in w.iter_mut().zip(&prop.state) {
+                for (wc, nc) in w.iter_mut().zip(&proposal.state) {
                     wc.copy_from_slice(nc);
                 }
-                keep = prop;
+                std::mem::swap(current, proposal);
                 self.accepted += 1;
             }
         }
         self.zeta = zeta;
-        self.mh_current = Some(keep);
+        self.mh = Some(mh);
     }
 }
 
@@ -395,6 +449,22 @@ impl NonlinearStep for NonlinearIntegrator<'_> {
             Scheme::Metropolis => self.step_metropolis(w, rng),
             Scheme::Theta(_) => self.step_theta(w, rng),
         }
+    }
+}
+
+/// Gives `v` `nc` components of `n` entries (allocating only if its shape differs).
+fn resize_state(v: &mut Vec<Vec<f64>>, nc: usize, n: usize) {
+    v.resize_with(nc, Vec::new);
+    for c in v {
+        c.resize(n, 0.0);
+    }
+}
+
+/// `dst ← src` (allocating only if the shapes differ).
+fn copy_state(dst: &mut Vec<Vec<f64>>, src: &[Vec<f64>]) {
+    dst.resize_with(src.len(), Vec::new);
+    for (d, s) in dst.iter_mut().zip(src) {
+        d.clone_from(s);
     }
 }
 
@@ -410,6 +480,35 @@ mod tests {
     use crate::fem::vonkarman::tests::{SEED, model, random_state};
     use crate::params::FilamentParams;
     use crate::rng::trajectory_rng;
+
+    /// The evaluation of `w` in fresh buffers.
+    fn evaluated(integ: &NonlinearIntegrator, w: &[Vec<f64>]) -> MhEvaluation {
+        let mut e = MhEvaluation::new(&integ.mh_base, w.len(), w[0].len()).unwrap();
+        copy_state(&mut e.state, w);
+        integ.evaluate_mh(&mut e);
+        e
+    }
+
+    /// The proposal from `cur` with noise `zeta`, if any.
+    fn proposal(
+        integ: &NonlinearIntegrator,
+        cur: &MhEvaluation,
+        zeta: &[Vec<f64>],
+    ) -> Option<Vec<Vec<f64>>> {
+        let mut next = Vec::new();
+        integ.propose(cur, zeta, &mut next).then_some(next)
+    }
+
+    /// The reverse noise of `cur → prop`.
+    fn reverse(
+        integ: &NonlinearIntegrator,
+        cur: &MhEvaluation,
+        prop: &MhEvaluation,
+    ) -> Vec<Vec<f64>> {
+        let mut out = Vec::new();
+        integ.reverse_noise(cur, prop, &mut out);
+        out
+    }
 
     /// Euler–Maruyama above its stability limit is refused before running, naming the
     /// limit; exact-modal is refused for the nonlinear filament; Metropolis refuses the
@@ -473,11 +572,11 @@ mod tests {
                         z
                     })
                     .collect();
-                let cur = integ.evaluate_mh(&w);
-                let next = integ.propose(&cur, &zeta).unwrap();
-                let prop = integ.evaluate_mh(&next);
-                let zeta_r = integ.reverse_noise(&cur, &prop);
-                let back = integ.propose(&prop, &zeta_r).unwrap();
+                let cur = evaluated(&integ, &w);
+                let next = proposal(&integ, &cur, &zeta).unwrap();
+                let prop = evaluated(&integ, &next);
+                let zeta_r = reverse(&integ, &cur, &prop);
+                let back = proposal(&integ, &prop, &zeta_r).unwrap();
                 let scale = w.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
                 for (a, b) in w.iter().flatten().zip(back.iter().flatten()) {
                     assert!(
@@ -486,12 +585,13 @@ mod tests {
                     );
                 }
                 // The reverse of the reverse noise is the forward noise.
-                let zeta_rr = integ.reverse_noise(&prop, &cur);
+                let zeta_rr = reverse(&integ, &prop, &cur);
                 for (a, b) in zeta.iter().flatten().zip(zeta_rr.iter().flatten()) {
                     assert!((a - b).abs() < 1e-7 * (1.0 + a.abs()), "{a} vs {b}");
                 }
-                let fwd = integ.log_acceptance(&cur, &prop, &zeta);
-                let rev = integ.log_acceptance(&prop, &cur, &zeta_r);
+                let mut buf = Vec::new();
+                let fwd = integ.log_acceptance(&cur, &prop, &zeta, &mut buf);
+                let rev = integ.log_acceptance(&prop, &cur, &zeta_r, &mut buf);
                 assert!(fwd.is_finite() && fwd != 0.0, "ln alpha {fwd}");
                 // An independent oracle: the proposal densities from dense matrices,
                 // ln q(a → b) = d ln det A_a − ½ Σ_c |A_a b_c − B_a a_c|²_{C⁻¹}/(2kTΔt),
@@ -529,8 +629,93 @@ mod tests {
                     "dims {dims} ratio {ratio}: ln alpha {fwd} and reverse {rev}"
                 );
                 // The tension really is in the proposal: A_w differs between the states.
-                let (ld, ldp) = (cur.lhs.as_ref().unwrap().1, prop.lhs.as_ref().unwrap().1);
+                let (ld, ldp) = (cur.log_det.unwrap(), prop.log_det.unwrap());
                 assert!(cur.force != prop.force && ld != ldp);
+            }
+        }
+    }
+
+    /// Counts heap allocations per thread (so that tests running in parallel do not
+    /// disturb each other).
+    mod counting {
+        use std::alloc::{GlobalAlloc, Layout, System};
+        use std::cell::Cell;
+
+        thread_local! {
+            static COUNT: Cell<u64> = const { Cell::new(0) };
+        }
+
+        fn count() {
+            let _ = COUNT.try_with(|c| c.set(c.get() + 1));
+        }
+
+        pub struct Counting;
+
+        // SAFETY: forwards to the system allocator; counting touches only a
+        // const-initialized thread-local without destructor (which does not allocate).
+        unsafe impl GlobalAlloc for Counting {
+            unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+                count();
+                unsafe { System.alloc(layout) }
+            }
+            unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+                count();
+                unsafe { System.alloc_zeroed(layout) }
+            }
+            unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+                count();
+                unsafe { System.realloc(ptr, layout, new_size) }
+            }
+            unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+                unsafe { System.dealloc(ptr, layout) }
+            }
+        }
+
+        #[global_allocator]
+        static ALLOCATOR: Counting = Counting;
+
+        /// Heap allocations made so far by this thread.
+        pub fn allocations() -> u64 {
+            COUNT.with(Cell::get)
+        }
+    }
+
+    /// After construction (and the first step, which evaluates the initial state), a
+    /// Metropolis or Crank–Nicolson step allocates nothing, with proposals both accepted
+    /// and rejected; 2D and 3D, in tension and buckled.
+    #[test]
+    fn steps_do_not_allocate() {
+        let probe = counting::allocations();
+        std::hint::black_box(vec![1.0; 8]);
+        assert!(counting::allocations() > probe, "the counter counts");
+        for kind in [
+            IntegratorKind::MetropolisCrankNicolson,
+            IntegratorKind::CrankNicolson,
+        ] {
+            for dims in [2, 3] {
+                for ratio in [0.0, 6.0] {
+                    let m = model(dims, ratio);
+                    let dt = 0.05 * m.beam().params().tau1();
+                    let mut integ =
+                        NonlinearIntegrator::new(&m, kind, NoiseModel::Consistent, dt).unwrap();
+                    let mut w = random_state(&m, 0.01, 40 + dims as u64);
+                    let mut rng = trajectory_rng(SEED, 50 + dims as u64);
+                    integ.step(&mut w, &mut rng);
+                    let before = counting::allocations();
+                    for _ in 0..2000 {
+                        integ.step(&mut w, &mut rng);
+                    }
+                    let allocations = counting::allocations() - before;
+                    assert_eq!(allocations, 0, "{kind} dims {dims} ratio {ratio}");
+                    if kind == IntegratorKind::MetropolisCrankNicolson {
+                        assert!(
+                            integ.accepted > 0 && integ.accepted < integ.proposed,
+                            "{kind} dims {dims} ratio {ratio}: {} of {} accepted",
+                            integ.accepted,
+                            integ.proposed
+                        );
+                    }
+                }
             }
         }
     }

@@ -135,6 +135,30 @@ impl SymBanded {
     /// [`Error::InvalidParameter`] if the dimensions differ.
     #[allow(non_snake_case)]
     pub fn linear_combination(a: f64, A: &SymBanded, b: f64, B: &SymBanded) -> Result<SymBanded> {
+        let mut out = SymBanded {
+            n: 0,
+            bw: 0,
+            data: Vec::new(),
+        };
+        out.linear_combination_into(a, A, b, B)?;
+        Ok(out)
+    }
+
+    /// `self ← a·A + b·B` (half-bandwidth `max(bw_A, bw_B)`), reusing the storage of `self`
+    /// (no allocation if `self` already has that shape). The same floating-point
+    /// operations as [`Self::linear_combination`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if the dimensions of `A` and `B` differ (`self` is then
+    /// unchanged).
+    #[allow(non_snake_case)]
+    pub fn linear_combination_into(
+        &mut self,
+        a: f64,
+        A: &SymBanded,
+        b: f64,
+        B: &SymBanded,
+    ) -> Result<()> {
         if A.n != B.n {
             return Err(Error::invalid(
                 "banded matrix dimension",
@@ -142,16 +166,19 @@ impl SymBanded {
                 format!("= {} (the other operand)", A.n),
             ));
         }
-        let mut out = SymBanded::new(A.n, A.bw.max(B.bw));
+        self.n = A.n;
+        self.bw = A.bw.max(B.bw);
+        self.data.clear();
+        self.data.resize(self.n * (self.bw + 1), 0.0);
         for (m, f) in [(A, a), (B, b)] {
             for i in 0..m.n {
                 for j in i.saturating_sub(m.bw)..=i {
-                    let k = out.idx(i, j);
-                    out.data[k] += f * m.data[m.idx(i, j)];
+                    let k = self.idx(i, j);
+                    self.data[k] += f * m.data[m.idx(i, j)];
                 }
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Banded Cholesky factorization `A = L Lᵀ` (`L` lower triangular with the same
@@ -161,43 +188,14 @@ impl SymBanded {
     /// # Errors
     /// [`Error::Numerical`] naming the pivot if `A` is not (numerically) positive definite.
     pub fn cholesky(&self) -> Result<BandedCholesky> {
-        let (n, bw) = (self.n, self.bw);
-        let w = bw + 1;
-        let mut l = self.data.clone();
-        for j in 0..n {
-            // diagonal
-            let kmin = j.saturating_sub(bw);
-            let mut d = l[j * w];
-            for k in kmin..j {
-                let ljk = l[j * w + (j - k)];
-                d -= ljk * ljk;
-            }
-            if !(d > 0.0 && d.is_finite()) {
-                return Err(Error::Numerical {
-                    routine: "banded Cholesky".into(),
-                    detail: format!(
-                        "pivot {j} is {d:e}: matrix (n = {n}) is not positive definite"
-                    ),
-                });
-            }
-            let ljj = d.sqrt();
-            l[j * w] = ljj;
-            for i in j + 1..(j + w).min(n) {
-                let kmin = i.saturating_sub(bw);
-                let mut s = l[i * w + (i - j)];
-                for k in kmin..j {
-                    s -= l[i * w + (i - k)] * l[j * w + (j - k)];
-                }
-                l[i * w + (i - j)] = s / ljj;
-            }
-        }
-        let inv_diag = (0..n).map(|j| 1.0 / l[j * w]).collect();
-        Ok(BandedCholesky {
-            n,
-            bw,
-            data: l,
-            inv_diag,
-        })
+        let mut l = BandedCholesky {
+            n: 0,
+            bw: 0,
+            data: Vec::new(),
+            inv_diag: Vec::new(),
+        };
+        l.factor_from(self)?;
+        Ok(l)
     }
 
     /// Number of negative eigenvalues of `A`, by Sylvester's law of inertia: the number of
@@ -255,6 +253,68 @@ pub struct BandedCholesky {
 }
 
 impl BandedCholesky {
+    /// Factors `a = L Lᵀ` into `self` ([`SymBanded::cholesky`]), reusing the storage of
+    /// `self` (no allocation if `self` already has the shape of `a`).
+    ///
+    /// # Errors
+    /// [`Error::Numerical`] naming the pivot if `a` is not (numerically) positive definite;
+    /// `self` then holds a partial factorization and must be refactored before use.
+    pub fn factor_from(&mut self, a: &SymBanded) -> Result<()> {
+        match self.factor(a) {
+            None => Ok(()),
+            Some((j, d)) => Err(Error::Numerical {
+                routine: "banded Cholesky".into(),
+                detail: format!(
+                    "pivot {j} is {d:e}: matrix (n = {}) is not positive definite",
+                    a.n
+                ),
+            }),
+        }
+    }
+
+    /// [`Self::factor_from`] without building the error: `false` if `a` is not
+    /// (numerically) positive definite. Allocation-free if `self` already has the shape of
+    /// `a`, also on failure.
+    pub fn try_factor_from(&mut self, a: &SymBanded) -> bool {
+        self.factor(a).is_none()
+    }
+
+    /// The factorization; the first non-positive (or non-finite) pivot `(j, d_j)` if any.
+    fn factor(&mut self, a: &SymBanded) -> Option<(usize, f64)> {
+        let (n, bw) = (a.n, a.bw);
+        let w = bw + 1;
+        self.n = n;
+        self.bw = bw;
+        self.data.clear();
+        self.data.extend_from_slice(&a.data);
+        self.inv_diag.clear();
+        let l = &mut self.data;
+        for j in 0..n {
+            // diagonal
+            let kmin = j.saturating_sub(bw);
+            let mut d = l[j * w];
+            for k in kmin..j {
+                let ljk = l[j * w + (j - k)];
+                d -= ljk * ljk;
+            }
+            if !(d > 0.0 && d.is_finite()) {
+                return Some((j, d));
+            }
+            let ljj = d.sqrt();
+            l[j * w] = ljj;
+            for i in j + 1..(j + w).min(n) {
+                let kmin = i.saturating_sub(bw);
+                let mut s = l[i * w + (i - j)];
+                for k in kmin..j {
+                    s -= l[i * w + (i - k)] * l[j * w + (j - k)];
+                }
+                l[i * w + (i - j)] = s / ljj;
+            }
+        }
+        self.inv_diag.extend((0..n).map(|j| 1.0 / l[j * w]));
+        None
+    }
+
     /// Dimension `n`.
     pub fn n(&self) -> usize {
         self.n
@@ -441,6 +501,34 @@ mod tests {
                 assert!((out[i] - od[i]).abs() < 1e-13);
                 assert_eq!(out[i], zz[i]);
             }
+        }
+    }
+
+    /// The in-place variants give bit-identical results to the allocating ones, reusing
+    /// storage across shapes and after a failed factorization.
+    #[test]
+    fn in_place_variants_match_allocating_ones() {
+        let mut c = SymBanded::new(1, 0);
+        let mut l = spd(1, 0).cholesky().unwrap();
+        let mut bad = spd(6, 2);
+        bad.add(3, 3, -100.0).unwrap();
+        assert!(l.factor_from(&bad).is_err());
+        assert!(!l.try_factor_from(&bad));
+        for &(n, bw_a, bw_b) in &[(9, 3, 1), (9, 1, 3), (4, 0, 0), (30, 5, 2)] {
+            let (a, b) = (spd(n, bw_a), spd(n, bw_b));
+            c.linear_combination_into(1.0, &a, -0.3, &b).unwrap();
+            let expected = SymBanded::linear_combination(1.0, &a, -0.3, &b).unwrap();
+            assert_eq!(c, expected);
+            l.factor_from(&c).unwrap();
+            assert_eq!(l, expected.cholesky().unwrap());
+            assert!(!l.try_factor_from(&bad));
+            assert!(l.try_factor_from(&c));
+            assert_eq!(l, expected.cholesky().unwrap());
+            assert!(
+                c.linear_combination_into(1.0, &a, 1.0, &spd(n + 1, 1))
+                    .is_err()
+            );
+            assert_eq!(c, expected);
         }
     }
 
