@@ -269,10 +269,35 @@ impl CompressionRun {
         sampled_steps: u64,
         tick: impl Fn() + Sync,
     ) -> Result<Vec<Vec<ForceRecord>>> {
+        let steps = vec![sampled_steps; self.points()];
+        self.simulate_ensemble_per_point(seed, trajectories, &steps, tick)
+    }
+
+    /// [`Self::simulate_ensemble`] with its own number of sampled steps at each strain
+    /// (`sampled_steps[i]` at strain `i`): the main stage of a budget by target
+    /// precision. Same streams as [`Self::simulate_ensemble`].
+    ///
+    /// # Errors
+    /// As [`Self::simulate`]; [`Error::InvalidParameter`] if `sampled_steps` does not have
+    /// one entry per strain.
+    pub fn simulate_ensemble_per_point(
+        &self,
+        seed: impl Fn(usize) -> u64 + Sync,
+        trajectories: usize,
+        sampled_steps: &[u64],
+        tick: impl Fn() + Sync,
+    ) -> Result<Vec<Vec<ForceRecord>>> {
+        if sampled_steps.len() != self.points() {
+            return Err(Error::invalid(
+                "sampled steps per strain",
+                sampled_steps.len(),
+                format!("one entry per strain ({})", self.points()),
+            ));
+        }
         let nt = trajectories.max(1);
         let flat = crate::dynamics::par_indexed((self.points() * nt) as u64, |t| {
             let (i, j) = (t as usize / nt, t % nt as u64);
-            let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps);
+            let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps[i]);
             tick();
             rec
         })?;
@@ -306,6 +331,36 @@ impl CompressionRun {
             .enumerate()
             .filter_map(|(i, r)| self.measured_rms_slope(r).map(|(s, x)| (s, x, i)))
             .max_by(|a, b| a.0.total_cmp(&b.0))
+    }
+}
+
+/// Safety factor on the sampled duration a pilot predicts for a target standard error:
+/// the pilot's own error estimate scatters (its integrated autocorrelation time most),
+/// and 1.5 on the duration is a margin of √1.5 ≈ 1.22 on the standard error.
+pub const DURATION_SAFETY: f64 = 1.5;
+
+/// The main stage's sampled duration per trajectory of a budget by target precision, from
+/// a pilot of the same trajectory count: the standard error of a time average falls as
+/// T^(-1/2) (for T much longer than the autocorrelation time), so the target `target` is
+/// reached at `T = pilot_duration · (pilot_std_error / target)²`; returned is that times
+/// [`DURATION_SAFETY`], at least `pilot_duration` (the main stage's own error estimate
+/// needs as many samples as the pilot's) and at most `max_duration` (also for a
+/// non-finite pilot error). Units are the caller's (τ1 in the scenes; F_c0 for errors).
+///
+/// The rule uses the pilot only, and the pilot's streams are independent of the main
+/// stage's: given the duration, the main stage is an ordinary fixed-budget estimate, so
+/// its standard error and p-values stay honest (no optional-stopping bias).
+pub fn targeted_duration(
+    pilot_std_error: f64,
+    pilot_duration: f64,
+    target: f64,
+    max_duration: f64,
+) -> f64 {
+    let needed = DURATION_SAFETY * pilot_duration * (pilot_std_error / target).powi(2);
+    if needed.is_finite() {
+        needed.max(pilot_duration).min(max_duration)
+    } else {
+        max_duration
     }
 }
 

@@ -20,6 +20,6 @@ pub mod spec;
 pub mod validate;
 
 pub use spec::{
-    Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, RunSpec, Sampling, Scene,
-    resolve_scenes,
+    Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, PrecisionTarget, RunSpec,
+    Sampling, Scene, resolve_scenes,
 };

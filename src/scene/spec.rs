@@ -30,6 +30,41 @@
 //! standard = { trajectories = 32, duration_tau1 = 100.0 }
 //! full = { trajectories = 64, duration_tau1 = 400.0 }
 //! ```
+//!
+//! An ensemble's keys (every budget: `quick`, `standard`, `full`):
+//!
+//! - `trajectories`: independent trajectories (per strain in a compression scene),
+//!   in [2, 100000];
+//! - `duration_tau1`: sampled duration of each trajectory after burn-in, in units of τ1
+//!   (a fixed budget; required unless `target_std_error` is given, and then left out);
+//! - `two_time_trajectories`: extra short trajectories of the two-time check (linear
+//!   scenes only), default 0.
+//!
+//! **Budgets by target precision** (compression scenes only): instead of
+//! `duration_tau1`, give all three of
+//!
+//! - `target_std_error`: the aimed standard error of ⟨F⟩ at every strain, in units of
+//!   the Euler load F_c0, in (0, 1];
+//! - `pilot_tau1`: sampled duration of each pilot trajectory, in units of τ1 (at least 16
+//!   samples, at most `max_duration_tau1`);
+//! - `max_duration_tau1`: the cap on the main stage's sampled duration per trajectory,
+//!   in units of τ1 (≤ 1e6).
+//!
+//! ```toml
+//! full = { trajectories = 16, target_std_error = 0.01, pilot_tau1 = 40.0, max_duration_tau1 = 2000.0 }
+//! ```
+//!
+//! At each strain separately a pilot of `trajectories` × `pilot_tau1` (its own random
+//! streams) estimates the standard error with the integrated autocorrelation time; the
+//! main stage then runs `trajectories` fresh, independent trajectories for the duration
+//! the pilot predicts for the target (s.e. ∝ T^(-1/2), times a safety factor, at least
+//! `pilot_tau1`, at most `max_duration_tau1`; see
+//! [`targeted_duration`](crate::scene::compression::targeted_duration)), and only the
+//! main stage is reported. The main stage's duration depends on the pilot only, which is
+//! independent of the main-stage samples, so given that duration the reported estimate
+//! is an ordinary fixed-budget estimate: its standard error and p-values are honest (no
+//! optional-stopping bias). A strain whose main stage misses the target is reported as it
+//! is, not rerun.
 
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
@@ -45,12 +80,59 @@ use std::path::{Path, PathBuf};
 pub struct Ensemble {
     /// Number of independent trajectories, each started from rest.
     pub trajectories: usize,
-    /// Sampled duration of each trajectory after burn-in, in units of τ1.
+    /// Sampled duration of each trajectory after burn-in, in units of τ1. Left out (NaN)
+    /// when `target_std_error` is given: the duration is then chosen per strain.
+    #[serde(default = "not_given", skip_serializing_if = "is_not_given")]
     pub duration_tau1: f64,
     /// Extra short trajectories (from rest to the largest η) for the two-time check only;
     /// default 0.
     #[serde(default)]
     pub two_time_trajectories: usize,
+    /// Compression scenes: the aimed standard error of ⟨F⟩ per strain, in units of F_c0
+    /// (a budget by target precision, see the module documentation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_std_error: Option<f64>,
+    /// With `target_std_error`: sampled duration of each pilot trajectory, in units of τ1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pilot_tau1: Option<f64>,
+    /// With `target_std_error`: the largest sampled duration of a main-stage trajectory,
+    /// in units of τ1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_duration_tau1: Option<f64>,
+}
+
+/// A missing `duration_tau1` (NaN: not a valid duration, refused by validation unless
+/// `target_std_error` replaces it).
+fn not_given() -> f64 {
+    f64::NAN
+}
+
+/// Whether a duration was left out ([`not_given`]).
+fn is_not_given(x: &f64) -> bool {
+    x.is_nan()
+}
+
+/// A budget by target precision of a compression run (all in F_c0 and τ1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrecisionTarget {
+    /// Aimed standard error of ⟨F⟩/F_c0 at every strain.
+    pub std_error: f64,
+    /// Sampled duration of each pilot trajectory (τ1).
+    pub pilot_tau1: f64,
+    /// Largest sampled duration of a main-stage trajectory (τ1).
+    pub max_duration_tau1: f64,
+}
+
+impl Ensemble {
+    /// The budget by target precision, if this ensemble has one (all three keys given;
+    /// validation refuses a partial set).
+    pub fn precision_target(&self) -> Option<PrecisionTarget> {
+        Some(PrecisionTarget {
+            std_error: self.target_std_error?,
+            pilot_tau1: self.pilot_tau1?,
+            max_duration_tau1: self.max_duration_tau1?,
+        })
+    }
 }
 
 /// How much statistics to gather.

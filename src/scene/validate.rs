@@ -421,14 +421,77 @@ impl Scene {
                 let k = key(&format!("{b}.trajectories"));
                 return Err(bad(self, &k, &e.trajectories, allowed));
             }
-            if let Some(allowed) = rules.duration_error(e.duration_tau1, dt) {
-                let k = key(&format!("{b}.duration_tau1"));
-                return Err(bad(self, &k, &e.duration_tau1, &allowed));
-            }
+            self.validate_duration(i, b, &e, dt, rules)?;
             if let Some(allowed) = rules.two_time_error(e.two_time_trajectories) {
                 let k = key(&format!("{b}.two_time_trajectories"));
                 return Err(bad(self, &k, &e.two_time_trajectories, allowed));
             }
+        }
+        Ok(())
+    }
+
+    /// The duration keys of the ensemble `e` of run `i` at budget `b`: a fixed
+    /// `duration_tau1`, or (compression scenes) a budget by target precision
+    /// (`target_std_error`, `pilot_tau1`, `max_duration_tau1`, all three).
+    fn validate_duration(
+        &self,
+        i: usize,
+        b: &str,
+        e: &super::spec::Ensemble,
+        dt: f64,
+        rules: &RunRules,
+    ) -> Result<()> {
+        let key = |k: &str| format!("runs[{i}].{b}.{k}");
+        let Some(target) = e.target_std_error else {
+            for (k, v) in [
+                ("pilot_tau1", e.pilot_tau1),
+                ("max_duration_tau1", e.max_duration_tau1),
+            ] {
+                if let Some(v) = v {
+                    let allowed = "left out unless target_std_error is given";
+                    return Err(bad(self, &key(k), &v, allowed));
+                }
+            }
+            if e.duration_tau1.is_nan() {
+                let allowed = "given (sampled duration per trajectory in tau1), or replaced by target_std_error, pilot_tau1 and max_duration_tau1 (compression scenes)";
+                return Err(bad(self, &key("duration_tau1"), &"nothing", allowed));
+            }
+            if let Some(allowed) = rules.duration_error(e.duration_tau1, dt) {
+                return Err(bad(self, &key("duration_tau1"), &e.duration_tau1, &allowed));
+            }
+            return Ok(());
+        };
+        if let RunRules::Linear(_) = rules {
+            let allowed = "left out for model \"fem\" or \"spectral\" (budgets by target precision are for model = \"compression\"); give duration_tau1";
+            return Err(bad(self, &key("target_std_error"), &target, allowed));
+        }
+        if !(target.is_finite() && target > 0.0 && target <= 1.0) {
+            let allowed = "in (0, 1] (standard error of <F> in units of the Euler load F_c0)";
+            return Err(bad(self, &key("target_std_error"), &target, allowed));
+        }
+        if !e.duration_tau1.is_nan() {
+            let allowed = "left out when target_std_error is given (the duration is chosen per strain, at most max_duration_tau1)";
+            return Err(bad(self, &key("duration_tau1"), &e.duration_tau1, allowed));
+        }
+        let mut given = [0.0; 2];
+        for (slot, (k, v)) in given.iter_mut().zip([
+            ("pilot_tau1", e.pilot_tau1),
+            ("max_duration_tau1", e.max_duration_tau1),
+        ]) {
+            let Some(v) = v else {
+                let allowed =
+                    "given with target_std_error (a sampled duration per trajectory in tau1)";
+                return Err(bad(self, &key(k), &"nothing", allowed));
+            };
+            if let Some(allowed) = rules.duration_error(v, dt) {
+                return Err(bad(self, &key(k), &v, &allowed));
+            }
+            *slot = v;
+        }
+        let [pilot, max] = given;
+        if pilot > max {
+            let allowed = format!("<= max_duration_tau1 = {max}");
+            return Err(bad(self, &key("pilot_tau1"), &pilot, &allowed));
         }
         Ok(())
     }

@@ -260,6 +260,9 @@ fn point_scene(
             opts.duration_tau1
         },
         two_time_trajectories: 0,
+        target_std_error: None,
+        pilot_tau1: None,
+        max_duration_tau1: None,
     };
     s.runs = vec![RunSpec {
         name: format!("{}-{}", kind.name(), noise.name()),

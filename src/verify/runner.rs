@@ -22,10 +22,11 @@ use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
 use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::compression::{
-    CompressionRun, CompressionTheoryTable, ForceEstimates, force_estimates_diagnosed,
+    CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates,
+    force_estimates_diagnosed, targeted_duration,
 };
 use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
-use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, Scene};
+use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scene};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
@@ -136,7 +137,9 @@ fn trajectory_count(scenes: &[Scene], budget: Budget) -> u64 {
                 .map(|r| {
                     let e = r.ensemble(budget);
                     if s.compression.is_some() {
-                        (e.trajectories * points) as u64
+                        // A budget by target precision runs a pilot and a main stage.
+                        let stages = if e.precision_target().is_some() { 2 } else { 1 };
+                        (stages * e.trajectories * points) as u64
                     } else {
                         (e.trajectories + e.two_time_trajectories) as u64
                     }
@@ -287,16 +290,27 @@ fn run_compression(
     outputs: &mut SceneOutputs,
 ) -> Result<(ForceEstimates, Option<RmsSlope>)> {
     let e = run.spec.ensemble(opts.budget);
-    let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
-    let records = run
-        .simulate_ensemble(
-            |i| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name)),
-            e.trajectories,
-            steps,
-            || bar.inc(1),
-        )
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-    let budget_key = format!("{}.duration_tau1", opts.budget.name());
+    let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
+    let (records, plan) = match e.precision_target() {
+        None => {
+            let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+            let records = run
+                .simulate_ensemble(seed, e.trajectories, steps, || bar.inc(1))
+                .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+            (records, None)
+        }
+        Some(target) => {
+            let plan = targeted_plan(scene, k, run, &e, target, opts.budget, bar)?;
+            let records = run
+                .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || bar.inc(1))
+                .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+            (records, Some(plan))
+        }
+    };
+    let budget_key = match plan {
+        None => format!("{}.duration_tau1", opts.budget.name()),
+        Some(_) => format!("{}.max_duration_tau1", opts.budget.name()),
+    };
     let est = force_estimates_diagnosed(&records, &scene.filament)
         .map_err(|e| scene.run_error(k, &budget_key, e))?;
     outputs.checks.extend(
@@ -307,7 +321,106 @@ fn run_compression(
     outputs
         .notes
         .push(compression_run_note(scene, theory, run, &e, &est, slope));
+    if let Some(plan) = &plan {
+        outputs.notes.push(targeted_note(run, &e, plan, &est));
+    }
     Ok((est, slope))
+}
+
+/// The pilot of a budget by target precision and the main-stage durations it chose.
+struct TargetedPlan {
+    /// The target (F_c0, τ1).
+    target: PrecisionTarget,
+    /// Sampled duration of each pilot trajectory actually run (τ1).
+    pilot_tau1: f64,
+    /// The pilot's standard error of ⟨F⟩/F_c0 per strain.
+    pilot_std_error: Vec<f64>,
+    /// Main-stage sampled duration per strain (τ1).
+    main_tau1: Vec<f64>,
+    /// Main-stage sampled steps per strain.
+    main_steps: Vec<u64>,
+}
+
+/// Runs the pilot of a budget by target precision at every strain — `trajectories` ×
+/// `pilot_tau1` on streams of their own (seed label `<run>/pilot/<strain>`), disjoint
+/// from the main stage's `<run>/<strain>` — and chooses each strain's main-stage duration
+/// with [`targeted_duration`]. The pilot's samples are discarded: the main stage is then
+/// an ordinary fixed-budget run given its durations, which depend on the pilot only.
+fn targeted_plan(
+    scene: &Scene,
+    k: usize,
+    run: &CompressionRun,
+    e: &Ensemble,
+    target: PrecisionTarget,
+    budget: Budget,
+    bar: &ProgressBar,
+) -> Result<TargetedPlan> {
+    let tau1 = scene.filament.tau1();
+    let pilot_steps = run.sampled_steps(target.pilot_tau1 * tau1);
+    let pilot = run
+        .simulate_ensemble(
+            |i| derive_seed(scene.seed, &format!("{}/pilot/{i}", run.spec.name)),
+            e.trajectories,
+            pilot_steps,
+            || bar.inc(1),
+        )
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let pilot_key = format!("{}.pilot_tau1", budget.name());
+    let pilot_est = force_estimates_diagnosed(&pilot, &scene.filament)
+        .map_err(|e| scene.run_error(k, &pilot_key, e))?;
+    let pilot_tau1 = pilot_steps as f64 * run.dt / tau1;
+    let pilot_std_error: Vec<f64> = pilot_est.force.iter().map(|f| f.1).collect();
+    let main_steps: Vec<u64> = pilot_std_error
+        .iter()
+        .map(|&se| {
+            let d = targeted_duration(se, pilot_tau1, target.std_error, target.max_duration_tau1);
+            run.sampled_steps(d * tau1)
+        })
+        .collect();
+    let main_tau1 = main_steps
+        .iter()
+        .map(|&n| n as f64 * run.dt / tau1)
+        .collect();
+    Ok(TargetedPlan {
+        target,
+        pilot_tau1,
+        pilot_std_error,
+        main_tau1,
+        main_steps,
+    })
+}
+
+/// The note of a budget by target precision: pilot, chosen durations, the strains that
+/// missed the target, and why the reported errors stay honest.
+fn targeted_note(
+    run: &CompressionRun,
+    e: &Ensemble,
+    plan: &TargetedPlan,
+    est: &ForceEstimates,
+) -> String {
+    let list = |v: &[f64], digits: usize| {
+        v.iter()
+            .map(|x| format!("{x:.digits$}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let se: Vec<f64> = est.force.iter().map(|f| f.1).collect();
+    let missed = se.iter().filter(|&&s| s > plan.target.std_error).count();
+    let largest = se.iter().copied().fold(0.0, f64::max);
+    format!(
+        "run {}: budget by target precision (standard error {} F_c0 per strain): a pilot of {} trajectories x {:.1} tau1 per strain on streams of its own (pilot s.e. per strain: {}) chose each strain's main-stage duration (s.e. ~ T^-1/2, safety factor {DURATION_SAFETY} on the duration, at least the pilot's, at most {} tau1): {} tau1 per trajectory, {} fresh trajectories; reported: the main stage only, largest s.e. {:.4}, {} of {} strains above the target (reported as they are, not rerun). The main stage's duration depends on the pilot only and the pilot is independent of the main-stage samples, so given its duration each point is an ordinary fixed-budget estimate: its standard error and p-values are honest (no optional-stopping bias)",
+        run.spec.name,
+        plan.target.std_error,
+        e.trajectories,
+        plan.pilot_tau1,
+        list(&plan.pilot_std_error, 4),
+        plan.target.max_duration_tau1,
+        list(&plan.main_tau1, 1),
+        e.trajectories,
+        largest,
+        missed,
+        se.len(),
+    )
 }
 
 /// The note of a compression run: scheme, ensemble, acceptance, autocorrelation and
@@ -321,13 +434,17 @@ fn compression_run_note(
     slope: Option<RmsSlope>,
 ) -> String {
     format!(
-        "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} tau1 per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
+        "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
         run.spec.name,
         run.spec.integrator,
         run.spec.noise.name(),
         run.spec.dt_tau1,
         e.trajectories,
-        e.duration_tau1,
+        if e.precision_target().is_some() {
+            "a duration chosen per strain (budget by target precision)".to_string()
+        } else {
+            format!("{} tau1", e.duration_tau1)
+        },
         scene.compression.as_ref().map_or(0.0, |c| c.burn_in_tau1),
         est.acceptance,
         est.max_tau_int,
