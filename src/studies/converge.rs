@@ -595,6 +595,20 @@ pub fn study_ensemble(opts: &ConvergeOptions, spec: &RunSpec) -> Result<Ensemble
         }
         e.duration_tau1 = d;
     }
+    if e.target_std_error.is_some() && e.duration_tau1.is_nan() {
+        // A budget by target precision chooses its duration per strain; a study compares
+        // values at one fixed ensemble.
+        let (lo, hi) = DURATION_RANGE;
+        return Err(Error::invalid(
+            "--duration-tau1",
+            "(not given)",
+            format!(
+                "a duration in [{lo}, {hi:e}] tau1: the {} budget of run {} sets a target standard error, and a study needs a fixed ensemble",
+                opts.budget.name(),
+                spec.name
+            ),
+        ));
+    }
     Ok(e)
 }
 
