@@ -185,6 +185,20 @@ impl SceneOutputs {
             notes: vec![scene.description.clone()],
         }
     }
+
+    /// Writes `fig` to `path` (SVG) and lists it among the scene's figures.
+    fn write_figure(&mut self, fig: &Figure, path: PathBuf) -> Result<()> {
+        fig.write_svg(&path)?;
+        self.figures.push(path);
+        Ok(())
+    }
+
+    /// Writes `rows` under `header` to `path` (CSV) and lists it among the scene's tables.
+    fn write_table(&mut self, path: PathBuf, header: &[&str], rows: &[Vec<f64>]) -> Result<()> {
+        write_csv(&path, header, rows)?;
+        self.tables.push(path);
+        Ok(())
+    }
 }
 
 /// One dimension's simulated and theoretical force–strain curve, for the Fig. 2 figure.
@@ -238,8 +252,7 @@ fn run_compression_scene(
         } else {
             dir.join(format!("{}-force-strain.csv", run.spec.name))
         };
-        write_csv(&path, &FORCE_STRAIN_HEADER, &rows)?;
-        outputs.tables.push(path);
+        outputs.write_table(path, &FORCE_STRAIN_HEADER, &rows)?;
         fig = fig.series(
             Series::markers(
                 format!("simulated: {} (±1 s.e.)", run.spec.name),
@@ -261,9 +274,7 @@ fn run_compression_scene(
         outputs.checks.push(check);
         outputs.notes.push(note);
     }
-    let path = dir.join("force-strain.svg");
-    fig.write_svg(&path)?;
-    outputs.figures.push(path);
+    outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
     outputs.figures.push(write_fig2(&opts.out, curves)?);
     let mut summary = finish_scene(scene, outputs, start, opts)?;
     if let Some((what, slope)) = largest_slope {
@@ -734,12 +745,11 @@ fn write_mode_variances(
             ]
         })
         .collect();
-    write_csv(
-        &path,
+    outputs.write_table(
+        path,
         &["mode", "predicted_ratio", "simulated_ratio", "std_error"],
         &rows,
     )?;
-    outputs.tables.push(path);
     let continuum = modes
         .iter()
         .map(|(mr, _)| {
@@ -767,9 +777,7 @@ fn write_mode_variances(
     ))
     .series(Series::line("continuum (kT/lambda_n) / equipartition", continuum).dashed())
     .hline(1.0, "equipartition");
-    let path = dir.join(format!("{name}-modes.svg"));
-    fig.write_svg(&path)?;
-    outputs.figures.push(path);
+    outputs.write_figure(&fig, dir.join(format!("{name}-modes.svg")))?;
     Ok(())
 }
 
@@ -802,8 +810,8 @@ fn write_mode_statistics(
             ]
         })
         .collect();
-    write_csv(
-        &stats_path,
+    outputs.write_table(
+        stats_path,
         &[
             "mode",
             "variance",
@@ -817,7 +825,6 @@ fn write_mode_statistics(
         ],
         &rows,
     )?;
-    outputs.tables.push(stats_path);
     if est.modes.iter().any(|m| m.rate.0.is_finite()) {
         let fig = Figure::new(
             format!("{name}: relaxation rate / continuum rate lambda_n"),
@@ -836,9 +843,7 @@ fn write_mode_statistics(
             rows.iter().map(|r| (r[0], r[7] / r[8])).collect(),
         ))
         .hline(1.0, "continuum");
-        let path = dir.join(format!("{name}-rates.svg"));
-        fig.write_svg(&path)?;
-        outputs.figures.push(path);
+        outputs.write_figure(&fig, dir.join(format!("{name}-rates.svg")))?;
     }
     Ok(())
 }
@@ -863,12 +868,11 @@ fn write_profile(
             ]
         })
         .collect();
-    write_csv(
-        &path,
+    outputs.write_table(
+        path,
         &["x", "variance", "std_error", "discrete", "continuum"],
         &rows,
     )?;
-    outputs.tables.push(path);
     Ok(())
 }
 
@@ -888,8 +892,8 @@ fn write_two_time(
         .zip(&est.two_time)
         .map(|(q, e)| vec![q.x, q.y, q.t, q.eta, e.0, e.1, q.discrete, q.continuum])
         .collect();
-    write_csv(
-        &path,
+    outputs.write_table(
+        path,
         &[
             "x",
             "y",
@@ -902,7 +906,6 @@ fn write_two_time(
         ],
         &rows,
     )?;
-    outputs.tables.push(path);
     Ok(())
 }
 
@@ -948,11 +951,8 @@ fn write_spectra(
         }
     }
     let path = dir.join(format!("{name}-spectrum.csv"));
-    write_csv(&path, &["mode", "frequency", "psd", "expected"], &rows)?;
-    outputs.tables.push(path);
-    let path = dir.join(format!("{name}-spectrum.svg"));
-    fig.write_svg(&path)?;
-    outputs.figures.push(path);
+    outputs.write_table(path, &["mode", "frequency", "psd", "expected"], &rows)?;
+    outputs.write_figure(&fig, dir.join(format!("{name}-spectrum.svg")))?;
     Ok(())
 }
 
@@ -972,14 +972,13 @@ fn write_noise_study(scene: &Scene, dir: &Path, outputs: &mut SceneOutputs) -> R
         .map(|(&ne, r)| std::iter::once(ne as f64).chain(r).collect())
         .collect();
     let path = dir.join("element-uniform-vs-elements.csv");
-    write_csv(
-        &path,
+    outputs.write_table(
+        path,
         &[
             "elements", "mode1", "mode2", "mode3", "mode4", "mode5", "mode6",
         ],
         &rows,
     )?;
-    outputs.tables.push(path);
     let mut fig = Figure::new(
         "element-uniform noise (eq. 5): 1 - variance/equipartition vs element count",
         "elements",
@@ -996,9 +995,7 @@ fn write_noise_study(scene: &Scene, dir: &Path, outputs: &mut SceneOutputs) -> R
             .with_style(SeriesStyle::LineMarkers),
         );
     }
-    let path = dir.join("element-uniform-vs-elements.svg");
-    fig.write_svg(&path)?;
-    outputs.figures.push(path);
+    outputs.write_figure(&fig, dir.join("element-uniform-vs-elements.svg"))?;
     // Observed order of the deficit of mode 1 between the two finest meshes.
     let k = rows.len() - 1;
     let order = ((1.0 - rows[k - 1][1]) / (1.0 - rows[k][1])).log2();
