@@ -28,15 +28,21 @@
 //!
 //! The θ-schemes cost one banded solve per step (O(n)); `exact-modal` uses dense modal
 //! transforms (O(n²)) but is exact in distribution for the linear problem at any Δt.
+//!
+//! The nonlinear (von Kármán) filament has its own schemes ([`nonlinear`]); on a uniform
+//! hinged mesh `metropolis-crank-nicolson` runs in the paired modal form
+//! ([`modal_metropolis`], O(n) per step with 2×2 solves).
 
 pub mod driver;
 pub mod ensemble;
 mod integrator;
+pub mod modal_metropolis;
 pub mod nonlinear;
 
 pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
+pub use modal_metropolis::ModalMetropolis;
 pub use nonlinear::{NonlinearIntegrator, NonlinearStep};
 
 use crate::error::Error;

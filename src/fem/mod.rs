@@ -9,6 +9,8 @@
 //! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
 //! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
+//! - [`paired`]: the paired modal form of a uniform hinged beam ([`PairedModes`]): `K`,
+//!   `C`, `G` block-diagonal with 2×2 blocks per wavenumber.
 //! - [`vonkarman`]: the finite-deflection filament under imposed end-shortening
 //!   ([`vonkarman::CompressedFilament`]): energy, internal force, axial solve.
 
@@ -18,6 +20,7 @@ pub mod hermite;
 pub mod mesh;
 pub mod modal;
 pub mod noise;
+pub mod paired;
 pub mod vonkarman;
 
 pub use banded::{BandedCholesky, SymBanded};
@@ -28,3 +31,4 @@ pub use modal::{
     generalized_modes, modal_noise_covariance, nodal_covariance,
 };
 pub use noise::{NoiseGenerator, NoiseModel};
+pub use paired::{ModeBlock, PairedModes};

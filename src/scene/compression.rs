@@ -3,11 +3,12 @@
 //! equilibrium theory of the same discretization ([`crate::theory::compression`]), with
 //! the continuum theory beside it.
 
-use crate::dynamics::{Driver, NonlinearState, Observer};
+use crate::dynamics::{Driver, Family, ModalMetropolis, NonlinearState, Observer};
 use crate::error::{Error, Result};
 use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
+use crate::fem::paired::PairedModes;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::linear::{add_slope_squares, largest_rms_slope};
 use crate::scene::{CompressionSpec, RunSpec, Scene};
@@ -115,6 +116,23 @@ impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
     }
 }
 
+/// The observer of [`CompressionRun::simulate_modal`]: F/F_c0 and the squared rotation
+/// amplitude per wavenumber at every sample.
+struct ModalForceRecorder {
+    euler_load: f64,
+    force_ratio: Vec<f64>,
+    block_squares: Vec<f64>,
+    samples: usize,
+}
+
+impl Observer<ModalMetropolis<'_>> for ModalForceRecorder {
+    fn on_sample(&mut self, _: usize, _: u64, chain: &ModalMetropolis<'_>) {
+        self.force_ratio.push(chain.force() / self.euler_load);
+        chain.add_block_rotation_squares(&mut self.block_squares);
+        self.samples += 1;
+    }
+}
+
 /// One run (integrator and time step) of a compression scene.
 pub struct CompressionRun {
     /// The run specification.
@@ -130,6 +148,9 @@ pub struct CompressionRun {
     pub euler_load: f64,
     /// Cholesky factor of the bending stiffness K, for the equilibrium start.
     stiffness: BandedCholesky,
+    /// The paired modal form, for `metropolis-crank-nicolson` on a uniform mesh (always,
+    /// in the scenes): [`Self::simulate`] then runs [`ModalMetropolis`].
+    paired: Option<PairedModes>,
 }
 
 /// What one trajectory at one strain recorded.
@@ -170,6 +191,10 @@ impl CompressionRun {
             burn_in_steps: (comp.burn_in_tau1 * tau1 / dt).round() as u64,
             sample_every: ((comp.sample_every_tau1 * tau1 / dt).round() as u64).max(1),
             stiffness: beam.stiffness().cholesky()?,
+            paired: match spec.integrator.family() {
+                Family::Metropolis => PairedModes::new(&beam),
+                Family::Theta(_) | Family::ExactModal => None,
+            },
             models,
             euler_load: p.euler_load(),
         })
@@ -222,6 +247,9 @@ impl CompressionRun {
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
         let model = &self.models[point];
+        if let Some(modes) = &self.paired {
+            return self.simulate_modal(point, modes, rng, sampled_steps);
+        }
         let integrator =
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
         let mut state = NonlinearState {
@@ -252,6 +280,49 @@ impl CompressionRun {
             )
         })?;
         Ok(recorder.rec)
+    }
+
+    /// [`Self::simulate`] for `metropolis-crank-nicolson` on the paired modal form
+    /// ([`ModalMetropolis`]): the same chain at O(n) per step, started from the free
+    /// bending equilibrium (moved onto the buckled branch above the Euler strain).
+    fn simulate_modal(
+        &self,
+        point: usize,
+        modes: &PairedModes,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<ForceRecord> {
+        let model = &self.models[point];
+        let mut chain = ModalMetropolis::new(model, modes, self.dt, rng)?;
+        let mut recorder = ModalForceRecorder {
+            euler_load: self.euler_load,
+            force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+            block_squares: vec![0.0; modes.pairs().len() + modes.singles().len()],
+            samples: 0,
+        };
+        Driver::new(
+            self.dt,
+            self.burn_in_steps,
+            sampled_steps,
+            self.sample_every,
+        )
+        .run(point, &mut chain, rng, &mut recorder, |_| {
+            format!(
+                "non-finite energy with {} at strain {:.4e} (dt = {:.3e} tau1)",
+                self.spec.integrator,
+                model.strain(),
+                self.spec.dt_tau1
+            )
+        })?;
+        let mut slope_squares = vec![0.0; model.beam().mesh().n_nodes()];
+        modes.add_rotation_squares(&recorder.block_squares, &mut slope_squares);
+        Ok(ForceRecord {
+            force_ratio: recorder.force_ratio,
+            proposed: chain.proposed,
+            accepted: chain.accepted,
+            slope_squares,
+            slope_samples: recorder.samples,
+        })
     }
 
     /// Simulates `trajectories` trajectories of `sampled_steps` steps at every strain, in
