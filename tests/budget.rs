@@ -176,6 +176,61 @@ fn a_targeted_budget_runs_and_says_so() {
     assert!(!summary.contains("NaN"), "{summary}");
 }
 
+const SEARCH_FULL: &str = "{ trajectories = 4, target_std_error = 0.05, pilot_tau1 = 5.0, max_duration_tau1 = 40.0, max_dt_tau1 = 0.32, min_acceptance = 0.6 }";
+
+/// The step search runs end to end: every strain gets a step from the ladder
+/// 0.02·2^k ≤ 0.32 (the note lists them with their probe acceptance), the search
+/// reaches larger steps than the scene's 0.02 in tension (acceptance there is high), and
+/// every chosen step's probe met the acceptance asked, or it is the scene's own step.
+#[test]
+fn a_step_search_chooses_steps_per_strain_and_says_so() {
+    let dir = TempDir::new("budget-search");
+    let path = write_scene(&dir, "search", scene_text(SEARCH_FULL).as_bytes());
+    let out = dir.join_str("out");
+    let args = [
+        "verify",
+        "--scene",
+        path.to_str().unwrap(),
+        "--budget",
+        "full",
+        "--out",
+        &out,
+    ];
+    let o = run(&args);
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        describe(&args, &o)
+    );
+    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let notes = v["scenes"][0]["notes"].to_string();
+    let start = notes.find("Chosen dt per strain (tau1): ").expect(&notes) + 29;
+    let chosen: Vec<f64> = notes[start..]
+        .split(';')
+        .next()
+        .unwrap()
+        .split(", ")
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let start = notes.find("probe acceptance at the chosen dt: ").unwrap() + 35;
+    let acc: Vec<f64> = notes[start..]
+        .split(". Then")
+        .next()
+        .unwrap()
+        .split(", ")
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(chosen.len(), 3, "{notes}");
+    for (&d, &a) in chosen.iter().zip(&acc) {
+        let k = (d / 0.02).log2();
+        assert!((k - k.round()).abs() < 1e-9 && d <= 0.32, "{d}");
+        assert!(a >= 0.6 || d == 0.02, "dt {d} with acceptance {a}");
+    }
+    assert!(chosen[0] > 0.02, "{chosen:?}");
+    assert!(!summary.contains("NaN"), "{summary}");
+}
+
 /// A bad targeted budget: exit 2, the message names the file, the key and the value.
 fn assert_refused(full: &str, key: &str, value: &str) {
     let dir = TempDir::new("budget-bad");
@@ -235,6 +290,59 @@ fn bad_targets_are_refused_naming_the_key() {
         "{ trajectories = 4, target_std_error = 0.05, pilot_tau1 = 0.1, max_duration_tau1 = 40.0 }",
         "runs[0].full.pilot_tau1",
         ">= 16 x sample_every_tau1",
+    );
+}
+
+#[test]
+fn bad_step_searches_are_refused_naming_the_key() {
+    let with = |extra: &str| {
+        format!(
+            "{{ trajectories = 4, target_std_error = 0.05, pilot_tau1 = 5.0, max_duration_tau1 = 40.0, {extra} }}"
+        )
+    };
+    assert_refused(
+        &with("max_dt_tau1 = 0.32"),
+        "runs[0].full.min_acceptance",
+        "given with max_dt_tau1",
+    );
+    assert_refused(
+        &with("min_acceptance = 0.6"),
+        "runs[0].full.max_dt_tau1",
+        "given with min_acceptance",
+    );
+    assert_refused(
+        &with("max_dt_tau1 = 0.01, min_acceptance = 0.6"),
+        "runs[0].full.max_dt_tau1",
+        "in [dt_tau1 = 0.02, 100]",
+    );
+    assert_refused(
+        &with("max_dt_tau1 = 0.32, min_acceptance = 1.0"),
+        "runs[0].full.min_acceptance",
+        "in (0, 1)",
+    );
+    assert_refused(
+        "{ trajectories = 4, duration_tau1 = 10.0, max_dt_tau1 = 0.32 }",
+        "runs[0].full.max_dt_tau1",
+        "unless target_std_error",
+    );
+    // Only for the Metropolis scheme (exact at any dt).
+    let dir = TempDir::new("budget-bad");
+    let text = scene_text(&with("max_dt_tau1 = 0.32, min_acceptance = 0.6"))
+        .replace("metropolis-crank-nicolson", "crank-nicolson");
+    let path = write_scene(&dir, "bad", text.as_bytes());
+    let args = [
+        "verify",
+        "--scene",
+        path.to_str().unwrap(),
+        "--out",
+        &dir.join_str("out"),
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    let err = stderr_of(&o);
+    assert!(
+        err.contains("runs[0].full.max_dt_tau1") && err.contains("exact at any dt"),
+        "{err}"
     );
 }
 

@@ -182,6 +182,23 @@ impl<'m> ModalMetropolis<'m> {
         }
     }
 
+    /// Changes the time step to `dt` (the chain's state is kept: its law is exact at any
+    /// Δt, so a burn-in at a small step may precede sampling at a large one).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a non-positive or non-finite `dt`.
+    pub fn set_dt(&mut self, dt: f64) -> Result<()> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::invalid("dt", dt, "finite and > 0"));
+        }
+        self.half_dt = 0.5 * dt;
+        self.scale = (2.0 * self.kt * dt).sqrt();
+        let mut cur = std::mem::take(&mut self.current);
+        self.evaluate(&mut cur);
+        self.current = cur;
+        Ok(())
+    }
+
     /// Number of modal coordinates per component.
     fn n(&self) -> usize {
         2 * self.pairs.len() + self.singles.len()

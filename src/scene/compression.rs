@@ -11,7 +11,7 @@ use crate::fem::mesh::Mesh;
 use crate::fem::paired::PairedModes;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::linear::{add_slope_squares, largest_rms_slope};
-use crate::scene::{CompressionSpec, RunSpec, Scene};
+use crate::scene::{CompressionSpec, RunSpec, Scene, StepSearch};
 use crate::stats;
 use crate::theory::compression::{CompressionTheory, Dims, ForceDistribution, StoredLengthLaw};
 use crate::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::CompressedFilament};
@@ -133,16 +133,69 @@ impl Observer<ModalMetropolis<'_>> for ModalForceRecorder {
     }
 }
 
+/// Sampled steps of each probe trajectory of a step search ([`CompressionRun::search_step`]),
+/// after its burn-in: with 16 trajectories, about 800 proposals, so the acceptance rate
+/// is known to about ±0.02.
+pub const PROBE_STEPS: u64 = 50;
+
+/// The outcome of a step search at one strain: the chosen step and every candidate probed
+/// with its acceptance rate, `(dt_tau1, acceptance)`, largest step first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepChoice {
+    /// The chosen step, in units of τ1.
+    pub dt_tau1: f64,
+    /// The candidates probed, `(dt_tau1, acceptance rate)`.
+    pub tried: Vec<(f64, f64)>,
+}
+
+/// The time step of one strain of a run, with its burn-in and sampling cadence in steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct StepPlan {
+    dt: f64,
+    /// The step of the burn-in (the scene's `dt_tau1`; see [`CompressionRun::with_steps`]).
+    burn_in_dt: f64,
+    /// Burn-in steps at `burn_in_dt`.
+    burn_in_steps: u64,
+    sample_every: u64,
+}
+
+impl StepPlan {
+    /// Step `dt`, burn-in and sampling interval in physical time (rounded to whole steps,
+    /// at least one step between samples); the burn-in at the step `burn_in_dt`.
+    fn new(dt: f64, burn_in: f64, sample_interval: f64, burn_in_dt: f64) -> Self {
+        StepPlan {
+            dt,
+            burn_in_dt,
+            burn_in_steps: (burn_in / burn_in_dt).round() as u64,
+            sample_every: ((sample_interval / dt).round() as u64).max(1),
+        }
+    }
+
+    /// Steps of a sampled duration (physical time): a whole number of sampling intervals,
+    /// at least one.
+    fn sampled_steps(&self, duration: f64) -> u64 {
+        let n = (duration / self.dt).round() as u64;
+        (n / self.sample_every).max(1) * self.sample_every
+    }
+}
+
 /// One run (integrator and time step) of a compression scene.
+#[derive(Debug, Clone)]
 pub struct CompressionRun {
     /// The run specification.
     pub spec: RunSpec,
-    /// Time step.
+    /// Time step (the scene's `dt_tau1`; a step search may choose other steps per strain,
+    /// see [`Self::with_steps`]).
     pub dt: f64,
-    /// Burn-in steps at each strain.
+    /// Burn-in steps at each strain (at `dt`).
     pub burn_in_steps: u64,
-    /// Steps between samples of F.
+    /// Steps between samples of F (at `dt`).
     pub sample_every: u64,
+    /// The step, burn-in and sampling cadence of each strain.
+    plans: Vec<StepPlan>,
+    /// Burn-in and sampling interval (physical time), for [`Self::with_steps`].
+    burn_in: f64,
+    sample_interval: f64,
     models: Vec<CompressedFilament>,
     /// Euler buckling load F_c0 (the unit of the recorded forces).
     pub euler_load: f64,
@@ -158,7 +211,8 @@ pub struct CompressionRun {
 pub struct ForceRecord {
     /// F/F_c0 every `sample_every` steps after burn-in.
     pub force_ratio: Vec<f64>,
-    /// Metropolis proposals and acceptances (0 for θ-schemes).
+    /// Metropolis proposals and acceptances (0 for θ-schemes); on a uniform mesh (the
+    /// modal chain) those of the sampled steps only, without the burn-in.
     pub proposed: u64,
     /// Accepted proposals.
     pub accepted: u64,
@@ -185,11 +239,16 @@ impl CompressionRun {
             .collect::<Result<_>>()?;
         // Fails early (exit 2) for a bad integrator or time step.
         NonlinearIntegrator::new(&models[0], spec.integrator, spec.noise, dt)?;
+        let (burn_in, sample_interval) = (comp.burn_in_tau1 * tau1, comp.sample_every_tau1 * tau1);
+        let plan = StepPlan::new(dt, burn_in, sample_interval, dt);
         Ok(CompressionRun {
             spec: spec.clone(),
             dt,
-            burn_in_steps: (comp.burn_in_tau1 * tau1 / dt).round() as u64,
-            sample_every: ((comp.sample_every_tau1 * tau1 / dt).round() as u64).max(1),
+            burn_in_steps: plan.burn_in_steps,
+            sample_every: plan.sample_every,
+            plans: vec![plan; models.len()],
+            burn_in,
+            sample_interval,
             stiffness: beam.stiffness().cholesky()?,
             paired: match spec.integrator.family() {
                 Family::Metropolis => PairedModes::new(&beam),
@@ -200,10 +259,51 @@ impl CompressionRun {
         })
     }
 
-    /// Number of steps for a sampled duration (physical time).
+    /// Number of steps for a sampled duration (physical time) at the scene's step `dt`.
     pub fn sampled_steps(&self, duration: f64) -> u64 {
-        let n = (duration / self.dt).round() as u64;
-        (n / self.sample_every).max(1) * self.sample_every
+        StepPlan::new(self.dt, self.burn_in, self.sample_interval, self.dt).sampled_steps(duration)
+    }
+
+    /// Number of steps for a sampled duration (physical time) at strain `point`'s step.
+    pub fn sampled_steps_at(&self, point: usize, duration: f64) -> u64 {
+        self.plans[point].sampled_steps(duration)
+    }
+
+    /// The time step of strain `point`.
+    pub fn dt_at(&self, point: usize) -> f64 {
+        self.plans[point].dt
+    }
+
+    /// This run with its own time step at every strain, `dt_tau1[i]` (units of τ1) at
+    /// strain `i` (burn-in and sampling interval kept in physical time): the outcome of a
+    /// step search, which only schemes exact at any Δt may use (validated with the scene).
+    ///
+    /// The burn-in stays at the scene's step: Crank–Nicolson damps a mode of rate λ only
+    /// by `(1 − a/2)/(1 + a/2) ≈ −1 + 4/a` per step (a = λΔt), so at a large step the
+    /// mid-spectrum modes would carry their start variance (free bending equilibrium,
+    /// not the tensioned or compressed one) for hundreds of steps; at 0.64 τ1 and 5 τ1
+    /// of burn-in this biased ⟨F⟩ in tension by about 3 standard errors (3D, 10
+    /// elements). The chain is exact at both steps, so the switch costs nothing in law.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] without one finite, positive step per strain.
+    pub fn with_steps(&self, dt_tau1: &[f64]) -> Result<Self> {
+        if dt_tau1.len() != self.points() {
+            return Err(Error::invalid(
+                "time steps per strain",
+                dt_tau1.len(),
+                format!("one per strain ({})", self.points()),
+            ));
+        }
+        let tau1 = self.dt / self.spec.dt_tau1;
+        let mut out = self.clone();
+        for (plan, &d) in out.plans.iter_mut().zip(dt_tau1) {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(Error::invalid("dt_tau1", d, "finite and > 0"));
+            }
+            *plan = StepPlan::new(d * tau1, self.burn_in, self.sample_interval, self.dt);
+        }
+        Ok(out)
     }
 
     /// An exact sample of the free bending equilibrium, `w_c ~ N(0, kT K⁻¹)` per
@@ -246,12 +346,23 @@ impl CompressionRun {
         rng: &mut TrajectoryRng,
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
+        self.simulate_plan(point, self.plans[point], rng, sampled_steps)
+    }
+
+    /// [`Self::simulate`] with the step and cadence `plan`.
+    fn simulate_plan(
+        &self,
+        point: usize,
+        plan: StepPlan,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<ForceRecord> {
         let model = &self.models[point];
         if let Some(modes) = &self.paired {
-            return self.simulate_modal(point, modes, rng, sampled_steps);
+            return self.simulate_modal(point, plan, modes, rng, sampled_steps);
         }
         let integrator =
-            NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, self.dt)?;
+            NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, plan.dt)?;
         let mut state = NonlinearState {
             integrator,
             w: self.equilibrium_start(rng),
@@ -260,25 +371,26 @@ impl CompressionRun {
             model,
             euler_load: self.euler_load,
             rec: ForceRecord {
-                force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+                force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
                 slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
                 ..Default::default()
             },
         };
-        Driver::new(
-            self.dt,
-            self.burn_in_steps,
-            sampled_steps,
-            self.sample_every,
-        )
-        .run(point, &mut state, rng, &mut recorder, |_| {
-            format!(
-                "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
-                self.spec.integrator,
-                model.strain(),
-                self.spec.dt_tau1
-            )
-        })?;
+        let burn_in_steps = (self.burn_in / plan.dt).round() as u64;
+        Driver::new(plan.dt, burn_in_steps, sampled_steps, plan.sample_every).run(
+            point,
+            &mut state,
+            rng,
+            &mut recorder,
+            |_| {
+                format!(
+                    "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
+                    self.spec.integrator,
+                    model.strain(),
+                    self.spec.dt_tau1
+                )
+            },
+        )?;
         Ok(recorder.rec)
     }
 
@@ -288,32 +400,44 @@ impl CompressionRun {
     fn simulate_modal(
         &self,
         point: usize,
+        plan: StepPlan,
         modes: &PairedModes,
         rng: &mut TrajectoryRng,
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
         let model = &self.models[point];
-        let mut chain = ModalMetropolis::new(model, modes, self.dt, rng)?;
+        let mut chain = ModalMetropolis::new(model, modes, plan.burn_in_dt, rng)?;
+        let detail = |phase: &str, dt: f64| {
+            format!(
+                "non-finite energy with {} at strain {:.4e} ({phase}, dt = {:.3e} tau1)",
+                self.spec.integrator,
+                model.strain(),
+                dt / (self.dt / self.spec.dt_tau1)
+            )
+        };
+        Driver::new(plan.burn_in_dt, plan.burn_in_steps, 0, 1).run(
+            point,
+            &mut chain,
+            rng,
+            &mut (),
+            |_| detail("burn-in", plan.burn_in_dt),
+        )?;
+        chain.set_dt(plan.dt)?;
+        chain.proposed = 0;
+        chain.accepted = 0;
         let mut recorder = ModalForceRecorder {
             euler_load: self.euler_load,
-            force_ratio: Vec::with_capacity((sampled_steps / self.sample_every) as usize),
+            force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
             block_squares: vec![0.0; modes.pairs().len() + modes.singles().len()],
             samples: 0,
         };
-        Driver::new(
-            self.dt,
-            self.burn_in_steps,
-            sampled_steps,
-            self.sample_every,
-        )
-        .run(point, &mut chain, rng, &mut recorder, |_| {
-            format!(
-                "non-finite energy with {} at strain {:.4e} (dt = {:.3e} tau1)",
-                self.spec.integrator,
-                model.strain(),
-                self.spec.dt_tau1
-            )
-        })?;
+        Driver::new(plan.dt, 0, sampled_steps, plan.sample_every).run(
+            point,
+            &mut chain,
+            rng,
+            &mut recorder,
+            |_| detail("sampling after the burn-in", plan.dt),
+        )?;
         let mut slope_squares = vec![0.0; model.beam().mesh().n_nodes()];
         modes.add_rotation_squares(&recorder.block_squares, &mut slope_squares);
         Ok(ForceRecord {
@@ -375,6 +499,50 @@ impl CompressionRun {
         Ok(flat.chunks(nt).map(<[_]>::to_vec).collect())
     }
 
+    /// The step search of a budget by target precision at strain `point` (see
+    /// [`StepSearch`]): the candidates `dt_tau1·2^k ≤ max_dt_tau1`, largest first, each
+    /// probed with `trajectories` trajectories of [`PROBE_STEPS`] sampled steps after the
+    /// burn-in (trajectory `j` of candidate `k` on the stream `trajectory_rng(seed(k), j)`),
+    /// until the acceptance rate over the probe's sampled steps (the burn-in runs at the
+    /// scene's step, see [`Self::with_steps`]) reaches `min_acceptance`; the scene's own
+    /// `dt_tau1` if none does. The probes are discarded.
+    ///
+    /// # Errors
+    /// As [`Self::simulate`].
+    pub fn search_step(
+        &self,
+        point: usize,
+        search: StepSearch,
+        trajectories: usize,
+        seed: impl Fn(usize) -> u64,
+    ) -> Result<StepChoice> {
+        let base = self.spec.dt_tau1;
+        let tau1 = self.dt / base;
+        let doublings = (search.max_dt_tau1 / base).log2().floor().max(0.0) as i32;
+        let mut tried = Vec::new();
+        for k in (0..=doublings).rev() {
+            let dt_tau1 = base * 2f64.powi(k);
+            let plan = StepPlan::new(dt_tau1 * tau1, self.burn_in, self.sample_interval, self.dt);
+            let (mut proposed, mut accepted) = (0, 0);
+            for j in 0..trajectories.max(1) {
+                let steps = PROBE_STEPS.div_ceil(plan.sample_every) * plan.sample_every;
+                let mut rng = trajectory_rng(seed(k as usize), j as u64);
+                let rec = self.simulate_plan(point, plan, &mut rng, steps)?;
+                proposed += rec.proposed;
+                accepted += rec.accepted;
+            }
+            let rate = accepted as f64 / proposed.max(1) as f64;
+            tried.push((dt_tau1, rate));
+            if rate >= search.min_acceptance {
+                return Ok(StepChoice { dt_tau1, tried });
+            }
+        }
+        Ok(StepChoice {
+            dt_tau1: base,
+            tried,
+        })
+    }
+
     /// The strains of this run (ε/ε_c0 is in the theory table).
     pub fn points(&self) -> usize {
         self.models.len()
@@ -406,9 +574,12 @@ impl CompressionRun {
 }
 
 /// Safety factor on the sampled duration a pilot predicts for a target standard error:
-/// the pilot's own error estimate scatters (its integrated autocorrelation time most),
-/// and 1.5 on the duration is a margin of √1.5 ≈ 1.22 on the standard error.
-pub const DURATION_SAFETY: f64 = 1.5;
+/// the pilot's own error estimate scatters (its integrated autocorrelation time most,
+/// about 20 % with 16 trajectories), and 2 on the duration is a margin of √2 ≈ 1.41 on
+/// the standard error, so that a strain misses the target only if its pilot
+/// underestimated the error by about 30 % (with 1.5, one or two of 24 strains missed by
+/// a few per cent).
+pub const DURATION_SAFETY: f64 = 2.0;
 
 /// The main stage's sampled duration per trajectory of a budget by target precision, from
 /// a pilot of the same trajectory count: the standard error of a time average falls as

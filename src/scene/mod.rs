@@ -21,5 +21,5 @@ pub mod validate;
 
 pub use spec::{
     Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, PrecisionTarget, RunSpec,
-    Sampling, Scene, resolve_scenes,
+    Sampling, Scene, StepSearch, resolve_scenes,
 };

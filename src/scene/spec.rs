@@ -99,6 +99,25 @@ pub struct Ensemble {
     /// in units of τ1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_duration_tau1: Option<f64>,
+    /// With `target_std_error`, Metropolis runs only: the largest step of the step search,
+    /// in units of τ1 (with `min_acceptance`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_dt_tau1: Option<f64>,
+    /// With `max_dt_tau1`: the acceptance rate the step search asks of a step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_acceptance: Option<f64>,
+}
+
+/// The step search of a budget by target precision (Metropolis runs only, whose
+/// stationary law is exact at any Δt): at each strain, the largest step
+/// `dt_tau1·2^k ≤ max_dt_tau1` whose probe acceptance is at least `min_acceptance`
+/// ([`crate::scene::compression::CompressionRun::search_step`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepSearch {
+    /// Largest step tried (τ1).
+    pub max_dt_tau1: f64,
+    /// Acceptance rate a step must reach.
+    pub min_acceptance: f64,
 }
 
 /// A missing `duration_tau1` (NaN: not a valid duration, refused by validation unless
@@ -121,6 +140,8 @@ pub struct PrecisionTarget {
     pub pilot_tau1: f64,
     /// Largest sampled duration of a main-stage trajectory (τ1).
     pub max_duration_tau1: f64,
+    /// The step search, if the budget has one.
+    pub step_search: Option<StepSearch>,
 }
 
 impl Ensemble {
@@ -131,6 +152,13 @@ impl Ensemble {
             std_error: self.target_std_error?,
             pilot_tau1: self.pilot_tau1?,
             max_duration_tau1: self.max_duration_tau1?,
+            step_search: match (self.max_dt_tau1, self.min_acceptance) {
+                (Some(max_dt_tau1), Some(min_acceptance)) => Some(StepSearch {
+                    max_dt_tau1,
+                    min_acceptance,
+                }),
+                _ => None,
+            },
         })
     }
 }

@@ -18,7 +18,7 @@
 //! range (exit code 2).
 
 use super::spec::{Budget, CheckKind, CompressionSpec, ModelKind, RunSpec, Sampling, Scene};
-use crate::dynamics::IntegratorKind;
+use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
 use std::fmt::Display;
@@ -446,6 +446,8 @@ impl Scene {
             for (k, v) in [
                 ("pilot_tau1", e.pilot_tau1),
                 ("max_duration_tau1", e.max_duration_tau1),
+                ("max_dt_tau1", e.max_dt_tau1),
+                ("min_acceptance", e.min_acceptance),
             ] {
                 if let Some(v) = v {
                     let allowed = "left out unless target_std_error is given";
@@ -492,6 +494,58 @@ impl Scene {
         if pilot > max {
             let allowed = format!("<= max_duration_tau1 = {max}");
             return Err(bad(self, &key("pilot_tau1"), &pilot, &allowed));
+        }
+        self.validate_step_search(i, b, e)
+    }
+
+    /// The step search of a budget by target precision (`max_dt_tau1` and
+    /// `min_acceptance`, both or neither): Metropolis runs only (exact at any Δt), steps
+    /// from `dt_tau1` to 100 τ1; the second run of the Δt-halving pair inherits the first
+    /// run's steps (halved), so it has no search of its own and comes after the first.
+    fn validate_step_search(&self, i: usize, b: &str, e: &super::spec::Ensemble) -> Result<()> {
+        let key = |k: &str| format!("runs[{i}].{b}.{k}");
+        let run = &self.runs[i];
+        let (max_dt, min_acc) = match (e.max_dt_tau1, e.min_acceptance) {
+            (None, None) => return Ok(()),
+            (Some(m), Some(a)) => (m, a),
+            (Some(_), None) => {
+                let allowed = "given with max_dt_tau1 (the acceptance rate the step search asks of a step, in (0, 1))";
+                return Err(bad(self, &key("min_acceptance"), &"nothing", allowed));
+            }
+            (None, Some(_)) => {
+                let allowed =
+                    "given with min_acceptance (the largest step of the step search, in tau1)";
+                return Err(bad(self, &key("max_dt_tau1"), &"nothing", allowed));
+            }
+        };
+        if run.integrator.family() != Family::Metropolis {
+            let allowed = format!(
+                "left out for integrator \"{}\" (a step search only for metropolis-crank-nicolson, whose stationary law is exact at any dt)",
+                run.integrator
+            );
+            return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+        }
+        if !(max_dt.is_finite() && max_dt >= run.dt_tau1 && max_dt <= 100.0) {
+            let allowed = format!("in [dt_tau1 = {}, 100] (tau1)", run.dt_tau1);
+            return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+        }
+        if !(min_acc > 0.0 && min_acc < 1.0) {
+            return Err(bad(self, &key("min_acceptance"), &min_acc, "in (0, 1)"));
+        }
+        if let Some([first, second]) = self.compression.as_ref().and_then(|c| c.halving.as_ref()) {
+            if &run.name == second {
+                let allowed = format!(
+                    "left out for the second run of compression.halving (it runs at half the steps that run \"{first}\" chose)"
+                );
+                return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+            }
+            let later = |name: &str| self.runs.iter().position(|r| r.name == name);
+            if &run.name == first && later(second).is_some_and(|j| j < i) {
+                let allowed = format!(
+                    "left out, or run \"{second}\" listed after run \"{first}\" (the second run of compression.halving inherits the steps the first chose)"
+                );
+                return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+            }
         }
         Ok(())
     }

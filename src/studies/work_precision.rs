@@ -263,6 +263,8 @@ fn point_scene(
         target_std_error: None,
         pilot_tau1: None,
         max_duration_tau1: None,
+        max_dt_tau1: None,
+        min_acceptance: None,
     };
     s.runs = vec![RunSpec {
         name: format!("{}-{}", kind.name(), noise.name()),

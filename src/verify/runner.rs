@@ -22,8 +22,8 @@ use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
 use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::compression::{
-    CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates,
-    force_estimates_diagnosed, targeted_duration,
+    CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
+    StepChoice, force_estimates_diagnosed, targeted_duration,
 };
 use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
 use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scene};
@@ -233,8 +233,21 @@ fn run_compression_scene(
     let mut estimates = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     let mut fig = force_strain_figure(scene, theory);
+    // Steps chosen by a step search, per run: the second run of the Δt-halving pair runs
+    // at half the first run's steps.
+    let mut chosen: Vec<Option<Vec<f64>>> = Vec::new();
     for (k, run) in runs.iter().enumerate() {
-        let (est, slope) = run_compression(scene, theory, k, run, opts, bar, &mut outputs)?;
+        let inherited = halved_steps(scene, runs, &chosen, k);
+        let halved;
+        let run = match inherited {
+            Some(dts) => {
+                halved = run.with_steps(&dts)?;
+                &halved
+            }
+            None => run,
+        };
+        let (est, slope, steps) = run_compression(scene, theory, k, run, opts, bar, &mut outputs)?;
+        chosen.push(steps);
         if let Some((s, x, i)) = slope
             && largest_slope.as_ref().is_none_or(|l| s > l.1.0)
         {
@@ -285,6 +298,23 @@ fn run_compression_scene(
     Ok(summary)
 }
 
+/// The steps of run `k` if it is the second run of the scene's Δt-halving pair and the
+/// first (an earlier run, validated) chose its steps by a step search: half of those.
+fn halved_steps(
+    scene: &Scene,
+    runs: &[CompressionRun],
+    chosen: &[Option<Vec<f64>>],
+    k: usize,
+) -> Option<Vec<f64>> {
+    let [a, b] = scene.compression.as_ref()?.halving.as_ref()?;
+    if &runs[k].spec.name != b {
+        return None;
+    }
+    let ia = runs.iter().position(|r| &r.spec.name == a)?;
+    let steps = chosen.get(ia)?.as_ref()?;
+    Some(steps.iter().map(|d| 0.5 * d).collect())
+}
+
 /// The largest RMS slope of a compression run: (slope in rad, x/L, strain index).
 type RmsSlope = (f64, f64, usize);
 
@@ -299,23 +329,28 @@ fn run_compression(
     opts: &VerifyOptions,
     bar: &ProgressBar,
     outputs: &mut SceneOutputs,
-) -> Result<(ForceEstimates, Option<RmsSlope>)> {
+) -> Result<(ForceEstimates, Option<RmsSlope>, Option<Vec<f64>>)> {
     let e = run.spec.ensemble(opts.budget);
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
-    let (records, plan) = match e.precision_target() {
+    let searched;
+    let (records, plan, run) = match e.precision_target() {
         None => {
-            let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+            let steps: Vec<u64> = (0..run.points())
+                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
+                .collect();
             let records = run
-                .simulate_ensemble(seed, e.trajectories, steps, || bar.inc(1))
+                .simulate_ensemble_per_point(seed, e.trajectories, &steps, || bar.inc(1))
                 .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-            (records, None)
+            (records, None, run)
         }
         Some(target) => {
-            let plan = targeted_plan(scene, k, run, &e, target, opts.budget, bar)?;
+            let (plan, adapted) = targeted_plan(scene, k, run, &e, target, opts.budget, bar)?;
+            searched = adapted;
+            let run = searched.as_ref().unwrap_or(run);
             let records = run
                 .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || bar.inc(1))
                 .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-            (records, Some(plan))
+            (records, Some(plan), run)
         }
     };
     let budget_key = match plan {
@@ -335,7 +370,10 @@ fn run_compression(
     if let Some(plan) = &plan {
         outputs.notes.push(targeted_note(run, &e, plan, &est));
     }
-    Ok((est, slope))
+    let steps = plan
+        .and_then(|p| p.search)
+        .map(|s| s.iter().map(|c| c.dt_tau1).collect());
+    Ok((est, slope, steps))
 }
 
 /// The pilot of a budget by target precision and the main-stage durations it chose.
@@ -350,6 +388,8 @@ struct TargetedPlan {
     main_tau1: Vec<f64>,
     /// Main-stage sampled steps per strain.
     main_steps: Vec<u64>,
+    /// The step search per strain, if the budget has one.
+    search: Option<Vec<StepChoice>>,
 }
 
 /// Runs the pilot of a budget by target precision at every strain — `trajectories` ×
@@ -365,40 +405,62 @@ fn targeted_plan(
     target: PrecisionTarget,
     budget: Budget,
     bar: &ProgressBar,
-) -> Result<TargetedPlan> {
+) -> Result<(TargetedPlan, Option<CompressionRun>)> {
     let tau1 = scene.filament.tau1();
-    let pilot_steps = run.sampled_steps(target.pilot_tau1 * tau1);
+    let name = &run.spec.name;
+    let (search, adapted) = match target.step_search {
+        None => (None, None),
+        Some(search) => {
+            let choices = crate::dynamics::par_indexed(run.points() as u64, |i| {
+                let i = i as usize;
+                let seed = |c: usize| derive_seed(scene.seed, &format!("{name}/probe/{i}/{c}"));
+                run.search_step(i, search, e.trajectories, seed)
+            })
+            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+            let dts: Vec<f64> = choices.iter().map(|c| c.dt_tau1).collect();
+            (Some(choices), Some(run.with_steps(&dts)?))
+        }
+    };
+    let run = adapted.as_ref().unwrap_or(run);
+    let pilot_steps: Vec<u64> = (0..run.points())
+        .map(|i| run.sampled_steps_at(i, target.pilot_tau1 * tau1))
+        .collect();
     let pilot = run
-        .simulate_ensemble(
-            |i| derive_seed(scene.seed, &format!("{}/pilot/{i}", run.spec.name)),
+        .simulate_ensemble_per_point(
+            |i| derive_seed(scene.seed, &format!("{name}/pilot/{i}")),
             e.trajectories,
-            pilot_steps,
+            &pilot_steps,
             || bar.inc(1),
         )
         .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
     let pilot_key = format!("{}.pilot_tau1", budget.name());
     let pilot_est = force_estimates_diagnosed(&pilot, &scene.filament)
         .map_err(|e| scene.run_error(k, &pilot_key, e))?;
-    let pilot_tau1 = pilot_steps as f64 * run.dt / tau1;
+    let pilot_tau1 = pilot_steps[0] as f64 * run.dt_at(0) / tau1;
     let pilot_std_error: Vec<f64> = pilot_est.force.iter().map(|f| f.1).collect();
     let main_steps: Vec<u64> = pilot_std_error
         .iter()
-        .map(|&se| {
-            let d = targeted_duration(se, pilot_tau1, target.std_error, target.max_duration_tau1);
-            run.sampled_steps(d * tau1)
+        .enumerate()
+        .map(|(i, &se)| {
+            let pilot_i = pilot_steps[i] as f64 * run.dt_at(i) / tau1;
+            let d = targeted_duration(se, pilot_i, target.std_error, target.max_duration_tau1);
+            run.sampled_steps_at(i, d * tau1)
         })
         .collect();
     let main_tau1 = main_steps
         .iter()
-        .map(|&n| n as f64 * run.dt / tau1)
+        .enumerate()
+        .map(|(i, &n)| n as f64 * run.dt_at(i) / tau1)
         .collect();
-    Ok(TargetedPlan {
+    let plan = TargetedPlan {
         target,
         pilot_tau1,
         pilot_std_error,
         main_tau1,
         main_steps,
-    })
+        search,
+    };
+    Ok((plan, adapted))
 }
 
 /// The note of a budget by target precision: pilot, chosen durations, the strains that
@@ -418,8 +480,25 @@ fn targeted_note(
     let se: Vec<f64> = est.force.iter().map(|f| f.1).collect();
     let missed = se.iter().filter(|&&s| s > plan.target.std_error).count();
     let largest = se.iter().copied().fold(0.0, f64::max);
+    let search = match (&plan.search, plan.target.step_search) {
+        (Some(choices), Some(s)) => format!(
+            "a step search first chose each strain's dt: the largest dt_tau1 x 2^k <= {} whose probe ({} trajectories x {PROBE_STEPS} steps after burn-in, streams of their own, discarded) accepted at least {} of its proposals (exact at any dt: the step changes the cost, not the law). Chosen dt per strain (tau1): {}; probe acceptance at the chosen dt: {}. Then ",
+            s.max_dt_tau1,
+            e.trajectories,
+            s.min_acceptance,
+            list(&choices.iter().map(|c| c.dt_tau1).collect::<Vec<_>>(), 2),
+            list(
+                &choices
+                    .iter()
+                    .map(|c| c.tried.last().map_or(f64::NAN, |t| t.1))
+                    .collect::<Vec<_>>(),
+                2
+            ),
+        ),
+        _ => String::new(),
+    };
     format!(
-        "run {}: budget by target precision (standard error {} F_c0 per strain): a pilot of {} trajectories x {:.1} tau1 per strain on streams of its own (pilot s.e. per strain: {}) chose each strain's main-stage duration (s.e. ~ T^-1/2, safety factor {DURATION_SAFETY} on the duration, at least the pilot's, at most {} tau1): {} tau1 per trajectory, {} fresh trajectories; reported: the main stage only, largest s.e. {:.4}, {} of {} strains above the target (reported as they are, not rerun). The main stage's duration depends on the pilot only and the pilot is independent of the main-stage samples, so given its duration each point is an ordinary fixed-budget estimate: its standard error and p-values are honest (no optional-stopping bias)",
+        "run {}: budget by target precision (standard error {} F_c0 per strain): {search}a pilot of {} trajectories x {:.1} tau1 per strain on streams of its own (pilot s.e. per strain: {}) chose each strain's main-stage duration (s.e. ~ T^-1/2, safety factor {DURATION_SAFETY} on the duration, at least the pilot's, at most {} tau1): {} tau1 per trajectory, {} fresh trajectories; reported: the main stage only, largest s.e. {:.4}, {} of {} strains above the target (reported as they are, not rerun). The main stage's duration depends on the pilot only and the pilot is independent of the main-stage samples, so given its duration each point is an ordinary fixed-budget estimate: its standard error and p-values are honest (no optional-stopping bias)",
         run.spec.name,
         plan.target.std_error,
         e.trajectories,
@@ -444,12 +523,19 @@ fn compression_run_note(
     est: &ForceEstimates,
     slope: Option<RmsSlope>,
 ) -> String {
+    let tau1 = scene.filament.tau1();
+    let dts: Vec<f64> = (0..run.points()).map(|i| run.dt_at(i) / tau1).collect();
+    let dt = if dts.iter().all(|&d| d == run.spec.dt_tau1) {
+        format!("{:.3e} tau1", run.spec.dt_tau1)
+    } else {
+        let list: Vec<String> = dts.iter().map(|d| format!("{d:.3e}")).collect();
+        format!("{} tau1 per strain", list.join(", "))
+    };
     format!(
-        "run {}: {} with {} noise, dt = {:.3e} tau1, {} trajectories x {} per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
+        "run {}: {} with {} noise, dt = {dt}, {} trajectories x {} per strain after {} tau1 burn-in; acceptance {:.4}; largest integrated autocorrelation time of F {:.1} samples{}",
         run.spec.name,
         run.spec.integrator,
         run.spec.noise.name(),
-        run.spec.dt_tau1,
         e.trajectories,
         if e.precision_target().is_some() {
             "a duration chosen per strain (budget by target precision)".to_string()
