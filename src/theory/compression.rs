@@ -217,6 +217,8 @@ const SERIES_RADIUS: f64 = 0.25;
 const CDF_TOLERANCE: f64 = 1e-14;
 /// Cap on the number of Fourier terms of a [`ForceDistribution`].
 const MAX_FOURIER_TERMS: usize = 200_000;
+/// Nodes per exponential in the Gaussian-kernel sums of a [`ForceDistribution`].
+const KERNEL_ANCHOR: i64 = 8;
 /// Extra exponent for the Gaussian range of the quadrature.
 const RANGE_MARGIN: f64 = 10.0;
 
@@ -1009,9 +1011,19 @@ struct Contour {
 
 impl Contour {
     /// `ln φ_η(τ)`.
+    /// The explicit modes in pairs: `ln((1 − ix)(1 − iy)) = ½ln(1 + x² + y² + x²y²)
+    /// − i·atan2(x + y, 1 − xy)`, exact because x, y have the same sign (the two arguments
+    /// add to less than π); half the logarithms and arctangents of one mode at a time.
     fn log_phi(&self, tau: f64) -> Complex<f64> {
         let (mut re, mut im) = (0.0, 0.0);
-        for &b in &self.explicit {
+        let mut pairs = self.explicit.chunks_exact(2);
+        for pair in &mut pairs {
+            let (x, y) = (pair[0] * tau, pair[1] * tau);
+            let (x2, y2) = (x * x, y * y);
+            re -= 0.5 * self.half_d * (x2 + y2 + x2 * y2).ln_1p();
+            im += self.half_d * (x + y).atan2(1.0 - x * y);
+        }
+        for &b in pairs.remainder() {
             let x = b * tau;
             re -= 0.5 * self.half_d * (x * x).ln_1p();
             im += self.half_d * x.atan();
@@ -1598,15 +1610,33 @@ impl KernelSums {
             let tau = self.vals.len() as f64 * self.h;
             self.vals.push(self.contour.shifted(tau));
         }
-        let mut acc = Complex::new(0.0, 0.0);
-        for j in jlo..=jhi {
-            let v = if j >= 0 {
+        let val = |j: i64| {
+            if j >= 0 {
                 self.vals[j as usize]
             } else {
                 self.vals[(-j) as usize].conj()
-            };
-            let d = j as f64 * self.h - u;
-            acc += v * (-d * d * self.inv4a).exp();
+            }
+        };
+        // The kernel w_j = e^{−d_j²/(4A)}, d_j = jh − u, by its exact recurrence
+        // w_{j+1} = w_j g_j, g_{j+1} = g_j e^{−2h²/(4A)}, g_j = e^{−(2d_j h + h²)/(4A)}, restarted
+        // from exponentials every KERNEL_ANCHOR nodes (rounding ≤ ≈ KERNEL_ANCHOR²ε/2
+        // relative; two products per node instead of an exponential).
+        let (h, c) = (self.h, self.inv4a);
+        let q = (-2.0 * h * h * c).exp();
+        let mut acc = Complex::new(0.0, 0.0);
+        let mut j = jlo;
+        while j <= jhi {
+            let d = j as f64 * h - u;
+            let mut w = (-d * d * c).exp();
+            let mut g = (-(2.0 * d * h + h * h) * c).exp();
+            let end = (j + KERNEL_ANCHOR - 1).min(jhi);
+            acc += val(j) * w;
+            for jj in j + 1..=end {
+                w *= g;
+                g *= q;
+                acc += val(jj) * w;
+            }
+            j = end + 1;
         }
         acc
     }
