@@ -124,9 +124,11 @@
 //! halving the step changes ⟨F⟩ by less than 10⁻¹⁰ relative.
 //!
 //! **Evaluation of φ_η.** `φ_η(τ) = Π (1 − i b_i τ)^{−d/2}` with
-//! `b_i = 2c_i/(1 − 2c_iη̂)` (times `e^{iτ(m_T + η̂v_T) − τ²v_T/2}` for a Gaussian tail), evaluated as a sum of logarithms
-//! (`−¼ d ln(1 + b²τ²) + ½ d i·atan(bτ)` per mode). Modes with `b_i τ_max ≤ ¼` are
-//! summed through the power series `−ln(1 − z) = Σ z^k/k` with the power sums
+//! `b_i = 2c_i/(1 − 2c_iη̂)` (times `e^{iτ(m_T + η̂v_T) − τ²v_T/2}` for a Gaussian tail),
+//! evaluated as a sum of logarithms (`−¼ d ln(1 + b²τ²) + ½ d i·atan(bτ)` per mode, taken
+//! two modes at a time: `ln((1 − ix)(1 − iy)) = ½ln(1 + x² + y² + x²y²) −
+//! i·atan2(x + y, 1 − xy)`, exact as x, y have the same sign). Modes with `b_i τ_max ≤ ¼`
+//! are summed through the power series `−ln(1 − z) = Σ z^k/k` with the power sums
 //! `Σ b_i^k`, 30 terms (remainder below `4^{−29}/31` of the first-order term), so the cost
 //! per node is independent of the number of small modes.
 //!
