@@ -33,8 +33,8 @@
 //! the eigenvalues of `L⁻¹GL⁻ᵀ`, i.e. of `K⁻¹G` (the generalized eigenvalues of
 //! `(G, K)`; `1/μ_i` are the buckling loads of the discretized filament). In the
 //! continuum `μ_n = 1/(EI(nπ/L)²)`, `c_n = kT L/(2EI n²π²)`. [`StoredLengthLaw`] holds
-//! the weights and, for the continuum, the first two cumulants of the omitted modes
-//! `n > M`, which are represented by a Gaussian (see *Truncation* below).
+//! the weights and, for the continuum, the omitted modes `n > M`, which it sums exactly
+//! (see *The continuum* below).
 //!
 //! For the uniform hinged mesh the pencil `(K, G)` block-diagonalizes exactly in
 //! sine/cosine modes (a hinge is a mirror), which gives all `2N` buckling loads in closed
@@ -50,9 +50,12 @@
 //! Its characteristic function and cumulant generating function are
 //!
 //! ```text
-//! φ(t) = E e^{its} = Π_i (1 − 2i c_i t)^{−d/2} · e^{i t m_T − t² v_T/2},
-//! ψ(η) = ln E e^{ηs} = −(d/2) Σ_i ln(1 − 2c_i η) + η m_T + η² v_T/2,   η < 1/(2 c_max).
+//! φ(t) = E e^{its} = Π_i (1 − 2i c_i t)^{−d/2},
+//! ψ(η) = ln E e^{ηs} = −(d/2) Σ_i ln(1 − 2c_i η),   η < 1/(2 c_max),
 //! ```
+//!
+//! the products and sums running over all modes (for the Gaussian-tail reference of the
+//! continuum, the omitted modes contribute `e^{i t m_T − t² v_T/2}` and `η m_T + η² v_T/2`).
 //!
 //! # The exact average at imposed strain
 //!
@@ -120,10 +123,12 @@
 //! running sum. [`QuadratureOptions`] scales the step and the level; the tests check that
 //! halving the step changes ⟨F⟩ by less than 10⁻¹⁰ relative.
 //!
-//! **Evaluation of φ_η.** `φ_η(τ) = Π (1 − i b_i τ)^{−d/2} e^{iτ(m_T + η̂v_T) − τ²v_T/2}`
-//! with `b_i = 2c_i/(1 − 2c_iη̂)`, evaluated as a sum of logarithms
-//! (`−¼ d ln(1 + b²τ²) + ½ d i·atan(bτ)` per mode). Modes with `b_i τ_max ≤ ¼` are
-//! summed through the power series `−ln(1 − z) = Σ z^k/k` with the power sums
+//! **Evaluation of φ_η.** `φ_η(τ) = Π (1 − i b_i τ)^{−d/2}` with
+//! `b_i = 2c_i/(1 − 2c_iη̂)` (times `e^{iτ(m_T + η̂v_T) − τ²v_T/2}` for a Gaussian tail),
+//! evaluated as a sum of logarithms (`−¼ d ln(1 + b²τ²) + ½ d i·atan(bτ)` per mode, taken
+//! two modes at a time: `ln((1 − ix)(1 − iy)) = ½ln(1 + x² + y² + x²y²) −
+//! i·atan2(x + y, 1 − xy)`, exact as x, y have the same sign). Modes with `b_i τ_max ≤ ¼`
+//! are summed through the power series `−ln(1 − z) = Σ z^k/k` with the power sums
 //! `Σ b_i^k`, 30 terms (remainder below `4^{−29}/31` of the first-order term), so the cost
 //! per node is independent of the number of small modes.
 //!
@@ -152,17 +157,44 @@
 //! needed. A density with a jump (a single element in 2D) gives `|χ| ∝ 1/u`; the series
 //! is then capped at 2·10⁵ terms. The CDF of `F = EA(ε − s)` is `1 − P(X ≤ (F_mf − F)/EA)`, `F_mf = (kT/L)η̂`.
 //!
-//! # Truncation of the continuum
+//! # The continuum
 //!
-//! [`StoredLengthLaw::continuum`] keeps M modes explicitly and replaces the rest by a
-//! Gaussian with their exact mean `m_T = d c₁ Σ_{n>M} n⁻²` and variance
-//! `v_T = 2d c₁² Σ_{n>M} n⁻⁴` (tail sums by Euler–Maclaurin). The omitted part of
-//! `ln φ(t)` is then `(d/2) Σ_{k≥3} (2it)^k p_k/k`, `p_k = Σ_{n>M} c_n^k`, bounded by
+//! [`StoredLengthLaw::continuum`] keeps M modes explicitly ([`DEFAULT_CONTINUUM_MODES`]
+//! = 64) and sums all the others, `c_n = c₁/n²` for `n ≥ N = M + 1`
+//! ([`Tail::InverseSquare`]), exactly to rounding. Every quantity the method needs is a
+//! sum over the tail of a function of `z/n²`, where `z` is `x = 2c₁η` (real: ψ, ψ′, ψ″ at
+//! the saddle and in the Chernoff bounds), `x + 2ic₁τ` (φ_η) or `2ic₁t` (φ). Expanding in
+//! powers of `r = z/N²` and exchanging the sums gives series in the scaled Hurwitz zeta
+//! values `ζ̃_{2j}(N) = N^{2j} ζ(2j, N) = Σ_{n≥N} (N/n)^{2j}` (all in `[1, N/(2j−1) + 1]`):
+//!
+//! ```text
+//! L(z)            = −Σ_{n≥N} ln(1 − z/n²)  = Σ_{j≥1} r^j ζ̃_{2j}(N)/j,
+//! Σ_{n≥N} b_n^k   = (2c₁/N²)^k Σ_{j≥0} C(k+j−1, j) r^j ζ̃_{2(k+j)}(N),   b_n = 2c₁/(n² − x),
+//! ```
+//!
+//! so the tail's part of ψ is `(d/2)L(x)`, of ψ′ and ψ″ `(d/2)Σb_n` and `(d/2)Σb_n²`, of
+//! `ln φ_η(τ)` `(d/2)[L(x + 2ic₁τ) − L(x)]`, which enters the contour through the power
+//! sums `Σ b_n^k`, k ≤ 30, of *Evaluation of φ_η* above. The series are used for
+//! `|r| ≤ 1/16`; a larger `|z|` (far out on the left Chernoff ladder, or a wide
+//! [`ForceDistribution`] range) moves the base to `N′ = ⌈4√|z|⌉` and sums the modes
+//! `N ≤ n < N′` one by one; the modes with `b_n τ_max > ¼` are always explicit. The terms
+//! fall by `|r| ≤ 1/16` (after the binomial's rise for large k) and are summed until below
+//! 10⁻¹⁸ of the sum. `ζ̃_{2j}(N)` is computed once per theory: Euler–Maclaurin at
+//! `K_j = max(N, 3(j + 8))` with the Bernoulli terms up to `B₁₆`, whose first omitted term
+//! bounds the error by `2((2j + 16)/(2πK_j))^{18} < 10⁻¹⁷` relative, plus the terms
+//! `N ≤ n < K_j`. The cost per evaluation is O(M + 30) instead of O(number of modes).
+//!
+//! **Reference.** [`StoredLengthLaw::continuum_gaussian_tail`] keeps M modes explicitly
+//! and replaces the rest by a Gaussian with their exact mean `m_T = d c₁ Σ_{n>M} n⁻²` and
+//! variance `v_T = 2d c₁² Σ_{n>M} n⁻⁴` (tail sums by Euler–Maclaurin). The omitted part
+//! of `ln φ(t)` is then `(d/2) Σ_{k≥3} (2it)^k p_k/k`, `p_k = Σ_{n>M} c_n^k`, bounded by
 //! [`continuum_tail_log_char_bound`]:
 //! `(d/2)(2|t|)³ p₃ / (3(1 − 2c_{M+1}|t|))`, `p₃ ≤ c₁³/(5(M+½)⁵)`. For P = EI/(kT·L) = 100,
 //! EA·L/kT = 10⁶ and M = 10⁴ the contour reaches `|t| ≲ 2·10⁴` and the bound is below
-//! 10⁻¹⁷ (relative error of φ, hence of ⟨F⟩ − F_mf); the tests confirm that M = 10³ and
-//! M = 2·10⁴ agree to better than 10⁻¹².
+//! 10⁻¹⁷ (relative error of φ, hence of ⟨F⟩ − F_mf). This brute-force route (O(M) per
+//! evaluation) checks the exact tail in `tests/compression_theory.rs`: ⟨F⟩/F_c0 agree to
+//! ≤ 10⁻¹⁴ over ε/ε_c0 ∈ [0, 10] for EI/(kT·L) ∈ {10, 100, 1000} and
+//! EA·L/kT ∈ {10⁴, 10⁶, 10⁸}.
 
 use crate::error::{Error, Result};
 use crate::fem::{BeamModel, Mesh};
@@ -170,8 +202,10 @@ use crate::params::FilamentParams;
 use nalgebra::{Complex, DMatrix};
 use std::f64::consts::PI;
 
-/// Number of explicit continuum modes used by default (e.g. by the CLI).
-pub const DEFAULT_CONTINUUM_MODES: usize = 10_000;
+/// Number of explicit continuum modes used by default (e.g. by the CLI); the others are
+/// summed exactly ([`Tail::InverseSquare`]), so this only splits the work: 64 keeps the
+/// Hurwitz series at `|r| ≤ 1/16` for saddle points `|2c₁η̂| ≤ 264` without moving the base.
+pub const DEFAULT_CONTINUUM_MODES: usize = 64;
 
 /// Largest mesh accepted by [`StoredLengthLaw::discrete`] and
 /// [`buckling_load_discrete`] (the generalized eigenproblem is solved densely, `O(N³)`).
@@ -185,6 +219,8 @@ const SERIES_RADIUS: f64 = 0.25;
 const CDF_TOLERANCE: f64 = 1e-14;
 /// Cap on the number of Fourier terms of a [`ForceDistribution`].
 const MAX_FOURIER_TERMS: usize = 200_000;
+/// Nodes per exponential in the Gaussian-kernel sums of a [`ForceDistribution`].
+const KERNEL_ANCHOR: i64 = 8;
 /// Extra exponent for the Gaussian range of the quadrature.
 const RANGE_MARGIN: f64 = 10.0;
 
@@ -258,24 +294,260 @@ fn inverse_power_tail(p: u32, m: usize) -> f64 {
         .fold(em, |acc, n| acc + (n as f64).powi(-(p as i32)))
 }
 
+/// `B_{2i}/(2i)!`, i = 1..=8: the Euler–Maclaurin coefficients.
+const BERNOULLI_OVER_FACTORIAL: [f64; 8] = [
+    1.0 / 12.0,
+    -1.0 / 720.0,
+    1.0 / 30_240.0,
+    -1.0 / 1_209_600.0,
+    1.0 / 47_900_160.0,
+    -691.0 / 1_307_674_368_000.0,
+    1.0 / 74_724_249_600.0,
+    -3617.0 / 10_670_622_842_880_000.0,
+];
+
+/// Terms of the scaled-zeta table of an [`InverseSquareTail`] used by the contour (power
+/// sums up to [`SERIES_TERMS`] need `k + j ≤ 64`, see [`ZetaSeries::power_sum`]).
+const CONTOUR_ZETA_TERMS: usize = 64;
+/// Terms of the scaled-zeta table for `L`, `Σ(n² − x)⁻¹` and `Σ(n² − x)⁻²` alone
+/// (`|r| ≤ 1/16`: 16⁻¹⁸ < 10⁻²¹).
+const LOG_SUM_TERMS: usize = 20;
+/// The series in `r = z/N²` are used for `|z| ≤ N²/16`, i.e. base `N ≥ 4√|z|`.
+const TAIL_BASE_FACTOR: f64 = 4.0;
+/// Relative size of the last term kept in the tail series.
+const TAIL_SERIES_TOLERANCE: f64 = 1e-18;
+
+/// The scaled Hurwitz zeta values `ζ̃_{2j}(N) = N^{2j} ζ(2j, N) = Σ_{n≥N} (N/n)^{2j}`,
+/// `j = 1..=count`: Euler–Maclaurin at `K_j = max(N, 3(j + 8))` with 8 Bernoulli terms
+/// (the first omitted term bounds the error, `≤ 2((2j+16)/(2πK_j))^{18} ≤ 2·0.107^{18}
+/// ≈ 7·10⁻¹⁸` relative), plus the explicit terms `N ≤ n < K_j`, smallest first.
+fn scaled_even_zeta(base: usize, count: usize) -> Vec<f64> {
+    let nb = base as f64;
+    let start = |j: usize| base.max(3 * (j + 8));
+    let mut z: Vec<f64> = (1..=count)
+        .map(|j| {
+            let s = 2.0 * j as f64;
+            let k = start(j) as f64;
+            let mut em = k / (s - 1.0) + 0.5;
+            let mut rising = s;
+            let mut k_pow = 1.0 / k;
+            for (i, b) in BERNOULLI_OVER_FACTORIAL.iter().enumerate() {
+                em += b * rising * k_pow;
+                let i2 = 2.0 * i as f64;
+                rising *= (s + i2 + 1.0) * (s + i2 + 2.0);
+                k_pow /= k * k;
+            }
+            (nb / k).powi(2 * j as i32) * em
+        })
+        .collect();
+    for n in (base..start(count)).rev() {
+        let q = (nb / n as f64).powi(2);
+        let mut p = q;
+        for (j, zj) in z.iter_mut().enumerate() {
+            if n < start(j + 1) {
+                *zj += p;
+            }
+            p *= q;
+        }
+    }
+    z
+}
+
+/// The series in `r = z/N²` of sums over `n ≥ N` (module docs, *The continuum*), from a
+/// table of [`scaled_even_zeta`]; valid for `|r| ≤ 1/16`.
+#[derive(Debug, Clone)]
+struct ZetaSeries {
+    base: usize,
+    zeta: Vec<f64>,
+}
+
+impl ZetaSeries {
+    fn new(base: usize, count: usize) -> Self {
+        ZetaSeries {
+            base,
+            zeta: scaled_even_zeta(base, count),
+        }
+    }
+
+    fn base_sq(&self) -> f64 {
+        (self.base as f64).powi(2)
+    }
+
+    /// `L_N(z) = −Σ_{n≥N} ln(1 − z/n²) = Σ_{j≥1} r^j ζ̃_{2j}/j`.
+    fn log_sum(&self, z: Complex<f64>) -> Complex<f64> {
+        let r = z / self.base_sq();
+        let mut acc = Complex::new(0.0, 0.0);
+        let mut p = r;
+        for (j, zj) in self.zeta.iter().enumerate() {
+            let term = p * (zj / (j + 1) as f64);
+            acc += term;
+            if term.norm() <= TAIL_SERIES_TOLERANCE * acc.norm() {
+                break;
+            }
+            p *= r;
+        }
+        acc
+    }
+
+    /// `L_N(x)` for real x.
+    fn log_sum_real(&self, x: f64) -> f64 {
+        let r = x / self.base_sq();
+        let mut acc = 0.0;
+        let mut p = r;
+        for (j, zj) in self.zeta.iter().enumerate() {
+            let term = p * zj / (j + 1) as f64;
+            acc += term;
+            if term.abs() <= TAIL_SERIES_TOLERANCE * acc.abs() {
+                break;
+            }
+            p *= r;
+        }
+        acc
+    }
+
+    /// `Σ_{n≥N} (a/(n² − x))^k = (a/N²)^k Σ_{j≥0} C(k+j−1, j) r^j ζ̃_{2(k+j)}`, k ≥ 1.
+    /// The terms first grow by the binomial, then fall by `≈ |r|`; for `k ≤ 30`,
+    /// `|r| ≤ 1/16` the term `k + j = 64` is below 10⁻²³ of the sum.
+    fn power_sum(&self, k: usize, a: f64, x: f64) -> f64 {
+        let nn = self.base_sq();
+        let r = x / nn;
+        let mut acc = 0.0;
+        let mut coef = 1.0;
+        for j in 0..self.zeta.len().saturating_sub(k - 1) {
+            let term = coef * self.zeta[k + j - 1];
+            acc += term;
+            if term.abs() <= TAIL_SERIES_TOLERANCE * acc.abs() {
+                break;
+            }
+            coef *= r * (k + j) as f64 / (j + 1) as f64;
+        }
+        (a / nn).powi(k as i32) * acc
+    }
+}
+
+/// The omitted modes `c_n = c₁/n²`, `n ≥ first` of [`Tail::InverseSquare`] with their
+/// scaled-zeta table at `N = first`. Arguments `|z| > N²/16` move the series to the base
+/// `⌈4√|z|⌉` (new table) and sum the modes in between explicitly.
+#[derive(Debug, Clone)]
+struct InverseSquareTail {
+    c1: f64,
+    series: ZetaSeries,
+}
+
+impl InverseSquareTail {
+    fn new(c1: f64, first: usize, count: usize) -> Self {
+        InverseSquareTail {
+            c1,
+            series: ZetaSeries::new(first, count),
+        }
+    }
+
+    fn first(&self) -> usize {
+        self.series.base
+    }
+
+    /// The base needed for `|z|` (at least `first`).
+    fn base_for(&self, z_abs: f64) -> usize {
+        let need = (TAIL_BASE_FACTOR * z_abs.sqrt()).ceil();
+        if need <= self.first() as f64 {
+            self.first()
+        } else {
+            need as usize
+        }
+    }
+
+    /// The series at `base` (this table, or a new one of `count` terms).
+    fn series_at(&self, base: usize, count: usize) -> std::borrow::Cow<'_, ZetaSeries> {
+        if base == self.first() && count <= self.series.zeta.len() {
+            std::borrow::Cow::Borrowed(&self.series)
+        } else {
+            std::borrow::Cow::Owned(ZetaSeries::new(base, count))
+        }
+    }
+
+    /// `L(z) = −Σ_{n≥first} ln(1 − z/n²)` for complex z.
+    fn log_sum(&self, z: Complex<f64>) -> Complex<f64> {
+        let base = self.base_for(z.norm());
+        let mut acc = self.series_at(base, LOG_SUM_TERMS).log_sum(z);
+        for n in (self.first()..base).rev() {
+            acc -= (1.0 - z / (n as f64).powi(2)).ln();
+        }
+        acc
+    }
+
+    /// `L(2c₁η)` for real η: the tail's `ψ/(d/2)`; `+∞` at or past the singularity of the
+    /// first omitted mode.
+    fn log_sum_real(&self, eta: f64) -> f64 {
+        let x = 2.0 * self.c1 * eta;
+        if x >= (self.first() as f64).powi(2) {
+            return f64::INFINITY;
+        }
+        let base = self.base_for(x.abs());
+        let mut acc = self.series_at(base, LOG_SUM_TERMS).log_sum_real(x);
+        for n in (self.first()..base).rev() {
+            acc -= (-x / (n as f64).powi(2)).ln_1p();
+        }
+        acc
+    }
+
+    /// `Σ_{n≥first} (2c₁/(n² − 2c₁η))^k = Σ b_n^k` (the tilted weights' power sums; k = 1, 2
+    /// give the tail's ψ′ and ψ″ up to the factors d/2 and d).
+    fn tilted_power_sum(&self, k: usize, eta: f64) -> f64 {
+        let a = 2.0 * self.c1;
+        let x = a * eta;
+        let base = self.base_for(x.abs());
+        let mut acc = self.series_at(base, LOG_SUM_TERMS + k).power_sum(k, a, x);
+        for n in (self.first()..base).rev() {
+            acc += (a / ((n as f64).powi(2) - x)).powi(k as i32);
+        }
+        acc
+    }
+}
+
+/// How the modes that are not in [`StoredLengthLaw::weights`] enter the law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tail {
+    /// No omitted modes (a discrete filament).
+    None,
+    /// The omitted modes replaced by a Gaussian `N(mean, variance)` with their exact mean
+    /// `d Σ c_n` and variance `2d Σ c_n²` ([`StoredLengthLaw::continuum_gaussian_tail`]):
+    /// an approximation, bounded by [`continuum_tail_log_char_bound`].
+    Gaussian {
+        /// Mean of the omitted modes.
+        mean: f64,
+        /// Variance of the omitted modes.
+        variance: f64,
+    },
+    /// The omitted modes exactly: a χ²_d of weight `c_n = first_weight/n²` for every
+    /// `n ≥ first_mode` (the continuum's modes beyond the explicit ones,
+    /// [`StoredLengthLaw::continuum`]), summed by Hurwitz-zeta series (module docs,
+    /// *The continuum*).
+    InverseSquare {
+        /// `c₁`: the weight the sequence `c₁/n²` would have at `n = 1`.
+        first_weight: f64,
+        /// The first omitted mode.
+        first_mode: usize,
+    },
+}
+
 /// The law of the stored length `s = (1/2L)∫|w'|² dx` under the bending-only Gaussian
-/// ensemble: `s = Σ_i c_i χ²_{d,i} + S_T`, with `S_T ~ N(tail_mean, tail_variance)`
-/// standing for omitted modes (zero for a discrete filament).
+/// ensemble: `s = Σ_i c_i χ²_{d,i} + S_T`, with `S_T` the omitted modes ([`Tail`]: none for
+/// a discrete filament, exact for the continuum).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StoredLengthLaw {
-    /// Mode weights `c_i = kT μ_i/(2L)`, descending.
+    /// Explicit mode weights `c_i = kT μ_i/(2L)`, descending.
     pub weights: Vec<f64>,
     /// Degrees of freedom `d` of each mode's χ² (1 in 2D, 2 in 3D).
     pub copies: usize,
-    /// Mean of the omitted modes, `d Σ_{omitted} c_n`.
-    pub tail_mean: f64,
-    /// Variance of the omitted modes, `2d Σ_{omitted} c_n²`.
-    pub tail_variance: f64,
+    /// The omitted modes.
+    pub tail: Tail,
 }
 
 impl StoredLengthLaw {
-    /// The continuum filament: `c_n = kT L/(2 EI n²π²)` for `n = 1..=n_modes`, and the
-    /// exact mean and variance of the modes `n > n_modes` as a Gaussian tail.
+    /// The continuum filament, exactly: `c_n = kT L/(2 EI n²π²)` for `n = 1..=n_modes`
+    /// explicitly, and every mode `n > n_modes` through the Hurwitz-zeta series of
+    /// [`Tail::InverseSquare`]. The law does not depend on `n_modes` beyond rounding; it only
+    /// splits the work ([`DEFAULT_CONTINUUM_MODES`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for invalid parameters or `n_modes = 0`.
@@ -285,14 +557,37 @@ impl StoredLengthLaw {
             return Err(Error::invalid("n_modes", n_modes, ">= 1"));
         }
         let c1 = continuum_first_weight(params);
-        let d = dims.copies() as f64;
-        let weights = (1..=n_modes).map(|n| c1 / (n as f64 * n as f64)).collect();
         Ok(StoredLengthLaw {
-            weights,
+            weights: (1..=n_modes).map(|n| c1 / (n as f64 * n as f64)).collect(),
             copies: dims.copies(),
-            tail_mean: d * c1 * inverse_power_tail(2, n_modes),
-            tail_variance: 2.0 * d * c1 * c1 * inverse_power_tail(4, n_modes),
+            tail: Tail::InverseSquare {
+                first_weight: c1,
+                first_mode: n_modes + 1,
+            },
         })
+    }
+
+    /// The continuum truncated to `n_modes` explicit modes, with the modes `n > n_modes`
+    /// replaced by a Gaussian of their exact mean and variance ([`Tail::Gaussian`]). The
+    /// brute-force reference for [`Self::continuum`] (cost `O(n_modes)` per evaluation; the
+    /// error in `ln φ` is bounded by [`continuum_tail_log_char_bound`], below 10⁻¹⁶ for
+    /// 10⁴ modes at the paper's parameters).
+    ///
+    /// # Errors
+    /// As [`Self::continuum`].
+    pub fn continuum_gaussian_tail(
+        params: &FilamentParams,
+        dims: Dims,
+        n_modes: usize,
+    ) -> Result<Self> {
+        let mut law = Self::continuum(params, dims, n_modes)?;
+        let c1 = continuum_first_weight(params);
+        let d = dims.copies() as f64;
+        law.tail = Tail::Gaussian {
+            mean: d * c1 * inverse_power_tail(2, n_modes),
+            variance: 2.0 * d * c1 * c1 * inverse_power_tail(4, n_modes),
+        };
+        Ok(law)
     }
 
     /// The filament discretized by `n_elements` uniform Hermite-cubic elements:
@@ -313,8 +608,7 @@ impl StoredLengthLaw {
         Ok(StoredLengthLaw {
             weights: loads.iter().map(|l| f / l).collect(),
             copies: dims.copies(),
-            tail_mean: 0.0,
-            tail_variance: 0.0,
+            tail: Tail::None,
         })
     }
 
@@ -332,13 +626,13 @@ impl StoredLengthLaw {
         Ok(StoredLengthLaw {
             weights: mu.iter().map(|m| f * m).collect(),
             copies: dims.copies(),
-            tail_mean: 0.0,
-            tail_variance: 0.0,
+            tail: Tail::None,
         })
     }
 
-    /// Checks the law is well formed: `copies ≥ 1`, weights finite and `≥ 0`, tail
-    /// cumulants finite and `≥ 0`.
+    /// Checks the law is well formed: `copies ≥ 1`, weights finite and `≥ 0`, Gaussian tail
+    /// cumulants finite and `≥ 0`, an inverse-square tail with a finite positive weight and
+    /// `first_mode ≥ 1`.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the offending field.
@@ -349,42 +643,90 @@ impl StoredLengthLaw {
         if let Some(c) = self.weights.iter().find(|c| !(c.is_finite() && **c >= 0.0)) {
             return Err(Error::invalid("weights", c, "finite and >= 0"));
         }
-        if !(self.tail_mean.is_finite() && self.tail_mean >= 0.0) {
-            return Err(Error::invalid(
-                "tail_mean",
-                self.tail_mean,
-                "finite and >= 0",
-            ));
-        }
-        if !(self.tail_variance.is_finite() && self.tail_variance >= 0.0) {
-            return Err(Error::invalid(
-                "tail_variance",
-                self.tail_variance,
-                "finite and >= 0",
-            ));
+        match self.tail {
+            Tail::None => {}
+            Tail::Gaussian { mean, variance } => {
+                if !(mean.is_finite() && mean >= 0.0) {
+                    return Err(Error::invalid("tail mean", mean, "finite and >= 0"));
+                }
+                if !(variance.is_finite() && variance >= 0.0) {
+                    return Err(Error::invalid("tail variance", variance, "finite and >= 0"));
+                }
+            }
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => {
+                if !(first_weight.is_finite() && first_weight > 0.0) {
+                    return Err(Error::invalid(
+                        "tail first_weight",
+                        first_weight,
+                        "finite and > 0",
+                    ));
+                }
+                if first_mode == 0 {
+                    return Err(Error::invalid("tail first_mode", first_mode, ">= 1"));
+                }
+            }
         }
         Ok(())
     }
 
-    /// `E s = d Σ c_i + tail_mean` (the stored length of the free filament, ⟨s⟩₀).
+    /// Mean of the omitted modes: 0, the Gaussian's mean, or `d c₁ Σ_{n≥first} n⁻²`.
+    pub fn tail_mean(&self) -> f64 {
+        match self.tail {
+            Tail::None => 0.0,
+            Tail::Gaussian { mean, .. } => mean,
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => self.copies as f64 * first_weight * inverse_power_tail(2, first_mode - 1),
+        }
+    }
+
+    /// Variance of the omitted modes: 0, the Gaussian's variance, or
+    /// `2d c₁² Σ_{n≥first} n⁻⁴`.
+    pub fn tail_variance(&self) -> f64 {
+        match self.tail {
+            Tail::None => 0.0,
+            Tail::Gaussian { variance, .. } => variance,
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => {
+                let d = self.copies as f64;
+                2.0 * d * first_weight * first_weight * inverse_power_tail(4, first_mode - 1)
+            }
+        }
+    }
+
+    /// `E s = d Σ c_i + tail mean` (the stored length of the free filament, ⟨s⟩₀).
     pub fn mean(&self) -> f64 {
         let d = self.copies as f64;
-        d * self.weights.iter().rev().sum::<f64>() + self.tail_mean
+        d * self.weights.iter().rev().sum::<f64>() + self.tail_mean()
     }
 
-    /// `Var s = 2d Σ c_i² + tail_variance`.
+    /// `Var s = 2d Σ c_i² + tail variance`.
     pub fn variance(&self) -> f64 {
         let d = self.copies as f64;
-        2.0 * d * self.weights.iter().rev().map(|c| c * c).sum::<f64>() + self.tail_variance
+        2.0 * d * self.weights.iter().rev().map(|c| c * c).sum::<f64>() + self.tail_variance()
     }
 
-    /// The largest weight (0 for an empty list).
+    /// The largest weight, omitted modes included (0 without modes).
     pub fn max_weight(&self) -> f64 {
-        self.weights.iter().fold(0.0_f64, |a, &c| a.max(c))
+        let explicit = self.weights.iter().fold(0.0_f64, |a, &c| a.max(c));
+        match self.tail {
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => explicit.max(first_weight / (first_mode as f64).powi(2)),
+            _ => explicit,
+        }
     }
 
-    /// The characteristic function `φ(t) = E e^{its} = Π(1 − 2ic_it)^{−d/2} ·
-    /// e^{it·tail_mean − t²·tail_variance/2}`, evaluated as a sum of logarithms.
+    /// The characteristic function `φ(t) = E e^{its} = Π(1 − 2ic_it)^{−d/2} · φ_T(t)`,
+    /// evaluated as a sum of logarithms; `φ_T` is 1, `e^{it m_T − t² v_T/2}` (Gaussian tail)
+    /// or `e^{(d/2) L(2ic₁t)}` (inverse-square tail, module docs).
     pub fn char_fn(&self, t: f64) -> Complex<f64> {
         let half_d = 0.5 * self.copies as f64;
         let (mut re, mut im) = (0.0, 0.0);
@@ -393,24 +735,65 @@ impl StoredLengthLaw {
             re -= 0.5 * half_d * (x * x).ln_1p();
             im += half_d * x.atan();
         }
-        re -= 0.5 * self.tail_variance * t * t;
-        im += t * self.tail_mean;
+        match self.tail {
+            Tail::None => {}
+            Tail::Gaussian { mean, variance } => {
+                re -= 0.5 * variance * t * t;
+                im += t * mean;
+            }
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => {
+                let l = InverseSquareTail::new(first_weight, first_mode, LOG_SUM_TERMS)
+                    .log_sum(Complex::new(0.0, 2.0 * first_weight * t));
+                re += half_d * l.re;
+                im += half_d * l.im;
+            }
+        }
         Complex::from_polar(re.exp(), im)
     }
 
     /// The cumulant generating function `ψ(η) = ln E e^{ηs}`, finite for
     /// `η < 1/(2 max c_i)`; `+∞` beyond.
     pub fn cumulant_generating_fn(&self, eta: f64) -> f64 {
-        let half_d = 0.5 * self.copies as f64;
-        let mut acc = 0.0;
-        for &c in self.weights.iter().rev() {
-            let a = -2.0 * c * eta;
-            if a <= -1.0 {
-                return f64::INFINITY;
-            }
-            acc -= half_d * a.ln_1p();
+        let tail = match self.tail {
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => Some(InverseSquareTail::new(
+                first_weight,
+                first_mode,
+                LOG_SUM_TERMS,
+            )),
+            _ => None,
+        };
+        cgf(&self.weights, self.copies, &self.tail, tail.as_ref(), eta)
+    }
+}
+
+/// `ψ(η)` of explicit weights plus a tail (`+∞` past the first singularity); `exact` is the
+/// prepared [`Tail::InverseSquare`], if any.
+fn cgf(
+    weights: &[f64],
+    copies: usize,
+    tail: &Tail,
+    exact: Option<&InverseSquareTail>,
+    eta: f64,
+) -> f64 {
+    let half_d = 0.5 * copies as f64;
+    let mut acc = 0.0;
+    for &c in weights.iter().rev() {
+        let a = -2.0 * c * eta;
+        if a <= -1.0 {
+            return f64::INFINITY;
         }
-        acc + eta * self.tail_mean + 0.5 * eta * eta * self.tail_variance
+        acc -= half_d * a.ln_1p();
+    }
+    match (tail, exact) {
+        (Tail::Gaussian { mean, variance }, _) => acc + eta * mean + 0.5 * eta * eta * variance,
+        (Tail::InverseSquare { .. }, Some(t)) => acc + half_d * t.log_sum_real(eta),
+        _ => acc,
     }
 }
 
@@ -420,7 +803,7 @@ fn continuum_first_weight(params: &FilamentParams) -> f64 {
 }
 
 /// Rigorous bound on `|ln φ_exact(t) − ln φ_law(t)|` for
-/// [`StoredLengthLaw::continuum`]`(params, dims, n_modes)`: the error of representing the
+/// [`StoredLengthLaw::continuum_gaussian_tail`]`(params, dims, n_modes)`: the error of representing the
 /// modes `n > n_modes` by a Gaussian with their exact mean and variance, at a complex
 /// argument of modulus `t_abs`. `(d/2)(2|t|)³ p₃/(3(1 − 2c_{M+1}|t|))` with
 /// `p₃ = Σ_{n>M} c_n³ ≤ c₁³/(5(M+½)⁵)` (midpoint bound of a convex sum); `+∞` if
@@ -594,6 +977,12 @@ pub struct CompressionTheory {
     options: QuadratureOptions,
     /// Positive weights only, descending.
     weights: Vec<f64>,
+    /// The prepared exact tail of a [`Tail::InverseSquare`] law.
+    exact_tail: Option<InverseSquareTail>,
+    /// The largest weight, tail included (0 without modes).
+    max_weight: f64,
+    /// ⟨s⟩₀ of the law.
+    mean: f64,
     half_d: f64,
     /// A = EA·L/(2kT).
     a: f64,
@@ -624,9 +1013,19 @@ struct Contour {
 
 impl Contour {
     /// `ln φ_η(τ)`.
+    /// The explicit modes in pairs: `ln((1 − ix)(1 − iy)) = ½ln(1 + x² + y² + x²y²)
+    /// − i·atan2(x + y, 1 − xy)`, exact because x, y have the same sign (the two arguments
+    /// add to less than π); half the logarithms and arctangents of one mode at a time.
     fn log_phi(&self, tau: f64) -> Complex<f64> {
         let (mut re, mut im) = (0.0, 0.0);
-        for &b in &self.explicit {
+        let mut pairs = self.explicit.chunks_exact(2);
+        for pair in &mut pairs {
+            let (x, y) = (pair[0] * tau, pair[1] * tau);
+            let (x2, y2) = (x * x, y * y);
+            re -= 0.5 * self.half_d * (x2 + y2 + x2 * y2).ln_1p();
+            im += self.half_d * (x + y).atan2(1.0 - x * y);
+        }
+        for &b in pairs.remainder() {
             let x = b * tau;
             re -= 0.5 * self.half_d * (x * x).ln_1p();
             im += self.half_d * x.atan();
@@ -677,12 +1076,26 @@ impl CompressionTheory {
         law.validate()?;
         let mut weights: Vec<f64> = law.weights.iter().copied().filter(|&c| c > 0.0).collect();
         weights.sort_by(|a, b| b.total_cmp(a));
+        let exact_tail = match law.tail {
+            Tail::InverseSquare {
+                first_weight,
+                first_mode,
+            } => Some(InverseSquareTail::new(
+                first_weight,
+                first_mode,
+                CONTOUR_ZETA_TERMS,
+            )),
+            _ => None,
+        };
         Ok(CompressionTheory {
             params: *params,
             half_d: 0.5 * law.copies as f64,
+            max_weight: law.max_weight(),
+            mean: law.mean(),
             law,
             options: QuadratureOptions::default(),
             weights,
+            exact_tail,
             a: params.stretch_rigidity * params.length / (2.0 * params.kt),
             force_unit: params.kt / params.length,
         })
@@ -730,21 +1143,37 @@ impl CompressionTheory {
     /// `(kT/L)/(2 c_max)`: the buckling load of the law's stiffest-to-buckle mode (F_c0 for
     /// the continuum, [`buckling_load_discrete`] for a mesh); `+∞` without weights.
     pub fn buckling_load(&self) -> f64 {
-        match self.weights.first() {
-            Some(&c) => self.force_unit / (2.0 * c),
-            None => f64::INFINITY,
-        }
+        self.force_unit * self.eta_max()
     }
 
     fn eta_max(&self) -> f64 {
-        match self.weights.first() {
-            Some(&c) => 1.0 / (2.0 * c),
-            None => f64::INFINITY,
+        if self.max_weight > 0.0 {
+            1.0 / (2.0 * self.max_weight)
+        } else {
+            f64::INFINITY
         }
     }
 
     fn psi(&self, eta: f64) -> f64 {
-        self.law.cumulant_generating_fn(eta)
+        cgf(
+            &self.weights,
+            self.law.copies,
+            &self.law.tail,
+            self.exact_tail.as_ref(),
+            eta,
+        )
+    }
+
+    /// `ψ′(η)` (k = 1) or `ψ″(η)` (k = 2) of the Gaussian or exact tail.
+    fn tail_derivative(&self, k: usize, eta: f64) -> f64 {
+        match (&self.law.tail, &self.exact_tail) {
+            (Tail::Gaussian { mean, variance }, _) => match k {
+                1 => mean + eta * variance,
+                _ => *variance,
+            },
+            (Tail::InverseSquare { .. }, Some(t)) => self.half_d * t.tilted_power_sum(k, eta),
+            _ => 0.0,
+        }
     }
 
     fn psi1(&self, eta: f64) -> f64 {
@@ -753,7 +1182,7 @@ impl CompressionTheory {
         for &c in self.weights.iter().rev() {
             acc += d * c / (1.0 - 2.0 * c * eta);
         }
-        acc + self.law.tail_mean + eta * self.law.tail_variance
+        acc + self.tail_derivative(1, eta)
     }
 
     fn psi2(&self, eta: f64) -> f64 {
@@ -763,14 +1192,14 @@ impl CompressionTheory {
             let q = c / (1.0 - 2.0 * c * eta);
             acc += 2.0 * d * q * q;
         }
-        acc + self.law.tail_variance
+        acc + self.tail_derivative(2, eta)
     }
 
     /// The saddle point η̂: `ψ'(η) + η/(2A) = ε`, by safeguarded Newton on a bracket.
     fn saddle(&self, strain: f64) -> Result<f64> {
         let inv2a = 0.5 / self.a;
         let g = |eta: f64| self.psi1(eta) + eta * inv2a - strain;
-        let mean = self.law.mean();
+        let mean = self.mean;
         let mut lo = (2.0 * self.a * (strain - mean)).min(0.0) - 1.0;
         let emax = self.eta_max();
         let mut hi = if emax.is_finite() {
@@ -888,8 +1317,7 @@ impl CompressionTheory {
     fn contour(&self, s: &Setup, tau_range: f64) -> Contour {
         let mut explicit = Vec::new();
         let mut power = vec![0.0; SERIES_TERMS];
-        for &c in &self.weights {
-            let b = 2.0 * c / (1.0 - 2.0 * c * s.eta);
+        let mut add_mode = |b: f64| {
             if b * tau_range > SERIES_RADIUS {
                 explicit.push(b);
             } else {
@@ -902,7 +1330,29 @@ impl CompressionTheory {
                     }
                 }
             }
+        };
+        for &c in &self.weights {
+            add_mode(2.0 * c / (1.0 - 2.0 * c * s.eta));
         }
+        if let Some(t) = &self.exact_tail {
+            // b_n = 2c₁/(n² − x): the modes below the base (b_n τ_range > SERIES_RADIUS or
+            // |x| > n²/16) one by one, the rest by their power sums
+            let a = 2.0 * t.c1;
+            let x = a * s.eta;
+            let radius = (x + a * tau_range / SERIES_RADIUS).max(0.0).sqrt().ceil();
+            let base = t.base_for(x.abs()).max(radius as usize);
+            for n in t.first()..base {
+                add_mode(a / ((n as f64).powi(2) - x));
+            }
+            let series = t.series_at(base, CONTOUR_ZETA_TERMS);
+            for (k, p) in power.iter_mut().enumerate() {
+                *p += series.power_sum(k + 1, a, x);
+            }
+        }
+        let (tail_lin, tail_var) = match self.law.tail {
+            Tail::Gaussian { mean, variance } => (mean + s.eta * variance, variance),
+            _ => (0.0, 0.0),
+        };
         let series = if power[0] > 0.0 {
             power
                 .iter()
@@ -918,8 +1368,8 @@ impl CompressionTheory {
             inv4a: 0.25 / self.a,
             explicit,
             series,
-            tail_lin: self.law.tail_mean + s.eta * self.law.tail_variance,
-            tail_half_var: 0.5 * self.law.tail_variance,
+            tail_lin,
+            tail_half_var: 0.5 * tail_var,
         }
     }
 
@@ -930,7 +1380,17 @@ impl CompressionTheory {
             let x = 2.0 * c / (1.0 - 2.0 * c * eta) * tau;
             re -= 0.5 * self.half_d * (x * x).ln_1p();
         }
-        (re - 0.5 * self.law.tail_variance * tau * tau).exp()
+        match (&self.law.tail, &self.exact_tail) {
+            (Tail::Gaussian { variance, .. }, _) => re -= 0.5 * variance * tau * tau,
+            (Tail::InverseSquare { .. }, Some(t)) => {
+                let x = 2.0 * t.c1 * eta;
+                let y = 2.0 * t.c1 * tau;
+                re += self.half_d
+                    * (t.log_sum(Complex::new(x, y)).re - t.log_sum(Complex::new(x, 0.0)).re);
+            }
+            _ => {}
+        }
+        re.exp()
     }
 
     fn moments(&self, s: &Setup, c: &Contour) -> Moments {
@@ -1152,15 +1612,33 @@ impl KernelSums {
             let tau = self.vals.len() as f64 * self.h;
             self.vals.push(self.contour.shifted(tau));
         }
-        let mut acc = Complex::new(0.0, 0.0);
-        for j in jlo..=jhi {
-            let v = if j >= 0 {
+        let val = |j: i64| {
+            if j >= 0 {
                 self.vals[j as usize]
             } else {
                 self.vals[(-j) as usize].conj()
-            };
-            let d = j as f64 * self.h - u;
-            acc += v * (-d * d * self.inv4a).exp();
+            }
+        };
+        // The kernel w_j = e^{−d_j²/(4A)}, d_j = jh − u, by its exact recurrence
+        // w_{j+1} = w_j g_j, g_{j+1} = g_j e^{−2h²/(4A)}, g_j = e^{−(2d_j h + h²)/(4A)}, restarted
+        // from exponentials every KERNEL_ANCHOR nodes (rounding ≤ ≈ KERNEL_ANCHOR²ε/2
+        // relative; two products per node instead of an exponential).
+        let (h, c) = (self.h, self.inv4a);
+        let q = (-2.0 * h * h * c).exp();
+        let mut acc = Complex::new(0.0, 0.0);
+        let mut j = jlo;
+        while j <= jhi {
+            let d = j as f64 * h - u;
+            let mut w = (-d * d * c).exp();
+            let mut g = (-(2.0 * d * h + h * h) * c).exp();
+            let end = (j + KERNEL_ANCHOR - 1).min(jhi);
+            acc += val(j) * w;
+            for jj in j + 1..=end {
+                w *= g;
+                g *= q;
+                acc += val(jj) * w;
+            }
+            j = end + 1;
         }
         acc
     }
@@ -1318,12 +1796,46 @@ mod tests {
     }
 
     #[test]
+    fn scaled_even_zeta_matches_known_values() {
+        // ζ(2j) at base 1: π²/6, π⁴/90, π⁶/945, π⁸/9450
+        let z = scaled_even_zeta(1, CONTOUR_ZETA_TERMS);
+        let exact = [
+            PI.powi(2) / 6.0,
+            PI.powi(4) / 90.0,
+            PI.powi(6) / 945.0,
+            PI.powi(8) / 9450.0,
+        ];
+        for (j, e) in exact.iter().enumerate() {
+            assert!((z[j] / e - 1.0).abs() < 5e-16, "j = {}", j + 1);
+        }
+        // other bases against the explicit sums of inverse_power_tail (p = 2, 4) and a
+        // direct sum over n < 40N (p = 2j ≥ 20: the rest is below 40^{−20})
+        for base in [2usize, 7, 65, 300, 5000] {
+            let nb = base as f64;
+            let z = scaled_even_zeta(base, CONTOUR_ZETA_TERMS);
+            for (j, p) in [(1usize, 2u32), (2, 4)] {
+                let e = nb.powi(p as i32) * inverse_power_tail(p, base - 1);
+                assert!((z[j - 1] / e - 1.0).abs() < 1e-15, "base {base}, p = {p}");
+            }
+            for j in [10usize, 30, 64] {
+                let e: f64 = (base..40 * base)
+                    .rev()
+                    .map(|n| (nb / n as f64).powi(2 * j as i32))
+                    .sum();
+                assert!((z[j - 1] / e - 1.0).abs() < 1e-14, "base {base}, j = {j}");
+            }
+        }
+    }
+
+    #[test]
     fn char_fn_of_law_matches_cumulants() {
         let law = StoredLengthLaw {
             weights: vec![0.3, 0.1],
             copies: 2,
-            tail_mean: 0.05,
-            tail_variance: 0.01,
+            tail: Tail::Gaussian {
+                mean: 0.05,
+                variance: 0.01,
+            },
         };
         let t = 1e-4;
         let phi = law.char_fn(t);

@@ -9,6 +9,6 @@ pub mod compression;
 
 pub use compression::{
     CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, ForceDistribution, MAX_DISCRETE_ELEMENTS,
-    QuadratureOptions, StoredLengthLaw, buckling_load_discrete, continuum_tail_log_char_bound,
-    discrete_buckling_loads,
+    QuadratureOptions, StoredLengthLaw, Tail, buckling_load_discrete,
+    continuum_tail_log_char_bound, discrete_buckling_loads,
 };
