@@ -18,7 +18,7 @@ use crate::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::Compressed
 use rand::RngExt;
 use rand_distr::StandardNormal;
 
-/// Modes of the continuum theory (plus the exact tail cumulants).
+/// Explicit modes of the continuum theory (the rest summed exactly as a Hurwitz-zeta series).
 pub const CONTINUUM_MODES: usize = crate::theory::DEFAULT_CONTINUUM_MODES;
 
 /// Theory of one compression scene, shared by its runs.

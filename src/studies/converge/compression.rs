@@ -571,7 +571,7 @@ fn texts(scene: &Scene, spec: &RunSpec, over: Over, comp: &CompressionSpec) -> (
     match over {
         Over::Elements => (
             format!(
-                "continuum exact equilibrium theory of <F>/F_c0 ({}D, EI/(kT L) = {}, EA L/kT = {:e}; {CONTINUUM_MODES} modes plus exact tail cumulants); the exact discrete reference is the same theory for each mesh",
+                "continuum exact equilibrium theory of <F>/F_c0 ({}D, EI/(kT L) = {}, EA L/kT = {:e}; {CONTINUUM_MODES} explicit modes plus the exact tail, a Hurwitz-zeta series); the exact discrete reference is the same theory for each mesh",
                 scene.dims,
                 p.bending_rigidity / (p.kt * p.length),
                 p.stretch_rigidity * p.length / p.kt
