@@ -1,28 +1,28 @@
-//! What the paper's explicit scheme would need for the Fig. 2 accuracy, measured on a
-//! short run and extrapolated (labelled as such in the README).
+//! Cost of one step of the Fig. 2 filament (EI = 100, EA = 1e6 in units L = kT = ξ = 1, at
+//! ε = 3 ε_c0), per trajectory-step, 2D and 3D, at 10, 100 and 1000 elements:
 //!
-//! For each compression scene, the cost of one step is measured for the paper's explicit
-//! Euler–Maruyama (with the axial solve of step i, at half its stability limit) and for the
-//! Metropolis-adjusted Crank–Nicolson used by the scene, on the same filament at
-//! ε = 3 ε_c0. The simulated time the scene needs at the full budget (all strains,
-//! trajectories, burn-in and sampling of its primary run) is then converted into the number
-//! of explicit steps and an extrapolated wall time. The extrapolation assumes the explicit
-//! scheme needs the same simulated time for the same error bar (its correlation times are
-//! the physical ones), which flatters it: it is a lower bound.
+//! - the Metropolis-adjusted Crank–Nicolson chain in the paired modal form
+//!   ([`ModalMetropolis`], what the scenes run on their uniform meshes), at Δt = 0.32 τ1;
+//! - the same chain in banded nodal form ([`NonlinearIntegrator`], the general-mesh
+//!   fallback), at Δt = 0.02 τ1;
+//! - the paper's explicit Euler–Maruyama (with the axial solve of step i) at half its
+//!   stability limit (10 elements only);
+//! - the random numbers alone: the step's standard normals and one uniform, from the same
+//!   generator.
 //!
-//! Run: `cargo bench --bench fig2_cost`; `cargo bench --bench fig2_cost -- metropolis`
-//! times only the scenes' Metropolis step (median of 7 runs of 100 000 steps each).
+//! Every figure is the median of 7 timed runs (after a warm-up of a quarter of the run).
+//! Run: `cargo bench --bench fig2_cost`; `-- quick` for 10 elements only.
 
-use langevin_fem::dynamics::{Driver, IntegratorKind, NonlinearState, Observer};
+use langevin_fem::dynamics::{Driver, IntegratorKind, ModalMetropolis, NonlinearState, Observer};
 use langevin_fem::fem::beam::BeamModel;
 use langevin_fem::fem::mesh::Mesh;
 use langevin_fem::fem::noise::NoiseModel;
+use langevin_fem::fem::paired::PairedModes;
 use langevin_fem::rng::trajectory_rng;
-use langevin_fem::scene::Budget;
-use langevin_fem::scene::Scene;
 use langevin_fem::{dynamics::nonlinear::NonlinearIntegrator, fem::vonkarman::CompressedFilament};
+use rand::RngExt;
+use rand_distr::StandardNormal;
 use std::hint::black_box;
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// Starts a clock at the end of the warm-up and reads it at the end of the run.
@@ -72,70 +72,98 @@ fn ns_per_step(model: &CompressedFilament, kind: IntegratorKind, dt: f64, steps:
     timer.elapsed.as_nanos() as f64 / steps as f64
 }
 
-/// The model of a compression scene at ε = 3 ε_c0, with the scene's primary run.
-fn scene_model(root: &Path, name: &str) -> (Scene, CompressedFilament) {
-    let scene = Scene::load(&root.join(format!("{name}.toml"))).expect("scene");
-    let p = scene.filament;
-    let beam = BeamModel::new(
-        p,
-        Mesh::uniform(p.length, scene.mesh.elements).expect("mesh"),
-    )
-    .expect("beam");
-    let model = CompressedFilament::new(beam, scene.dims, 3.0 * p.euler_strain()).expect("model");
-    (scene, model)
+/// The Fig. 2 filament with `elements` elements at ε = 3 ε_c0.
+fn fig2_model(dims: usize, elements: usize) -> CompressedFilament {
+    let p = langevin_fem::FilamentParams {
+        bending_rigidity: 100.0,
+        stretch_rigidity: 1e6,
+        ..langevin_fem::FilamentParams::default()
+    };
+    let beam = BeamModel::new(p, Mesh::uniform(p.length, elements).expect("mesh")).expect("beam");
+    CompressedFilament::new(beam, dims, 3.0 * p.euler_strain()).expect("model")
 }
 
-/// The Metropolis step alone at each scene: median ns/step of 7 runs.
-fn metropolis_only(root: &Path) {
-    println!("| scene | elements | dt / tau1 | Metropolis ns/step (median of 7) | min | max |");
-    println!("|---|---:|---:|---:|---:|---:|");
-    for name in ["compression-2d", "compression-3d"] {
-        let (scene, model) = scene_model(root, name);
-        let run = &scene.runs[0];
-        let dt = run.dt_tau1 * scene.filament.tau1();
-        let mut t: Vec<f64> = (0..7)
-            .map(|_| ns_per_step(&model, run.integrator, dt, 100_000))
-            .collect();
-        t.sort_by(f64::total_cmp);
-        println!(
-            "| {name} | {} | {:.2e} | {:.0} | {:.0} | {:.0} |",
-            scene.mesh.elements, run.dt_tau1, t[3], t[0], t[6]
-        );
+/// ns per step of the modal chain at step `dt`.
+fn modal_ns_per_step(model: &CompressedFilament, modes: &PairedModes, dt: f64, steps: u64) -> f64 {
+    let mut rng = trajectory_rng(1, 0);
+    let mut chain = ModalMetropolis::new(model, modes, dt, &mut rng).expect("chain");
+    let mut timer = Timer {
+        warm_up: steps / 4,
+        start: None,
+        elapsed: Duration::ZERO,
+    };
+    Driver::new(dt, steps / 4, steps, steps)
+        .run(0, &mut chain, &mut rng, &mut timer, |_| {
+            "diverged".to_string()
+        })
+        .expect("finite trajectory");
+    timer.elapsed.as_nanos() as f64 / steps as f64
+}
+
+/// ns per step of the random numbers alone: `n` standard normals and one uniform.
+fn normals_ns_per_step(n: usize, steps: u64) -> f64 {
+    let mut rng = trajectory_rng(1, 0);
+    let mut buf = vec![0.0; n];
+    let start = Instant::now();
+    for _ in 0..steps {
+        for z in &mut buf {
+            *z = rng.sample(StandardNormal);
+        }
+        let u: f64 = rng.random();
+        black_box((&buf, u));
     }
+    start.elapsed().as_nanos() as f64 / steps as f64
+}
+
+/// Median of 7 runs of `f`.
+fn median7(mut f: impl FnMut() -> f64) -> f64 {
+    let mut t: Vec<f64> = (0..7).map(|_| f()).collect();
+    t.sort_by(f64::total_cmp);
+    t[3]
 }
 
 fn main() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("verification");
-    if std::env::args().any(|a| a == "metropolis") {
-        metropolis_only(&root);
-        return;
-    }
+    let quick = std::env::args().any(|a| a == "quick");
+    let sizes: &[usize] = if quick { &[10] } else { &[10, 100, 1000] };
     println!(
-        "| scene | explicit dt / tau1 | explicit ns/step | scene dt / tau1 | scene ns/step | simulated tau1 (full budget) | scene steps | explicit steps | explicit wall (extrapolated, 1 core) |"
+        "| dims | elements | unknowns | modal Metropolis ns/step (0.32 tau1) | normals + uniform alone ns | modal / normals | banded Metropolis ns/step (0.02 tau1) | explicit EM ns/step |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for name in ["compression-2d", "compression-3d"] {
-        let (scene, model) = scene_model(&root, name);
-        let comp = scene.compression.as_ref().expect("compression scene");
-        let p = scene.filament;
-        let tau1 = p.tau1();
-        let limit = 2.0 / model.beam().max_rate().expect("max rate");
-        let run = &scene.runs[0];
-        let e = run.ensemble(Budget::Full);
-        let simulated = comp.strain_ratios.len() as f64
-            * e.trajectories as f64
-            * (e.duration_tau1 + comp.burn_in_tau1);
-        let dt_explicit = 0.5 * limit;
-        let explicit = ns_per_step(&model, IntegratorKind::EulerMaruyama, dt_explicit, 400_000);
-        let scene_cost = ns_per_step(&model, run.integrator, run.dt_tau1 * tau1, 100_000);
-        let scene_steps = simulated / run.dt_tau1;
-        let explicit_steps = simulated * tau1 / dt_explicit;
-        let wall = explicit_steps * explicit * 1e-9;
-        println!(
-            "| {name} | {:.2e} | {explicit:.0} | {:.2e} | {scene_cost:.0} | {simulated:.3e} | {scene_steps:.2e} | {explicit_steps:.2e} | {:.1} h |",
-            dt_explicit / tau1,
-            run.dt_tau1,
-            wall / 3600.0
-        );
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for dims in [2, 3] {
+        for &ne in sizes {
+            let model = fig2_model(dims, ne);
+            let tau1 = model.beam().params().tau1();
+            let modes = PairedModes::new(model.beam()).expect("uniform mesh");
+            let unknowns = model.components() * model.beam().n_dofs();
+            let steps = (2_000_000 / unknowns as u64).max(2000);
+            let modal = median7(|| modal_ns_per_step(&model, &modes, 0.32 * tau1, steps));
+            let normals = median7(|| normals_ns_per_step(unknowns, steps));
+            let banded = median7(|| {
+                ns_per_step(
+                    &model,
+                    IntegratorKind::MetropolisCrankNicolson,
+                    0.02 * tau1,
+                    steps / 2,
+                )
+            });
+            let explicit = if ne == 10 {
+                let limit = 2.0 / model.beam().max_rate().expect("max rate");
+                format!(
+                    "{:.0}",
+                    median7(|| ns_per_step(
+                        &model,
+                        IntegratorKind::EulerMaruyama,
+                        0.5 * limit,
+                        steps
+                    ))
+                )
+            } else {
+                "-".to_string()
+            };
+            println!(
+                "| {dims} | {ne} | {unknowns} | {modal:.0} | {normals:.0} | {:.2} | {banded:.0} | {explicit} |",
+                modal / normals
+            );
+        }
     }
 }

@@ -27,9 +27,11 @@ use crate::rng::TrajectoryRng;
 use rand::RngExt;
 use rand_distr::StandardNormal;
 
-/// Blocks whose determinants are multiplied before one logarithm is taken: a product of 8
-/// determinants stays far inside the range of f64 for every accepted filament.
-const LOG_CHUNK: usize = 8;
+/// The block determinants are multiplied, and the logarithm of the running product taken
+/// only when it leaves this range (a block determinant is at most `(1 + ½Δtλ_max)²`, far
+/// below 1e58 for any accepted filament and step, so the product never overflows): one
+/// logarithm per evaluation instead of one per block.
+const PRODUCT_RANGE: (f64, f64) = (1e-250, 1e250);
 
 /// One evaluated state of the chain: the modal coordinates (component-major), `B a`, the
 /// energy, the compressive force and the inverse blocks of `A_a` with `ln det A_a`
@@ -240,16 +242,17 @@ impl<'m> ModalMetropolis<'m> {
         let h = self.half_dt;
         let (mut ok, mut log_det, mut prod) = (true, 0.0, 1.0);
         let (ip, is) = e.inverse.split_at_mut(self.pairs.len());
-        for (k, (inv, blk)) in ip.iter_mut().zip(&self.pairs).enumerate() {
+        for (inv, blk) in ip.iter_mut().zip(&self.pairs) {
             let [l0, l1, b00, b01, b11] = *blk;
             let a00 = 1.0 + h * (l0 - f * b00);
             let a01 = -h * f * b01;
             let a11 = 1.0 + h * (l1 - f * b11);
             let det = a00 * a11 - a01 * a01;
             ok &= a00 > 0.0 && det > 0.0;
-            *inv = [a11 / det, -a01 / det, a00 / det];
+            let r = 1.0 / det;
+            *inv = [a11 * r, -a01 * r, a00 * r];
             prod *= det;
-            if k % LOG_CHUNK == LOG_CHUNK - 1 {
+            if !(PRODUCT_RANGE.0..PRODUCT_RANGE.1).contains(&prod) {
                 log_det += prod.ln();
                 prod = 1.0;
             }
