@@ -136,7 +136,8 @@ struct ScaledNoise<'a> {
 impl RowTerm for ScaledNoise<'_> {
     #[inline(always)]
     fn term(&mut self, _i: usize) -> f64 {
-        self.scale * self.zeta.next_value()
+        // the sweep prepares every row before requesting it
+        self.scale * self.zeta.next_prepared()
     }
     #[inline]
     fn prepare(&mut self, end: usize) {

@@ -703,8 +703,27 @@ impl BandedCholesky {
     /// If `z.len() != n`.
     pub fn mul_lower_in_place(&self, z: &mut [f64]) {
         assert_eq!(z.len(), self.n, "mul_lower_in_place: wrong length");
-        for i in (0..self.n).rev() {
-            z[i] = self.mul_lower_row(z, i);
+        match self.bw {
+            1 => self.mul_lower_in_place_fixed::<2>(z),
+            2 => self.mul_lower_in_place_fixed::<3>(z),
+            3 => self.mul_lower_in_place_fixed::<4>(z),
+            _ => {
+                for i in (0..self.n).rev() {
+                    z[i] = self.mul_lower_row(z, i);
+                }
+            }
+        }
+    }
+
+    /// [`Self::mul_lower_in_place`] for half-bandwidth `W − 1`.
+    fn mul_lower_in_place_fixed<const W: usize>(&self, z: &mut [f64]) {
+        let rows = band_rows::<W>(&self.data, self.n);
+        let head = (W - 1).min(self.n);
+        for i in (head..self.n).rev() {
+            z[i] = lower_row(&rows[i], z, i, W - 1);
+        }
+        for i in (0..head).rev() {
+            z[i] = lower_row(&rows[i], z, i, i);
         }
     }
 
@@ -776,17 +795,12 @@ impl<const W: usize, D: FnMut() -> f64> RowTerm for LowerProductTerm<'_, W, D> {
     fn term(&mut self, i: usize) -> f64 {
         debug_assert!(i < self.drawn);
         let row = &self.rows[i];
-        let mut acc = 0.0;
-        if i + 1 >= W {
-            for d in (1..W).rev() {
-                acc += row[d] * self.z[i - d];
-            }
+        let lz = if i + 1 >= W {
+            lower_row(row, self.z, i, W - 1)
         } else {
-            for d in (1..=i).rev() {
-                acc += row[d] * self.z[i - d];
-            }
-        }
-        self.s * (acc + row[0] * self.z[i])
+            lower_row(row, self.z, i, i)
+        };
+        self.s * lz
     }
 }
 
@@ -838,6 +852,17 @@ fn product_row<const W: usize>(
         acc += rows[i + d][d] * x[i + d];
     }
     acc
+}
+
+/// Row `i` of `L z`, summed as [`BandedCholesky::mul_lower_row`] does: `0 + Σ_k L_ik z_k`,
+/// `k` ascending over the `lower` entries left of the diagonal, then the diagonal.
+#[inline(always)]
+fn lower_row<const W: usize>(row: &[f64; W], z: &[f64], i: usize, lower: usize) -> f64 {
+    let mut acc = 0.0;
+    for d in (1..=lower).rev() {
+        acc += row[d] * z[i - d];
+    }
+    acc + row[0] * z[i]
 }
 
 /// `window ← [v, window[0], …]`: the last values of a sweep, nearest first.

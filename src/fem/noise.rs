@@ -326,13 +326,31 @@ impl<R: rand::Rng + ?Sized> NoiseStream<'_, R> {
     /// If all `n` entries have been pulled already.
     #[inline]
     pub fn next_value(&mut self) -> f64 {
+        self.prepare(self.next + 1);
+        self.next_prepared()
+    }
+
+    /// [`Self::next_value`] for an entry that [`Self::prepare`] has drawn for: never
+    /// calls the generator (so a sweep over prepared entries keeps its values in
+    /// registers).
+    ///
+    /// # Panics
+    /// If all `n` entries have been pulled already, or the entry was not prepared.
+    #[inline]
+    pub fn next_prepared(&mut self) -> f64 {
         let i = self.next;
         assert!(i < self.n, "NoiseStream: all {} entries drawn", self.n);
         self.next += 1;
-        self.prepare(i + 1);
         match self.source {
-            Source::Consistent(l) => l.mul_lower_row(self.scratch, i),
+            Source::Consistent(l) => {
+                assert!(i < self.drawn, "NoiseStream: entry {i} not prepared");
+                l.mul_lower_row(self.scratch, i)
+            }
             Source::ElementUniform { by_dof, .. } => {
+                assert!(
+                    by_dof.elements_needed[i] <= self.drawn,
+                    "NoiseStream: entry {i} not prepared"
+                );
                 let mut s = 0.0;
                 for &(e, bv) in &by_dof.entries[by_dof.start[i]..by_dof.start[i + 1]] {
                     s += self.scratch[e] * bv;
