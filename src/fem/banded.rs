@@ -86,6 +86,30 @@ impl SymBanded {
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         assert_eq!(x.len(), self.n, "mul_vec: x has wrong length");
         assert_eq!(y.len(), self.n, "mul_vec: y has wrong length");
+        match self.bw {
+            1 => self.mul_vec_fixed::<2>(x, y),
+            2 => self.mul_vec_fixed::<3>(x, y),
+            3 => self.mul_vec_fixed::<4>(x, y),
+            _ => self.mul_vec_generic(x, y),
+        }
+    }
+
+    /// [`Self::mul_vec`] for half-bandwidth `W − 1`: one pass, row by row
+    /// ([`product_row`]).
+    fn mul_vec_fixed<const W: usize>(&self, x: &[f64], y: &mut [f64]) {
+        let rows = band_rows::<W>(&self.data, self.n);
+        for_rows::<W>(
+            self.n,
+            #[inline(always)]
+            |i, lower, upper| {
+                y[i] = product_row(rows, x, i, lower, upper);
+            },
+        );
+    }
+
+    /// [`Self::mul_vec`] for any half-bandwidth: the lower band row by row, then the
+    /// upper band column by column. The reference for the fixed-bandwidth kernels.
+    fn mul_vec_generic(&self, x: &[f64], y: &mut [f64]) {
         let w = self.bw + 1;
         for i in 0..self.n {
             let row = &self.data[i * w..(i + 1) * w];
@@ -340,22 +364,147 @@ impl BandedCholesky {
 
     /// Solves `A x = b` in place (forward `L y = b`, then backward `Lᵀ x = y`), `O(n·bw)`.
     ///
+    /// Row `i` of the forward sweep is `y_i = (b_i − Σ_k L_ik y_k)·(1/L_ii)`, `k` ascending;
+    /// row `i` of the backward sweep `x_i = (y_i − Σ_k L_ki x_k)·(1/L_ii)`, `k` ascending.
+    ///
     /// # Panics
     /// If `b.len() != n`.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         assert_eq!(b.len(), self.n, "solve_in_place: wrong length");
-        let w = self.bw + 1;
-        let n = self.n;
-        for i in 0..n {
-            let row = &self.data[i * w..i * w + w];
-            let lo = i.saturating_sub(self.bw);
-            let mut s = b[i];
-            for (k, bk) in b[lo..i].iter().enumerate() {
-                s -= row[i - lo - k] * bk;
+        match self.bw {
+            1 => self.solve_fixed::<2>(b),
+            2 => self.solve_fixed::<3>(b),
+            3 => self.solve_fixed::<4>(b),
+            _ => {
+                self.forward_generic(b);
+                self.backward_generic(b);
             }
-            b[i] = s * self.inv_diag[i];
         }
-        self.solve_upper_in_place(b);
+    }
+
+    /// `y ← L⁻¹ (A x + g)`: a banded product fused with the forward half of
+    /// [`Self::solve_in_place`] in one sweep, the additive term `g_i` given by `term`
+    /// ([`RowTerm`]; any `FnMut(usize) -> f64` closure is one). [`RowTerm::term`] is called
+    /// once per row, for `i = 0, 1, …, n − 1` in this order (so it may draw random
+    /// numbers). The same floating-point operations as [`SymBanded::mul_vec`] into `y`,
+    /// then `y_i += g_i` for ascending `i`, then the forward sweep of
+    /// [`Self::solve_in_place`], so the result is bit-identical to them. Follow with
+    /// [`Self::solve_upper_into`] for `A_L⁻¹ (A x + g)`.
+    ///
+    /// # Panics
+    /// If `a`, `x` or `y` does not have dimension `n`.
+    pub fn solve_lower_product<T: RowTerm>(
+        &self,
+        a: &SymBanded,
+        x: &[f64],
+        mut term: T,
+        y: &mut [f64],
+    ) {
+        assert_eq!(a.n, self.n, "solve_lower_product: matrix has wrong size");
+        assert_eq!(x.len(), self.n, "solve_lower_product: x has wrong length");
+        assert_eq!(y.len(), self.n, "solve_lower_product: y has wrong length");
+        match (self.bw, a.bw) {
+            (1, 1) => self.solve_lower_product_fixed::<2, _>(a, x, &mut term, y),
+            (2, 2) => self.solve_lower_product_fixed::<3, _>(a, x, &mut term, y),
+            (3, 3) => self.solve_lower_product_fixed::<4, _>(a, x, &mut term, y),
+            _ => {
+                a.mul_vec_generic(x, y);
+                term.prepare(self.n);
+                for (i, yi) in y.iter_mut().enumerate() {
+                    *yi += term.term(i);
+                }
+                self.forward_generic(y);
+            }
+        }
+    }
+
+    /// `y ← L⁻¹ (A x + s·M z)`: [`Self::solve_lower_product`] with the additive term the
+    /// product of a lower factor `M` (same dimension) with a vector `z` drawn during the
+    /// sweep, `z_i = draw()` for `i = 0, 1, …, n − 1` in this order (row `i` of `M z`
+    /// as [`Self::mul_lower_row`] sums it). `z` receives the draws where the sweep needs
+    /// them stored (its contents afterwards are unspecified). Bit-identical to drawing
+    /// all of `z`, [`SymBanded::mul_vec`] into `y`, [`Self::mul_lower`] into `m`,
+    /// `y_i += s·m_i`, then the forward sweep of [`Self::solve_in_place`].
+    ///
+    /// # Panics
+    /// If `a`, `m`, `x`, `z` or `y` does not have dimension `n`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_lower_product_noise(
+        &self,
+        a: &SymBanded,
+        x: &[f64],
+        m: &BandedCholesky,
+        s: f64,
+        mut draw: impl FnMut() -> f64,
+        z: &mut [f64],
+        y: &mut [f64],
+    ) {
+        assert_eq!(
+            a.n, self.n,
+            "solve_lower_product_noise: matrix has wrong size"
+        );
+        assert_eq!(
+            m.n, self.n,
+            "solve_lower_product_noise: factor has wrong size"
+        );
+        assert_eq!(
+            x.len(),
+            self.n,
+            "solve_lower_product_noise: x has wrong length"
+        );
+        assert_eq!(
+            z.len(),
+            self.n,
+            "solve_lower_product_noise: z has wrong length"
+        );
+        assert_eq!(
+            y.len(),
+            self.n,
+            "solve_lower_product_noise: y has wrong length"
+        );
+        match (self.bw, a.bw, m.bw) {
+            (1, 1, 1) => {
+                let mut term = LowerProductTerm::<2, _>::new(m, s, draw, z);
+                self.solve_lower_product_fixed::<2, _>(a, x, &mut term, y);
+            }
+            (2, 2, 2) => {
+                let mut term = LowerProductTerm::<3, _>::new(m, s, draw, z);
+                self.solve_lower_product_fixed::<3, _>(a, x, &mut term, y);
+            }
+            (3, 3, 3) => {
+                let mut term = LowerProductTerm::<4, _>::new(m, s, draw, z);
+                self.solve_lower_product_fixed::<4, _>(a, x, &mut term, y);
+            }
+            _ => {
+                for zi in z.iter_mut() {
+                    *zi = draw();
+                }
+                a.mul_vec_generic(x, y);
+                for (i, yi) in y.iter_mut().enumerate() {
+                    *yi += s * m.mul_lower_row(z, i);
+                }
+                self.forward_generic(y);
+            }
+        }
+    }
+
+    /// Solves `Lᵀ x = y` from `y` into `x` (the backward half of [`Self::solve_in_place`],
+    /// same operations as [`Self::solve_upper_in_place`]), `O(n·bw)`.
+    ///
+    /// # Panics
+    /// If `y.len()` or `x.len()` differs from `n`.
+    pub fn solve_upper_into(&self, y: &[f64], x: &mut [f64]) {
+        assert_eq!(y.len(), self.n, "solve_upper_into: y has wrong length");
+        assert_eq!(x.len(), self.n, "solve_upper_into: x has wrong length");
+        match self.bw {
+            1 => self.backward_fixed::<2>(Some(y), x),
+            2 => self.backward_fixed::<3>(Some(y), x),
+            3 => self.backward_fixed::<4>(Some(y), x),
+            _ => {
+                x.copy_from_slice(y);
+                self.backward_generic(x);
+            }
+        }
     }
 
     /// Solves `Lᵀ x = b` in place (the backward half of [`Self::solve_in_place`]),
@@ -365,6 +514,129 @@ impl BandedCholesky {
     /// If `b.len() != n`.
     pub fn solve_upper_in_place(&self, b: &mut [f64]) {
         assert_eq!(b.len(), self.n, "solve_upper_in_place: wrong length");
+        match self.bw {
+            1 => self.backward_fixed::<2>(None, b),
+            2 => self.backward_fixed::<3>(None, b),
+            3 => self.backward_fixed::<4>(None, b),
+            _ => self.backward_generic(b),
+        }
+    }
+
+    /// [`Self::solve_in_place`] for half-bandwidth `W − 1`.
+    fn solve_fixed<const W: usize>(&self, b: &mut [f64]) {
+        let n = self.n;
+        let (rows, inv) = (band_rows::<W>(&self.data, n), &self.inv_diag[..n]);
+        let head = (W - 1).min(n);
+        for i in 0..head {
+            b[i] = forward_row_edge(&rows[i], b, i, b[i], inv[i]);
+        }
+        if head < n {
+            // pipelined as in `solve_lower_product_fixed`
+            let mut window = window_before::<W>(b, head);
+            let mut partial = far_terms_from(&rows[head], b, head, b[head]);
+            for i in head..n {
+                let v = near_term(&rows[i], &window, partial) * inv[i];
+                b[i] = v;
+                if i + 1 < n {
+                    partial = far_terms(&rows[i + 1], &window, b[i + 1]);
+                }
+                push(&mut window, v);
+            }
+        }
+        self.backward_fixed::<W>(None, b);
+    }
+
+    /// [`Self::solve_lower_product`] for half-bandwidth `W − 1` (of both matrices).
+    fn solve_lower_product_fixed<const W: usize, T: RowTerm>(
+        &self,
+        a: &SymBanded,
+        x: &[f64],
+        term: &mut T,
+        y: &mut [f64],
+    ) {
+        let (n, bw) = (self.n, W - 1);
+        let (rows, inv) = (band_rows::<W>(&self.data, n), &self.inv_diag[..n]);
+        let a_rows = band_rows::<W>(&a.data, n);
+        let head = bw.min(n);
+        term.prepare((head + 1).min(n));
+        for i in 0..head {
+            let b = product_row(a_rows, x, i, i, (n - 1 - i).min(bw)) + term.term(i);
+            y[i] = forward_row_edge(&rows[i], y, i, b, inv[i]);
+        }
+        if head < n {
+            // Software-pipelined: the terms of row i + 1 that do not involve y_i are
+            // formed in iteration i, so the chain from y_{i−1} to y_i is one
+            // multiply-subtract-multiply (the data flow, and so the result, is that of the
+            // plain sweep; written this way no vectorized pair of products with y_{i−1}
+            // lengthens the chain). The terms are prepared block by block, so that the
+            // rows of a block make no calls (which would spill the windows).
+            let upper = |i: usize| (n - 1 - i).min(bw);
+            let mut window = window_before::<W>(y, head);
+            let b = product_row(a_rows, x, head, bw, upper(head)) + term.term(head);
+            let mut partial = far_terms_from(&rows[head], y, head, b);
+            // rows whose successor has the full band (constant counts: unrolled)
+            let full = n.saturating_sub(bw + 1).max(head);
+            let mut start = head;
+            while start < full {
+                let end = (start + ROW_BLOCK).min(full);
+                term.prepare(end + 1);
+                for i in start..end {
+                    let v = near_term(&rows[i], &window, partial) * inv[i];
+                    y[i] = v;
+                    let b = product_row(a_rows, x, i + 1, bw, bw) + term.term(i + 1);
+                    partial = far_terms(&rows[i + 1], &window, b);
+                    push(&mut window, v);
+                }
+                start = end;
+            }
+            term.prepare(n);
+            for i in full..n {
+                let v = near_term(&rows[i], &window, partial) * inv[i];
+                y[i] = v;
+                if i + 1 < n {
+                    let b = product_row(a_rows, x, i + 1, bw, upper(i + 1)) + term.term(i + 1);
+                    partial = far_terms(&rows[i + 1], &window, b);
+                }
+                push(&mut window, v);
+            }
+        }
+    }
+
+    /// The backward sweep for half-bandwidth `W − 1`, from `y` into `x`, or in place in
+    /// `x` if `y` is `None`.
+    fn backward_fixed<const W: usize>(&self, y: Option<&[f64]>, x: &mut [f64]) {
+        let n = self.n;
+        let (rows, inv) = (band_rows::<W>(&self.data, n), &self.inv_diag[..n]);
+        let tail = n.saturating_sub(W - 1);
+        for i in (tail..n).rev() {
+            let s = y.map_or(x[i], |y| y[i]);
+            x[i] = backward_row_edge(rows, x, i, s, inv[i]);
+        }
+        if tail > 0 {
+            let mut window = window_after::<W>(x, tail - 1);
+            for i in (0..tail).rev() {
+                let s = y.map_or(x[i], |y| y[i]);
+                x[i] = backward_row(rows, &mut window, i, s, inv[i]);
+            }
+        }
+    }
+
+    /// The forward sweep `L y = b` in place, any half-bandwidth.
+    fn forward_generic(&self, b: &mut [f64]) {
+        let w = self.bw + 1;
+        for i in 0..self.n {
+            let row = &self.data[i * w..i * w + w];
+            let lo = i.saturating_sub(self.bw);
+            let mut s = b[i];
+            for (k, bk) in b[lo..i].iter().enumerate() {
+                s -= row[i - lo - k] * bk;
+            }
+            b[i] = s * self.inv_diag[i];
+        }
+    }
+
+    /// The backward sweep `Lᵀ x = b` in place, any half-bandwidth.
+    fn backward_generic(&self, b: &mut [f64]) {
         let w = self.bw + 1;
         let n = self.n;
         for i in (0..n).rev() {
@@ -382,6 +654,36 @@ impl BandedCholesky {
         -2.0 * self.inv_diag.iter().map(|d| d.ln()).sum::<f64>()
     }
 
+    /// Row `i` of `L z`: `(L z)_i = 0 + Σ_k L_ik z_k`, `k` ascending from
+    /// `max(0, i − bw)` to `i`, reading only `z_k` for those `k`. The same operations as
+    /// row `i` of [`Self::mul_lower`].
+    ///
+    /// # Panics
+    /// If `i ≥ n` or `z.len() ≤ i`.
+    #[inline]
+    pub fn mul_lower_row(&self, z: &[f64], i: usize) -> f64 {
+        self.mul_lower_row_with(i, z[i], |d| z[i - d])
+    }
+
+    /// [`Self::mul_lower_row`] with `z_i` given as a value and the earlier entries by
+    /// distance, `previous(d) = z_{i−d}` for `d = 1 … min(i, bw)`: for forming `L z` row by
+    /// row while `z` is being drawn, without reading `z_i` back from memory right after
+    /// storing it (a wide load over a fresh narrow store stalls store forwarding).
+    ///
+    /// # Panics
+    /// If `i ≥ n`.
+    #[inline]
+    pub fn mul_lower_row_with(&self, i: usize, z_i: f64, previous: impl Fn(usize) -> f64) -> f64 {
+        assert!(i < self.n, "mul_lower_row: row {i} out of range");
+        let w = self.bw + 1;
+        let row = &self.data[i * w..i * w + w];
+        let mut s = 0.0;
+        for d in (1..=i.min(self.bw)).rev() {
+            s += row[d] * previous(d);
+        }
+        s + row[0] * z_i
+    }
+
     /// `out = L z`. With `z` iid standard normal, `out ~ N(0, A)`.
     ///
     /// # Panics
@@ -389,13 +691,8 @@ impl BandedCholesky {
     pub fn mul_lower(&self, z: &[f64], out: &mut [f64]) {
         assert_eq!(z.len(), self.n, "mul_lower: z has wrong length");
         assert_eq!(out.len(), self.n, "mul_lower: out has wrong length");
-        let w = self.bw + 1;
-        for i in 0..self.n {
-            let mut s = 0.0;
-            for k in i.saturating_sub(self.bw)..=i {
-                s += self.data[i * w + (i - k)] * z[k];
-            }
-            out[i] = s;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.mul_lower_row(z, i);
         }
     }
 
@@ -406,13 +703,27 @@ impl BandedCholesky {
     /// If `z.len() != n`.
     pub fn mul_lower_in_place(&self, z: &mut [f64]) {
         assert_eq!(z.len(), self.n, "mul_lower_in_place: wrong length");
-        let w = self.bw + 1;
-        for i in (0..self.n).rev() {
-            let mut s = 0.0;
-            for k in i.saturating_sub(self.bw)..=i {
-                s += self.data[i * w + (i - k)] * z[k];
+        match self.bw {
+            1 => self.mul_lower_in_place_fixed::<2>(z),
+            2 => self.mul_lower_in_place_fixed::<3>(z),
+            3 => self.mul_lower_in_place_fixed::<4>(z),
+            _ => {
+                for i in (0..self.n).rev() {
+                    z[i] = self.mul_lower_row(z, i);
+                }
             }
-            z[i] = s;
+        }
+    }
+
+    /// [`Self::mul_lower_in_place`] for half-bandwidth `W − 1`.
+    fn mul_lower_in_place_fixed<const W: usize>(&self, z: &mut [f64]) {
+        let rows = band_rows::<W>(&self.data, self.n);
+        let head = (W - 1).min(self.n);
+        for i in (head..self.n).rev() {
+            z[i] = lower_row(&rows[i], z, i, W - 1);
+        }
+        for i in (0..head).rev() {
+            z[i] = lower_row(&rows[i], z, i, i);
         }
     }
 
@@ -420,6 +731,245 @@ impl BandedCholesky {
     pub fn to_dense_lower(&self) -> DMatrix<f64> {
         DMatrix::from_fn(self.n, self.n, |i, j| self.get(i, j))
     }
+}
+
+/// Rows per block of the fused forward sweep: [`RowTerm::prepare`] is called once per
+/// block.
+const ROW_BLOCK: usize = 16;
+
+/// The additive term `g_i` of the rows of a fused forward sweep
+/// ([`BandedCholesky::solve_lower_product`]).
+pub trait RowTerm {
+    /// `g_i`. Called once per row, for `i = 0, 1, …, n − 1` in this order.
+    fn term(&mut self, i: usize) -> f64;
+
+    /// Announces that the rows `i < end` will be requested next (`end` never decreases,
+    /// and is `n` before the last rows): a term that draws random numbers may draw them
+    /// here, block by block, so that the sweep over the block makes no calls. Does
+    /// nothing by default.
+    #[inline]
+    fn prepare(&mut self, _end: usize) {}
+}
+
+impl<F: FnMut(usize) -> f64> RowTerm for F {
+    #[inline(always)]
+    fn term(&mut self, i: usize) -> f64 {
+        self(i)
+    }
+}
+
+/// `g_i = s·(M z)_i` for a lower factor `M` of half-bandwidth `W − 1`, with `z_i = draw()`
+/// drawn into `z` block by block ([`RowTerm::prepare`]), in ascending `i`.
+struct LowerProductTerm<'a, const W: usize, D> {
+    rows: &'a [[f64; W]],
+    s: f64,
+    draw: D,
+    z: &'a mut [f64],
+    /// Entries of `z` drawn so far.
+    drawn: usize,
+}
+
+impl<'a, const W: usize, D: FnMut() -> f64> LowerProductTerm<'a, W, D> {
+    fn new(m: &'a BandedCholesky, s: f64, draw: D, z: &'a mut [f64]) -> Self {
+        debug_assert_eq!(m.bw + 1, W);
+        LowerProductTerm {
+            rows: band_rows::<W>(&m.data, m.n),
+            s,
+            draw,
+            z,
+            drawn: 0,
+        }
+    }
+}
+
+impl<const W: usize, D: FnMut() -> f64> RowTerm for LowerProductTerm<'_, W, D> {
+    #[inline]
+    fn prepare(&mut self, end: usize) {
+        while self.drawn < end {
+            self.z[self.drawn] = (self.draw)();
+            self.drawn += 1;
+        }
+    }
+
+    #[inline(always)]
+    fn term(&mut self, i: usize) -> f64 {
+        debug_assert!(i < self.drawn);
+        let row = &self.rows[i];
+        let lz = if i + 1 >= W {
+            lower_row(row, self.z, i, W - 1)
+        } else {
+            lower_row(row, self.z, i, i)
+        };
+        self.s * lz
+    }
+}
+
+/// The band of an `n`-row banded matrix as rows of `W = bw + 1` entries (row `i`:
+/// `[M_ii, M_i,i−1, …, M_i,i−bw]`).
+fn band_rows<const W: usize>(data: &[f64], n: usize) -> &[[f64; W]] {
+    let (rows, rest) = data.as_chunks::<W>();
+    debug_assert!(rest.is_empty());
+    &rows[..n]
+}
+
+/// Calls `f(i, lower, upper)` for the rows `i = 0, 1, …, n − 1` of an `n × n` matrix of
+/// half-bandwidth `W − 1`, with `lower = min(i, W − 1)` and `upper = min(n − 1 − i, W − 1)`
+/// the numbers of band entries left and right of the diagonal. On the interior rows both
+/// are the constant `W − 1`, so that the loops over them unroll.
+#[inline(always)]
+fn for_rows<const W: usize>(n: usize, mut f: impl FnMut(usize, usize, usize)) {
+    let bw = W - 1;
+    let head = bw.min(n);
+    let tail = n.saturating_sub(bw).max(head);
+    for i in 0..head {
+        f(i, i, (n - 1 - i).min(bw));
+    }
+    for i in head..tail {
+        f(i, bw, bw);
+    }
+    for i in tail..n {
+        f(i, i.min(bw), n - 1 - i);
+    }
+}
+
+/// Row `i` of `A x` for a symmetric band `rows`, summed as [`SymBanded::mul_vec`] does:
+/// the diagonal term, then the `lower` terms left of it in ascending column, then the
+/// `upper` terms right of it in ascending column.
+#[inline(always)]
+fn product_row<const W: usize>(
+    rows: &[[f64; W]],
+    x: &[f64],
+    i: usize,
+    lower: usize,
+    upper: usize,
+) -> f64 {
+    let row = &rows[i];
+    let mut acc = row[0] * x[i];
+    for d in (1..=lower).rev() {
+        acc += row[d] * x[i - d];
+    }
+    for d in 1..=upper {
+        acc += rows[i + d][d] * x[i + d];
+    }
+    acc
+}
+
+/// Row `i` of `L z`, summed as [`BandedCholesky::mul_lower_row`] does: `0 + Σ_k L_ik z_k`,
+/// `k` ascending over the `lower` entries left of the diagonal, then the diagonal.
+#[inline(always)]
+fn lower_row<const W: usize>(row: &[f64; W], z: &[f64], i: usize, lower: usize) -> f64 {
+    let mut acc = 0.0;
+    for d in (1..=lower).rev() {
+        acc += row[d] * z[i - d];
+    }
+    acc + row[0] * z[i]
+}
+
+/// `window ← [v, window[0], …]`: the last values of a sweep, nearest first.
+#[inline(always)]
+fn push<const W: usize>(window: &mut [f64; W], v: f64) {
+    for k in (1..W).rev() {
+        window[k] = window[k - 1];
+    }
+    window[0] = v;
+}
+
+/// The values of a forward sweep before row `i ≥ W − 1`, nearest first:
+/// `window[d − 1] = y_{i−d}` for `d = 1 … W − 1` (the last slot is unused). Held in
+/// registers over the interior rows: read back from memory, each would wait for the store
+/// of the previous row.
+#[inline(always)]
+fn window_before<const W: usize>(y: &[f64], i: usize) -> [f64; W] {
+    let mut window = [0.0; W];
+    for d in 1..W {
+        window[d - 1] = y[i - d];
+    }
+    window
+}
+
+/// The values of a backward sweep after row `i`, nearest first: `window[d − 1] = x_{i+d}`
+/// for `d = 1 … W − 1`, `i + W − 1 < n`.
+#[inline(always)]
+fn window_after<const W: usize>(x: &[f64], i: usize) -> [f64; W] {
+    let mut window = [0.0; W];
+    window[..W - 1].copy_from_slice(&x[i + 1..i + W]);
+    window
+}
+
+/// `s − Σ_{d = W−1 … 2} row[d]·y_{i−d}`: the first terms of an interior row `i ≥ W − 1`
+/// of the forward sweep `y_i = (s − Σ_k L_ik y_k)·inv` (`k` ascending), formed in the
+/// iteration of row `i − 1`, before `y_{i−1}` is pushed (`window[d − 2] = y_{i−d}`).
+#[inline(always)]
+fn far_terms<const W: usize>(row: &[f64; W], window: &[f64; W], mut s: f64) -> f64 {
+    for d in (2..W).rev() {
+        s -= row[d] * window[d - 2];
+    }
+    s
+}
+
+/// [`far_terms`] for the first interior row `i`, reading `y_{i−d}` from `y`.
+#[inline(always)]
+fn far_terms_from<const W: usize>(row: &[f64; W], y: &[f64], i: usize, mut s: f64) -> f64 {
+    for d in (2..W).rev() {
+        s -= row[d] * y[i - d];
+    }
+    s
+}
+
+/// `s − row[1]·y_{i−1}` (`window[0] = y_{i−1}`): the last term of an interior forward row, after
+/// [`far_terms`].
+#[inline(always)]
+fn near_term<const W: usize>(row: &[f64; W], window: &[f64; W], s: f64) -> f64 {
+    if W > 1 { s - row[1] * window[0] } else { s }
+}
+
+/// A first row of the forward sweep (`i < W − 1`), the previous values read from `y`.
+#[inline(always)]
+fn forward_row_edge<const W: usize>(
+    row: &[f64; W],
+    y: &[f64],
+    i: usize,
+    mut s: f64,
+    inv: f64,
+) -> f64 {
+    for d in (1..=i).rev() {
+        s -= row[d] * y[i - d];
+    }
+    s * inv
+}
+
+/// One interior row of the backward sweep (`i + W − 1 < n`): `x_i = (s − Σ_k L_ki x_k)·inv`,
+/// `k` ascending over the `W − 1` next rows, whose values `window` holds
+/// ([`window_after`]); `x_i` is pushed onto `window`.
+#[inline(always)]
+fn backward_row<const W: usize>(
+    rows: &[[f64; W]],
+    window: &mut [f64; W],
+    i: usize,
+    mut s: f64,
+    inv: f64,
+) -> f64 {
+    for d in 1..W {
+        s -= rows[i + d][d] * window[d - 1];
+    }
+    let v = s * inv;
+    push(window, v);
+    v
+}
+
+/// A last row of the backward sweep (`i + W − 1 ≥ n`), the next values read from `x`.
+#[inline(always)]
+fn backward_row_edge<const W: usize>(
+    rows: &[[f64; W]],
+    x: &[f64],
+    i: usize,
+    mut s: f64,
+    inv: f64,
+) -> f64 {
+    for d in 1..rows.len() - i {
+        s -= rows[i + d][d] * x[i + d];
+    }
+    s * inv
 }
 
 #[cfg(test)]
@@ -530,6 +1080,126 @@ mod tests {
             );
             assert_eq!(c, expected);
         }
+    }
+
+    /// A test vector with signed zeros among its entries (a sign of zero that a
+    /// padded kernel would flip shows up in the bitwise comparisons).
+    fn test_vector(n: usize, phase: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| match i % 5 {
+                1 => -0.0,
+                3 => 0.0,
+                _ => (i as f64 * 0.91 + phase).sin(),
+            })
+            .collect()
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// The fixed-bandwidth kernels behind the public products and solves (bandwidths 1 to
+    /// 3) perform the operations of the generic loops in the same order: bit-identical
+    /// results, at every size including those smaller than the band, for the generic
+    /// bandwidths too.
+    #[test]
+    fn fixed_bandwidth_kernels_are_bit_identical_to_generic_loops() {
+        for bw in 0..=5 {
+            for n in 1..=13 {
+                let (a, r) = (spd(n, bw), spd(n, bw).cholesky().unwrap());
+                let mut other = spd(n, bw);
+                for i in 0..n {
+                    other.add(i, i, -(bw as f64) - 0.5).unwrap();
+                }
+                let l = a.cholesky().unwrap();
+                let x = test_vector(n, 0.3);
+                let g = test_vector(n, 1.7);
+
+                let (mut y, mut y_ref) = (vec![0.0; n], vec![0.0; n]);
+                other.mul_vec(&x, &mut y);
+                other.mul_vec_generic(&x, &mut y_ref);
+                assert_eq!(bits(&y), bits(&y_ref), "mul_vec n={n} bw={bw}");
+
+                let (mut s, mut s_ref) = (g.clone(), g.clone());
+                l.solve_in_place(&mut s);
+                l.forward_generic(&mut s_ref);
+                l.backward_generic(&mut s_ref);
+                assert_eq!(bits(&s), bits(&s_ref), "solve n={n} bw={bw}");
+
+                let (mut u, mut u_ref) = (g.clone(), g.clone());
+                l.solve_upper_in_place(&mut u);
+                l.backward_generic(&mut u_ref);
+                assert_eq!(bits(&u), bits(&u_ref), "solve_upper n={n} bw={bw}");
+                let mut u_into = vec![0.0; n];
+                l.solve_upper_into(&g, &mut u_into);
+                assert_eq!(
+                    bits(&u_into),
+                    bits(&u_ref),
+                    "solve_upper_into n={n} bw={bw}"
+                );
+
+                // fused product + extra + forward sweep, then the backward sweep
+                let mut calls = Vec::new();
+                let mut f = vec![0.0; n];
+                l.solve_lower_product(
+                    &other,
+                    &x,
+                    |i| {
+                        calls.push(i);
+                        0.25 * g[i]
+                    },
+                    &mut f,
+                );
+                assert_eq!(calls, (0..n).collect::<Vec<_>>());
+                let mut out = vec![0.0; n];
+                l.solve_upper_into(&f, &mut out);
+                let mut b_ref = vec![0.0; n];
+                other.mul_vec_generic(&x, &mut b_ref);
+                for (b, gi) in b_ref.iter_mut().zip(&g) {
+                    *b += 0.25 * gi;
+                }
+                l.forward_generic(&mut b_ref);
+                assert_eq!(bits(&f), bits(&b_ref), "forward product n={n} bw={bw}");
+                l.backward_generic(&mut b_ref);
+                assert_eq!(bits(&out), bits(&b_ref), "product solve n={n} bw={bw}");
+
+                // L z: the row-wise form against the plain loop
+                let w = bw + 1;
+                let lz_ref: Vec<f64> = (0..n)
+                    .map(|i| {
+                        let mut acc = 0.0;
+                        for k in i.saturating_sub(bw)..=i {
+                            acc += r.data[i * w + (i - k)] * x[k];
+                        }
+                        acc
+                    })
+                    .collect();
+                let mut lz = vec![0.0; n];
+                r.mul_lower(&x, &mut lz);
+                assert_eq!(bits(&lz), bits(&lz_ref), "mul_lower n={n} bw={bw}");
+                let mut lz_in_place = x.clone();
+                r.mul_lower_in_place(&mut lz_in_place);
+                assert_eq!(bits(&lz_in_place), bits(&lz_ref), "mul_lower_in_place");
+            }
+        }
+    }
+
+    /// A product solve with matrices of different bandwidths takes the generic path.
+    #[test]
+    fn product_solve_with_mixed_bandwidths() {
+        let (a, l) = (spd(11, 1), spd(11, 3).cholesky().unwrap());
+        let x = test_vector(11, 0.1);
+        let mut f = vec![0.0; 11];
+        l.solve_lower_product(&a, &x, |i| i as f64, &mut f);
+        let mut b = vec![0.0; 11];
+        a.mul_vec(&x, &mut b);
+        for (i, bi) in b.iter_mut().enumerate() {
+            *bi += i as f64;
+        }
+        l.solve_in_place(&mut b);
+        let mut out = vec![0.0; 11];
+        l.solve_upper_into(&f, &mut out);
+        assert_eq!(bits(&out), bits(&b));
     }
 
     #[test]

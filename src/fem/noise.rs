@@ -60,7 +60,60 @@ enum Source {
         /// `sqrt(ξ/h_e)` per element.
         amplitude: Vec<f64>,
         loads: Vec<ElementLoad>,
+        /// The same loads by free DOF, for [`NoiseStream`].
+        by_dof: DofLoads,
     },
+}
+
+/// The element loads gathered by free DOF: the contributions `(e, b_e[p])` to DOF `i` are
+/// `entries[start[i]..start[i + 1]]`, in the order in which [`NoiseGenerator::draw`]
+/// scatters them (ascending element, then local DOF).
+#[derive(Debug, Clone)]
+struct DofLoads {
+    start: Vec<usize>,
+    entries: Vec<(usize, f64)>,
+    /// Number of elements (drawn in element order) that DOFs `0 … i` need: one more than
+    /// the largest element loading any of them, and all elements for the last DOF.
+    elements_needed: Vec<usize>,
+}
+
+impl DofLoads {
+    fn new(n: usize, loads: &[ElementLoad]) -> Self {
+        let mut elements_needed = Vec::with_capacity(n);
+        let mut per_dof = vec![Vec::new(); n];
+        for (e, (b, dofs)) in loads.iter().enumerate() {
+            for (bv, d) in b.iter().zip(dofs) {
+                if let Some(i) = d {
+                    per_dof[*i].push((e, *bv));
+                }
+            }
+        }
+        let mut start = Vec::with_capacity(n + 1);
+        start.push(0);
+        let mut entries = Vec::new();
+        let mut needed = 0;
+        for list in per_dof {
+            needed = list.iter().fold(needed, |m, &(e, _)| m.max(e + 1));
+            elements_needed.push(needed);
+            entries.extend(list);
+            start.push(entries.len());
+        }
+        if let Some(last) = elements_needed.last_mut() {
+            *last = loads.len();
+        }
+        DofLoads {
+            start,
+            entries,
+            elements_needed,
+        }
+    }
+}
+
+/// One standard normal `N(0, 1)` from `rng`, as every draw of this module takes it
+/// (`rand_distr::StandardNormal`).
+#[inline]
+pub fn standard_normal<R: rand::Rng + ?Sized>(rng: &mut R) -> f64 {
+    rng.sample(StandardNormal)
 }
 
 /// Draws the standardized noise vector `ζ` (covariance `Σ_ζ`) over the free DOFs of a
@@ -89,7 +142,12 @@ impl NoiseGenerator {
                     .map(|e| (xi / mesh.element_length(e)).sqrt())
                     .collect();
                 let loads = beam.load_vectors().to_vec();
-                Source::ElementUniform { amplitude, loads }
+                let by_dof = DofLoads::new(n, &loads);
+                Source::ElementUniform {
+                    amplitude,
+                    loads,
+                    by_dof,
+                }
             }
         };
         Ok(NoiseGenerator { model, n, source })
@@ -98,6 +156,17 @@ impl NoiseGenerator {
     /// The noise model.
     pub fn model(&self) -> NoiseModel {
         self.model
+    }
+
+    /// For [`NoiseModel::Consistent`], the factor `L` of `C = LLᵀ` with which
+    /// [`Self::draw`] forms `ζ = L z` from `z_0 … z_{n−1}` drawn in this order by
+    /// [`standard_normal`]; `None` for [`NoiseModel::ElementUniform`]. For fused kernels
+    /// such as [`BandedCholesky::solve_lower_product_noise`].
+    pub fn lower_factor(&self) -> Option<&BandedCholesky> {
+        match &self.source {
+            Source::Consistent(l) => Some(l),
+            Source::ElementUniform { .. } => None,
+        }
     }
 
     /// Number of free DOFs (length of the drawn vector).
@@ -117,15 +186,16 @@ impl NoiseGenerator {
         match &self.source {
             Source::Consistent(l) => {
                 for v in out.iter_mut() {
-                    *v = rng.sample(StandardNormal);
+                    *v = standard_normal(rng);
                 }
                 l.mul_lower_in_place(out);
             }
-            Source::ElementUniform { amplitude, loads } => {
+            Source::ElementUniform {
+                amplitude, loads, ..
+            } => {
                 out.fill(0.0);
                 for (a, (b, dofs)) in amplitude.iter().zip(loads) {
-                    let z: f64 = rng.sample(StandardNormal);
-                    let f = a * z;
+                    let f = a * standard_normal(rng);
                     for (bv, d) in b.iter().zip(dofs) {
                         if let Some(i) = d {
                             out[*i] += f * bv;
@@ -133,6 +203,34 @@ impl NoiseGenerator {
                     }
                 }
             }
+        }
+    }
+
+    /// The same draw as [`Self::draw`], handed out one entry at a time: pull `ζ_0, ζ_1,
+    /// …, ζ_{n−1}` with [`NoiseStream::next_value`], e.g. while a banded sweep consumes
+    /// them. The random numbers are drawn as they are needed, in the order of
+    /// [`Self::draw`], and every entry is bit-identical to that of [`Self::draw`] with the
+    /// same generator state. After all `n` entries the generator has consumed exactly the
+    /// draws of [`Self::draw`]; pulling fewer leaves the draw incomplete.
+    ///
+    /// `scratch` is resized to the length needed (no allocation once it has it).
+    pub fn stream<'a, R: rand::Rng + ?Sized>(
+        &'a self,
+        rng: &'a mut R,
+        scratch: &'a mut Vec<f64>,
+    ) -> NoiseStream<'a, R> {
+        let len = match &self.source {
+            Source::Consistent(_) => self.n,
+            Source::ElementUniform { amplitude, .. } => amplitude.len(),
+        };
+        scratch.resize(len, 0.0);
+        NoiseStream {
+            source: &self.source,
+            n: self.n,
+            rng,
+            scratch,
+            next: 0,
+            drawn: 0,
         }
     }
 
@@ -154,7 +252,9 @@ impl NoiseGenerator {
                 let l = l.to_dense_lower();
                 &l * l.transpose()
             }
-            Source::ElementUniform { amplitude, loads } => {
+            Source::ElementUniform {
+                amplitude, loads, ..
+            } => {
                 let mut cov = DMatrix::zeros(self.n, self.n);
                 for (a, (b, dofs)) in amplitude.iter().zip(loads) {
                     for p in 0..4 {
@@ -166,6 +266,96 @@ impl NoiseGenerator {
                     }
                 }
                 cov
+            }
+        }
+    }
+}
+
+/// One draw of `ζ` handed out entry by entry ([`NoiseGenerator::stream`]).
+pub struct NoiseStream<'a, R: ?Sized> {
+    source: &'a Source,
+    n: usize,
+    rng: &'a mut R,
+    /// `z_k` drawn so far (consistent) or `sqrt(ξ/h_e)·z_e` per element drawn so far
+    /// (element-uniform).
+    scratch: &'a mut [f64],
+    /// Index of the next entry.
+    next: usize,
+    /// Entries of `scratch` drawn so far.
+    drawn: usize,
+}
+
+impl<R: rand::Rng + ?Sized> NoiseStream<'_, R> {
+    /// Draws now what the entries `ζ_i`, `i < end`, need (consistent: `z_i`;
+    /// element-uniform: every element up to the last one loading one of these DOFs, and
+    /// for `end = n` every element), so that pulling them makes no calls to the
+    /// generator. Optional: [`Self::next_value`] draws whatever is missing. The draws
+    /// and their order are the same either way.
+    #[inline]
+    pub fn prepare(&mut self, end: usize) {
+        if end == 0 {
+            return;
+        }
+        let end = end.min(self.n);
+        match self.source {
+            Source::Consistent(_) => {
+                while self.drawn < end {
+                    self.scratch[self.drawn] = standard_normal(self.rng);
+                    self.drawn += 1;
+                }
+            }
+            Source::ElementUniform {
+                amplitude, by_dof, ..
+            } => {
+                let needed = by_dof.elements_needed[end - 1];
+                while self.drawn < needed {
+                    let z = standard_normal(self.rng);
+                    self.scratch[self.drawn] = amplitude[self.drawn] * z;
+                    self.drawn += 1;
+                }
+            }
+        }
+    }
+
+    /// The next entry `ζ_i` (`i = 0, 1, …`): for consistent noise, row `i` of `L z`
+    /// ([`BandedCholesky::mul_lower_row`]); for element-uniform noise, the sum of the
+    /// loads of the elements on DOF `i`. Draws what [`Self::prepare`] has not drawn yet
+    /// (after `ζ_{n−1}`, also the elements loading no free DOF).
+    ///
+    /// # Panics
+    /// If all `n` entries have been pulled already.
+    #[inline]
+    pub fn next_value(&mut self) -> f64 {
+        self.prepare(self.next + 1);
+        self.next_prepared()
+    }
+
+    /// [`Self::next_value`] for an entry that [`Self::prepare`] has drawn for: never
+    /// calls the generator (so a sweep over prepared entries keeps its values in
+    /// registers).
+    ///
+    /// # Panics
+    /// If all `n` entries have been pulled already, or the entry was not prepared.
+    #[inline]
+    pub fn next_prepared(&mut self) -> f64 {
+        let i = self.next;
+        assert!(i < self.n, "NoiseStream: all {} entries drawn", self.n);
+        self.next += 1;
+        match self.source {
+            Source::Consistent(l) => {
+                assert!(i < self.drawn, "NoiseStream: entry {i} not prepared");
+                l.mul_lower_row(self.scratch, i)
+            }
+            Source::ElementUniform { by_dof, .. } => {
+                assert!(
+                    by_dof.elements_needed[i] <= self.drawn,
+                    "NoiseStream: entry {i} not prepared"
+                );
+                let mut s = 0.0;
+                for &(e, bv) in &by_dof.entries[by_dof.start[i]..by_dof.start[i + 1]] {
+                    s += self.scratch[e] * bv;
+                }
+                s
             }
         }
     }
@@ -226,6 +416,34 @@ mod tests {
         let m: NoiseModel = serde_json::from_str("\"consistent\"").unwrap();
         assert_eq!(m, NoiseModel::Consistent);
         assert!(serde_json::from_str::<NoiseModel>("\"uniform\"").is_err());
+    }
+
+    /// The streamed draw equals the whole-vector draw bit for bit and leaves the generator
+    /// in the same state, for both models, on meshes of 1 to 12 elements.
+    #[test]
+    fn stream_matches_draw_bit_for_bit() {
+        use crate::rng::trajectory_rng;
+        use rand::Rng;
+        let params = FilamentParams::default();
+        let mut scratch = Vec::new();
+        for ne in 1..=12 {
+            let beam = BeamModel::new(params, Mesh::uniform(params.length, ne).unwrap()).unwrap();
+            for model in NoiseModel::ALL {
+                let g = NoiseGenerator::new(model, &beam).unwrap();
+                let n = g.n_dofs();
+                let (mut r1, mut r2) =
+                    (trajectory_rng(11, ne as u64), trajectory_rng(11, ne as u64));
+                for _ in 0..3 {
+                    let mut whole = vec![0.0; n];
+                    g.draw(&mut r1, &mut whole);
+                    let mut stream = g.stream(&mut r2, &mut scratch);
+                    let streamed: Vec<f64> = (0..n).map(|_| stream.next_value()).collect();
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&streamed), bits(&whole), "{model} at {ne} elements");
+                }
+                assert_eq!(r1.next_u64(), r2.next_u64(), "{model} at {ne} elements");
+            }
+        }
     }
 
     #[test]
