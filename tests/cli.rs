@@ -1244,7 +1244,7 @@ fn diverging_run_stops_with_the_step() {
     );
     let text = text
         // A step search is for the Metropolis scheme only.
-        .replace(", max_dt_tau1 = 0.64, min_acceptance = 0.6", "")
+        .replace(", max_dt_tau1 = 0.16, min_acceptance = 0.6", "")
         .replace("dt_tau1 = 0.02\n", "dt_tau1 = 7.0e-6\n")
         .replace("dt_tau1 = 0.01\n", "dt_tau1 = 3.0e-6\n")
         .replace(

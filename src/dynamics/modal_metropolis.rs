@@ -312,7 +312,9 @@ impl<'m> ModalMetropolis<'m> {
                 *o = inv[0] * (x - h * (blk[0] * x - f * gx) + sc * zx);
             }
         }
-        self.proposal.a.iter().all(|v| v.is_finite())
+        // A non-finite proposal needs no separate pass: its energy, force or ln det A
+        // comes out non-finite, so it is rejected (ln α = −∞ or NaN).
+        true
     }
 
     /// `ln α` of the move `current → proposal` (both evaluated) made with noise `self.z`.
@@ -380,19 +382,24 @@ impl<'m> ModalMetropolis<'m> {
     pub fn add_block_rotation_squares(&self, acc: &mut [f64]) {
         let n = self.n();
         let np = 2 * self.pairs.len();
-        let blocks = self.modes.pairs().iter().chain(self.modes.singles());
         assert_eq!(
             acc.len(),
             self.pairs.len() + self.singles.len(),
             "one entry per block"
         );
-        for (k, (b, out)) in blocks.zip(acc.iter_mut()).enumerate() {
-            for a in self.current.a.chunks_exact(n) {
-                let u = if k < self.pairs.len() {
-                    b.rotation[0] * a[2 * k] + b.rotation[1] * a[2 * k + 1]
-                } else {
-                    b.rotation[0] * a[np + k - self.pairs.len()]
-                };
+        let (acc_pairs, acc_singles) = acc.split_at_mut(self.pairs.len());
+        for a in self.current.a.chunks_exact(n) {
+            let (ap, as_) = a.split_at(np);
+            for ((out, b), x) in acc_pairs
+                .iter_mut()
+                .zip(self.modes.pairs())
+                .zip(ap.chunks_exact(2))
+            {
+                let u = b.rotation[0] * x[0] + b.rotation[1] * x[1];
+                *out += u * u;
+            }
+            for ((out, b), x) in acc_singles.iter_mut().zip(self.modes.singles()).zip(as_) {
+                let u = b.rotation[0] * x;
                 *out += u * u;
             }
         }
