@@ -293,6 +293,40 @@ fn bad_targets_are_refused_naming_the_key() {
     );
 }
 
+/// A Δt-halving pair naming one run twice would compare the run with itself: refused.
+#[test]
+fn a_halving_pair_of_one_run_is_refused() {
+    let dir = TempDir::new("budget-bad");
+    let text = scene_text(GOOD_FULL)
+        .replace(
+            "checks = [\"force-strain\"]",
+            "checks = [\"force-strain\", \"dt-halving\"]",
+        )
+        .replace(
+            "sample_every_tau1 = 0.05",
+            "sample_every_tau1 = 0.05\nhalving = [\"metropolis\", \"metropolis\"]",
+        );
+    let path = write_scene(&dir, "bad", text.as_bytes());
+    let args = [
+        "verify",
+        "--scene",
+        path.to_str().unwrap(),
+        "--out",
+        &dir.join_str("out"),
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    let err = stderr_of(&o);
+    for want in [
+        "bad.toml",
+        "compression.halving[1]",
+        "metropolis",
+        "another run",
+    ] {
+        assert!(err.contains(want), "{want:?} not in: {err}");
+    }
+}
+
 #[test]
 fn bad_step_searches_are_refused_naming_the_key() {
     let with = |extra: &str| {

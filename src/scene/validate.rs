@@ -561,6 +561,13 @@ impl Scene {
                         return Err(bad(self, &key, n, "the name of a run of this scene"));
                     }
                 }
+                if pair[0] == pair[1] {
+                    let allowed = format!(
+                        "the name of another run than compression.halving[0] = \"{}\" (the check compares a run at dt with one at dt/2)",
+                        pair[0]
+                    );
+                    return Err(bad(self, "compression.halving[1]", &pair[1], &allowed));
+                }
                 Ok(())
             }
             None if self.checks.contains(&CheckKind::DtHalving) => {
