@@ -293,6 +293,31 @@ fn bad_targets_are_refused_naming_the_key() {
     );
 }
 
+/// A compression step so small that a trajectory would take more than 1e10 steps (or
+/// overflow the step count) is refused naming dt_tau1, before anything runs.
+#[test]
+fn a_vanishing_compression_step_is_refused() {
+    for dt in ["1.0e-300", "1.0e-9"] {
+        let dir = TempDir::new("budget-bad");
+        let text = scene_text(GOOD_FULL).replace("dt_tau1 = 0.02", &format!("dt_tau1 = {dt}"));
+        let path = write_scene(&dir, "bad", text.as_bytes());
+        let args = [
+            "verify",
+            "--scene",
+            path.to_str().unwrap(),
+            "--out",
+            &dir.join_str("out"),
+        ];
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let err = stderr_of(&o);
+        for want in ["bad.toml", "runs[0].dt_tau1", "1e10 steps per trajectory"] {
+            assert!(err.contains(want), "{want:?} not in: {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
 /// A Δt-halving pair naming one run twice would compare the run with itself: refused.
 #[test]
 fn a_halving_pair_of_one_run_is_refused() {

@@ -74,6 +74,9 @@ enum RunRules<'a> {
     Compression(&'a CompressionSpec),
 }
 
+/// The most steps one compression trajectory may take (burn-in and sampling).
+const MAX_STEPS_PER_TRAJECTORY: f64 = 1e10;
+
 impl RunRules<'_> {
     /// The integrator and noise of run `i`: linear scenes cannot use the Metropolis
     /// scheme, compression scenes neither the exact modal one nor Metropolis with
@@ -412,6 +415,27 @@ impl Scene {
         let dt = run.dt_tau1;
         if !(dt.is_finite() && dt > 0.0 && dt <= dt_max) {
             return Err(bad(self, &key("dt_tau1"), &dt, &dt_allowed));
+        }
+        if let RunRules::Compression(c) = rules {
+            // Steps per trajectory, at the longest duration any budget may run.
+            let longest = [Budget::Quick, Budget::Standard, Budget::Full]
+                .iter()
+                .map(|&b| {
+                    let e = run.ensemble(b);
+                    [e.duration_tau1, e.max_duration_tau1.unwrap_or(0.0)]
+                        .into_iter()
+                        .filter(|d| d.is_finite())
+                        .fold(0.0, f64::max)
+                })
+                .fold(0.0, f64::max)
+                .min(1e6);
+            let shortest_dt = (c.burn_in_tau1 + longest) / MAX_STEPS_PER_TRAJECTORY;
+            if dt < shortest_dt {
+                let allowed = format!(
+                    ">= (burn_in_tau1 + longest duration_tau1 = {longest})/1e10 = {shortest_dt:.3e}, at most 1e10 steps per trajectory"
+                );
+                return Err(bad(self, &key("dt_tau1"), &dt, &allowed));
+            }
         }
         for budget in [Budget::Quick, Budget::Standard, Budget::Full] {
             let e = run.ensemble(budget);
