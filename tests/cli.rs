@@ -496,6 +496,27 @@ fn usage_errors_exit_2() {
             &["verify", "--budget", "huge"],
             &["--budget", "huge", "quick"],
         ),
+        // Unbounded sizes are refused before anything runs (issue #12).
+        (
+            &[
+                "stability",
+                "--scene",
+                "hinged-linear-2d",
+                "--burn-in",
+                "18446744073709551615",
+            ],
+            &["--burn-in", "[0, 1e8]", "18446744073709551615"],
+        ),
+        (
+            &[
+                "work-precision",
+                "--scene",
+                "hinged-linear-2d",
+                "--dt-tau1",
+                "1e-12",
+            ],
+            &["--dt-tau1", "1e10 steps per trajectory"],
+        ),
     ];
     for (args, needles) in cases {
         assert_bad_input(args, needles);

@@ -272,6 +272,13 @@ fn validate(opts: &StabilityOptions) -> Result<()> {
             "an integer in [1000, 1e8]",
         ));
     }
+    if opts.burn_in_steps > 100_000_000 {
+        return Err(Error::invalid(
+            "--burn-in",
+            opts.burn_in_steps,
+            "an integer in [0, 1e8]",
+        ));
+    }
     crate::error::require_in_range("--alpha", opts.alpha, 1e-6, 0.5)?;
     Ok(())
 }

@@ -236,8 +236,20 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
     crate::error::require_in_range("--duration", opts.duration_tau1, 1.0, 1e6)?;
     crate::error::require_in_range("--em-duration", opts.em_duration_tau1, 1.0, 1e6)?;
     crate::error::require_in_range("--tolerance", opts.tolerance, 1e-6, 1.0)?;
+    // At most 1e10 sampled steps per trajectory (--dt-tau1 1e-12 would ask for 1e18).
+    let shortest = opts.duration_tau1 / MAX_STEPS_PER_TRAJECTORY;
+    if let Some(&d) = opts.dt_tau1.iter().find(|&&d| d < shortest) {
+        return Err(Error::invalid(
+            "--dt-tau1",
+            d,
+            format!(">= --duration/1e10 = {shortest:.3e} (at most 1e10 steps per trajectory)"),
+        ));
+    }
     Ok(())
 }
+
+/// The most sampled steps one trajectory of the study may take.
+const MAX_STEPS_PER_TRAJECTORY: f64 = 1e10;
 
 /// Projected wall time to reach relative error `eps` at 95 % (b + 2s ≤ ε).
 fn projected_seconds(p: &WpPoint, eps: f64) -> Option<f64> {
