@@ -523,6 +523,39 @@ fn usage_errors_exit_2() {
     }
 }
 
+/// What: an `--out` that cannot be created or written is refused before anything runs:
+/// exit 2 naming `--out`, no simulation (the verify of the paper's 3D scene would take
+/// seconds; the refusal is immediate). Set-up: `--out` below a regular file.
+/// Tolerance: exact substrings.
+#[test]
+fn unwritable_out_is_refused_before_running() {
+    let dir = TempDir::new("out-file");
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let out = file.join("reports");
+    for cmd in ["verify", "converge", "stability", "work-precision"] {
+        let mut args = vec![
+            cmd,
+            "--scene",
+            "hinged-linear-2d",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if cmd == "converge" {
+            args.extend(["--over", "elements"]);
+        }
+        let start = std::time::Instant::now();
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let err = stderr_of(&o);
+        assert!(err.contains("--out") && err.contains("a-file"), "{err}");
+        assert!(
+            start.elapsed().as_secs_f64() < 5.0,
+            "{cmd} ran before refusing --out"
+        );
+    }
+}
+
 /// What: a negative value after a space (`--bending-rigidity -1`, the usual spelling) must
 /// be reported like `--bending-rigidity=-1`: exit 2 naming the flag and its range.
 /// Today clap takes `-1` for a flag ("unexpected argument '-1' found"): the exit code

@@ -51,7 +51,7 @@ pub struct ConvergeArgs {
     duration_tau1: Option<f64>,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,

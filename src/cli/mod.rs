@@ -44,11 +44,58 @@ pub fn run() -> Result<i32> {
     let cli = Cli::parse();
     match cli.command {
         Command::Theory(args) => theory::run(args),
-        Command::Verify(args) => verify::run(args),
-        Command::Converge(args) => converge::run(args),
-        Command::Stability(args) => stability::run(args),
-        Command::WorkPrecision(args) => work_precision::run(args),
+        Command::Verify(args) => {
+            check_out_dir(&args.out)?;
+            verify::run(args)
+        }
+        Command::Converge(args) => {
+            check_out_dir(&args.out)?;
+            converge::run(args)
+        }
+        Command::Stability(args) => {
+            check_out_dir(&args.out)?;
+            stability::run(args)
+        }
+        Command::WorkPrecision(args) => {
+            check_out_dir(&args.out)?;
+            work_precision::run(args)
+        }
     }
+}
+
+/// `--out` must be, or be creatable as, a writable directory: checked before anything
+/// runs, so an unwritable location fails at once (exit 2, naming `--out`) instead of after
+/// the whole simulation. Nothing is created here: the nearest existing ancestor (or `out`
+/// itself) must be a directory that accepts a file (probed and removed at once).
+fn check_out_dir(out: &Path) -> Result<()> {
+    let fail = |why: String| {
+        Error::invalid(
+            "--out",
+            out.display(),
+            format!("a directory that can be created and written ({why})"),
+        )
+    };
+    let mut existing = out;
+    while !existing.as_os_str().is_empty() && !existing.exists() {
+        existing = existing.parent().unwrap_or(Path::new(""));
+    }
+    let existing = if existing.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        existing
+    };
+    if !existing.is_dir() {
+        return Err(fail(format!("{} is not a directory", existing.display())));
+    }
+    let probe = existing.join(format!(".langevin-fem-write-test.{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| fail(format!("cannot write in {}: {e}", existing.display())))?;
+    std::fs::remove_file(&probe).map_err(|e| {
+        fail(format!(
+            "cannot remove a file in {}: {e}",
+            existing.display()
+        ))
+    })
 }
 
 /// Parses a comma-separated list for `flag`; a bad item exits with code 2 naming the

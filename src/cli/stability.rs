@@ -43,7 +43,7 @@ pub struct StabilityArgs {
     alpha: f64,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,

@@ -19,7 +19,7 @@ pub struct VerifyArgs {
     budget: BudgetArg,
     /// Output directory for summary.json, index.html and per-scene figures and tables.
     #[arg(long, default_value = "reports")]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,

@@ -46,7 +46,7 @@ pub struct WorkPrecisionArgs {
     tolerance: f64,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,
