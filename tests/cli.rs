@@ -523,6 +523,32 @@ fn usage_errors_exit_2() {
     }
 }
 
+/// What: a `--scene` path that is a directory or a FIFO named `*.toml` is refused with
+/// exit 2 naming the file (a FIFO used to block the run, a directory exited 3).
+/// Tolerance: exact substrings; a time limit for the FIFO.
+#[test]
+fn scene_paths_that_are_not_files_are_refused() {
+    let dir = TempDir::new("scene-kinds");
+    let d = dir.path().join("x.toml");
+    std::fs::create_dir(&d).unwrap();
+    let fifo = dir.path().join("f.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    let mut cases = vec![(d, "a directory")];
+    if made.is_ok_and(|s| s.success()) {
+        cases.push((fifo, "not a regular file"));
+    }
+    for (path, want) in cases {
+        let p = path.to_str().unwrap();
+        let args = ["verify", "--scene", p, "--out", &dir.join_str("out")];
+        let start = std::time::Instant::now();
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let err = stderr_of(&o);
+        assert!(err.contains(p) && err.contains(want), "{err}");
+        assert!(start.elapsed().as_secs_f64() < 5.0);
+    }
+}
+
 /// What: an `--out` that cannot be created or written is refused before anything runs:
 /// exit 2 naming `--out`, no simulation (the verify of the paper's 3D scene would take
 /// seconds; the refusal is immediate). Set-up: `--out` below a regular file.

@@ -85,6 +85,9 @@ use crate::params::FilamentParams;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+/// The largest scene file read (1 MiB; the shipped scenes are a few KiB).
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
 /// The ensemble size and duration of a run at one budget.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -403,6 +406,28 @@ impl Scene {
     /// [`Error::Io`] if unreadable; [`Error::Scene`] naming the file, key, value and
     /// allowed range if invalid.
     pub fn load(path: &Path) -> Result<Scene> {
+        // A directory, FIFO or device named *.toml is the user's mistake (exit 2), and a
+        // FIFO must not block the run: only regular files of bounded size are read.
+        let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+        let refuse = |message: String| Error::Scene {
+            file: path.to_path_buf(),
+            key: "-".to_string(),
+            message,
+        };
+        if !meta.is_file() {
+            let what = if meta.is_dir() {
+                "a directory"
+            } else {
+                "not a regular file (a FIFO, socket or device)"
+            };
+            return Err(refuse(format!("is {what}: a scene is a TOML text file")));
+        }
+        if meta.len() > MAX_SCENE_BYTES {
+            return Err(refuse(format!(
+                "is {} bytes: a scene file has at most {MAX_SCENE_BYTES} bytes",
+                meta.len()
+            )));
+        }
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         let text = String::from_utf8(bytes).map_err(|e| Error::Scene {
             file: path.to_path_buf(),
