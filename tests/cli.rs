@@ -549,6 +549,37 @@ fn scene_paths_that_are_not_files_are_refused() {
     }
 }
 
+/// What: temporary files that a killed run left in `--out` (`.<name>.tmp.<pid>.<n>` of a
+/// process that is gone) are removed by the next run, which says so.
+/// Tolerance: exact substrings.
+#[test]
+fn stale_temporaries_of_killed_runs_are_removed() {
+    if !Path::new("/proc").is_dir() {
+        return;
+    }
+    let dir = TempDir::new("stale-tmp");
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("hinged-linear-2d")).unwrap();
+    let stale = [
+        out.join(".summary.json.tmp.4000000000.0"),
+        out.join("hinged-linear-2d")
+            .join(".modes.csv.tmp.4000000000.5"),
+    ];
+    for p in &stale {
+        std::fs::write(p, b"half").unwrap();
+    }
+    let tiny = fixture(TINY).display().to_string();
+    let args = ["verify", "--scene", &tiny, "--out", out.to_str().unwrap()];
+    let o = run(&args);
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        describe(&args, &o)
+    );
+    assert!(stale.iter().all(|p| !p.exists()));
+    assert!(stderr_of(&o).contains("removed 2 temporary file(s)"));
+}
+
 /// What: an `--out` that cannot be created or written is refused before anything runs:
 /// exit 2 naming `--out`, no simulation (the verify of the paper's 3D scene would take
 /// seconds; the refusal is immediate). Set-up: `--out` below a regular file.

@@ -66,7 +66,9 @@ pub fn run() -> Result<i32> {
 /// `--out` must be, or be creatable as, a writable directory: checked before anything
 /// runs, so an unwritable location fails at once (exit 2, naming `--out`) instead of after
 /// the whole simulation. Nothing is created here: the nearest existing ancestor (or `out`
-/// itself) must be a directory that accepts a file (probed and removed at once).
+/// itself) must be a directory that accepts a file (probed and removed at once). The
+/// temporary files that interrupted runs left in an existing `out` are removed
+/// ([`langevin_fem::output::remove_stale_temporaries`]).
 fn check_out_dir(out: &Path) -> Result<()> {
     let fail = |why: String| {
         Error::invalid(
@@ -90,6 +92,15 @@ fn check_out_dir(out: &Path) -> Result<()> {
     let probe = existing.join(format!(".langevin-fem-write-test.{}", std::process::id()));
     std::fs::write(&probe, b"")
         .map_err(|e| fail(format!("cannot write in {}: {e}", existing.display())))?;
+    if out.is_dir() {
+        let removed = langevin_fem::output::remove_stale_temporaries(out);
+        if removed > 0 {
+            eprintln!(
+                "removed {removed} temporary file(s) left in {} by interrupted runs",
+                out.display()
+            );
+        }
+    }
     std::fs::remove_file(&probe).map_err(|e| {
         fail(format!(
             "cannot remove a file in {}: {e}",

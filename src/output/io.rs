@@ -52,6 +52,63 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// Removes the temporary files that interrupted runs left in `dir` and its
+/// subdirectories (two levels down): files named like those of [`write_atomic`],
+/// `.<name>.tmp.<pid>.<n>`, whose process is gone (on Linux: no `/proc/<pid>`; elsewhere:
+/// older than a day). Files of this process and of running processes are kept. Returns
+/// the number removed; errors are ignored (best effort, like the files themselves).
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    fn walk(dir: &Path, depth: usize, removed: &mut usize) {
+        let Ok(entries) = fs::read_dir(dir) else {
+            return;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let Ok(kind) = entry.file_type() else {
+                continue;
+            };
+            if kind.is_dir() && depth > 0 {
+                walk(&path, depth - 1, removed);
+            } else if kind.is_file() && is_stale_temporary(&path) && fs::remove_file(&path).is_ok()
+            {
+                *removed += 1;
+            }
+        }
+    }
+    let mut removed = 0;
+    walk(dir, 2, &mut removed);
+    removed
+}
+
+/// Whether `path` is a temporary file of [`write_atomic`] whose writer is gone.
+fn is_stale_temporary(path: &Path) -> bool {
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    let mut parts = name.rsplitn(4, '.');
+    let (Some(n), Some(pid), Some("tmp"), Some(rest)) =
+        (parts.next(), parts.next(), parts.next(), parts.next())
+    else {
+        return false;
+    };
+    let (Ok(_), Ok(pid)) = (n.parse::<u64>(), pid.parse::<u32>()) else {
+        return false;
+    };
+    if !rest.starts_with('.') || rest.len() < 2 || pid == std::process::id() {
+        return false;
+    }
+    let proc_dir = Path::new("/proc");
+    if proc_dir.is_dir() {
+        !proc_dir.join(pid.to_string()).exists()
+    } else {
+        fs::metadata(path)
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() > 86_400)
+    }
+}
+
 fn write_and_sync(temp: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut file = OpenOptions::new().write(true).create_new(true).open(temp)?;
     file.write_all(bytes)?;
@@ -153,4 +210,37 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
     let mut text = serde_json::to_string_pretty(value).map_err(|e| Error::io(path, e.into()))?;
     text.push('\n');
     write_atomic(path, text.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Stale temporaries of a dead process are removed, down to two directory levels;
+    /// this process's, other names and deeper files are kept.
+    #[test]
+    fn stale_temporaries_are_removed() {
+        let root = std::env::temp_dir().join(format!("lfem-stale-{}", std::process::id()));
+        let sub = root.join("scene");
+        fs::create_dir_all(&sub).unwrap();
+        let dead = 4_000_000_000u32; // above any Linux pid_max
+        let stale = [
+            root.join(format!(".summary.json.tmp.{dead}.0")),
+            sub.join(format!(".force-strain.csv.tmp.{dead}.17")),
+        ];
+        let kept = [
+            root.join(format!(".summary.json.tmp.{}.3", std::process::id())),
+            root.join("summary.json"),
+            root.join(".summary.json.tmp.x.0"),
+        ];
+        for p in stale.iter().chain(&kept) {
+            fs::write(p, b"x").unwrap();
+        }
+        if Path::new("/proc").is_dir() {
+            assert_eq!(remove_stale_temporaries(&root), 2);
+            assert!(stale.iter().all(|p| !p.exists()));
+        }
+        assert!(kept.iter().all(|p| p.exists()));
+        fs::remove_dir_all(&root).unwrap();
+    }
 }

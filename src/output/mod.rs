@@ -14,4 +14,4 @@ pub mod figure;
 pub mod io;
 
 pub use figure::{Figure, Series, SeriesStyle};
-pub use io::{write_atomic, write_csv, write_json};
+pub use io::{remove_stale_temporaries, write_atomic, write_csv, write_json};
