@@ -231,6 +231,45 @@ fn a_step_search_chooses_steps_per_strain_and_says_so() {
     assert!(!summary.contains("NaN"), "{summary}");
 }
 
+/// The step search and the budget it drives do not depend on the thread count: the
+/// full budget with a search (probes and pilot in parallel over strains, main stage over
+/// strain × trajectory) writes byte-identical CSV files with 1 and 2 threads.
+#[test]
+fn a_step_search_does_not_depend_on_the_thread_count() {
+    let dir = TempDir::new("budget-threads");
+    let path = write_scene(&dir, "search", scene_text(SEARCH_FULL).as_bytes());
+    let mut csv = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.join_str(&format!("out{threads}"));
+        let args = [
+            "verify",
+            "--scene",
+            path.to_str().unwrap(),
+            "--budget",
+            "full",
+            "--out",
+            &out,
+        ];
+        let o = common::command()
+            .args(args)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("binary runs");
+        assert!(
+            matches!(o.status.code(), Some(0 | 1)),
+            "{}",
+            describe(&args, &o)
+        );
+        csv.push(
+            std::fs::read(dir.join(&format!("out{threads}/search/force-strain.csv"))).unwrap(),
+        );
+    }
+    assert!(
+        csv[0] == csv[1],
+        "force-strain.csv differs between 1 and 2 threads"
+    );
+}
+
 /// A bad targeted budget: exit 2, the message names the file, the key and the value.
 fn assert_refused(full: &str, key: &str, value: &str) {
     let dir = TempDir::new("budget-bad");
