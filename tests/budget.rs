@@ -148,29 +148,41 @@ fn fig2_scenes_use_a_target_at_the_full_budget() {
     }
 }
 
+/// Runs `verify --budget full` on `scene` into `dir/<out>` (with `RAYON_NUM_THREADS =
+/// threads` if given), asserts that it ran (exit 0, or 1 for a failed check) and returns
+/// its `summary.json`.
+fn run_full(dir: &TempDir, scene: &Path, out: &str, threads: Option<&str>) -> String {
+    let out_s = dir.join_str(out);
+    let args = [
+        "verify",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--budget",
+        "full",
+        "--out",
+        &out_s,
+    ];
+    let mut c = common::command();
+    c.args(args);
+    if let Some(t) = threads {
+        c.env("RAYON_NUM_THREADS", t);
+    }
+    let o = c.output().expect("binary runs");
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        describe(&args, &o)
+    );
+    std::fs::read_to_string(dir.join(&format!("{out}/summary.json"))).unwrap()
+}
+
 /// The targeted budget runs end to end: the note names the pilot, the main stage and why
 /// the errors stay honest; the quick (fixed) budget's note is unchanged in form.
 #[test]
 fn a_targeted_budget_runs_and_says_so() {
     let dir = TempDir::new("budget-run");
     let path = write_scene(&dir, "target", scene_text(GOOD_FULL).as_bytes());
-    let out = dir.join_str("out");
-    let args = [
-        "verify",
-        "--scene",
-        path.to_str().unwrap(),
-        "--budget",
-        "full",
-        "--out",
-        &out,
-    ];
-    let o = run(&args);
-    assert!(
-        matches!(o.status.code(), Some(0 | 1)),
-        "{}",
-        describe(&args, &o)
-    );
-    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    let summary = run_full(&dir, &path, "out", None);
     assert!(summary.contains("budget by target precision"), "{summary}");
     assert!(summary.contains("no optional-stopping bias"), "{summary}");
     assert!(!summary.contains("NaN"), "{summary}");
@@ -186,23 +198,7 @@ const SEARCH_FULL: &str = "{ trajectories = 4, target_std_error = 0.05, pilot_ta
 fn a_step_search_chooses_steps_per_strain_and_says_so() {
     let dir = TempDir::new("budget-search");
     let path = write_scene(&dir, "search", scene_text(SEARCH_FULL).as_bytes());
-    let out = dir.join_str("out");
-    let args = [
-        "verify",
-        "--scene",
-        path.to_str().unwrap(),
-        "--budget",
-        "full",
-        "--out",
-        &out,
-    ];
-    let o = run(&args);
-    assert!(
-        matches!(o.status.code(), Some(0 | 1)),
-        "{}",
-        describe(&args, &o)
-    );
-    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    let summary = run_full(&dir, &path, "out", None);
     let v: serde_json::Value = serde_json::from_str(&summary).unwrap();
     let notes = v["scenes"][0]["notes"].to_string();
     let start = notes.find("Chosen dt per strain (tau1): ").expect(&notes) + 29;
@@ -240,29 +236,9 @@ fn a_step_search_does_not_depend_on_the_thread_count() {
     let path = write_scene(&dir, "search", scene_text(SEARCH_FULL).as_bytes());
     let mut csv = Vec::new();
     for threads in ["1", "2"] {
-        let out = dir.join_str(&format!("out{threads}"));
-        let args = [
-            "verify",
-            "--scene",
-            path.to_str().unwrap(),
-            "--budget",
-            "full",
-            "--out",
-            &out,
-        ];
-        let o = common::command()
-            .args(args)
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .expect("binary runs");
-        assert!(
-            matches!(o.status.code(), Some(0 | 1)),
-            "{}",
-            describe(&args, &o)
-        );
-        csv.push(
-            std::fs::read(dir.join(&format!("out{threads}/search/force-strain.csv"))).unwrap(),
-        );
+        let out = format!("out{threads}");
+        run_full(&dir, &path, &out, Some(threads));
+        csv.push(std::fs::read(dir.join(&format!("{out}/search/force-strain.csv"))).unwrap());
     }
     assert!(
         csv[0] == csv[1],
@@ -270,10 +246,11 @@ fn a_step_search_does_not_depend_on_the_thread_count() {
     );
 }
 
-/// A bad targeted budget: exit 2, the message names the file, the key and the value.
-fn assert_refused(full: &str, key: &str, value: &str) {
+/// A bad scene `text` (written as `bad.toml`): `verify` exits 2 without a panic, and the
+/// message names the file and contains every one of `needles`.
+fn assert_text_refused(text: &str, needles: &[&str]) {
     let dir = TempDir::new("budget-bad");
-    let path = write_scene(&dir, "bad", scene_text(full).as_bytes());
+    let path = write_scene(&dir, "bad", text.as_bytes());
     let out = dir.join_str("out");
     let args = [
         "verify",
@@ -287,10 +264,15 @@ fn assert_refused(full: &str, key: &str, value: &str) {
     let o = run(&args);
     assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
     let err = stderr_of(&o);
-    for want in ["bad.toml", key, value] {
+    for want in std::iter::once(&"bad.toml").chain(needles) {
         assert!(err.contains(want), "{want:?} not in: {err}");
     }
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// A bad targeted budget: exit 2, the message names the file, the key and the value.
+fn assert_refused(full: &str, key: &str, value: &str) {
+    assert_text_refused(&scene_text(full), &[key, value]);
 }
 
 #[test]
@@ -337,30 +319,14 @@ fn bad_targets_are_refused_naming_the_key() {
 #[test]
 fn a_vanishing_compression_step_is_refused() {
     for dt in ["1.0e-300", "1.0e-9"] {
-        let dir = TempDir::new("budget-bad");
         let text = scene_text(GOOD_FULL).replace("dt_tau1 = 0.02", &format!("dt_tau1 = {dt}"));
-        let path = write_scene(&dir, "bad", text.as_bytes());
-        let args = [
-            "verify",
-            "--scene",
-            path.to_str().unwrap(),
-            "--out",
-            &dir.join_str("out"),
-        ];
-        let o = run(&args);
-        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
-        let err = stderr_of(&o);
-        for want in ["bad.toml", "runs[0].dt_tau1", "1e10 steps per trajectory"] {
-            assert!(err.contains(want), "{want:?} not in: {err}");
-        }
-        assert!(!err.contains("panicked"), "{err}");
+        assert_text_refused(&text, &["runs[0].dt_tau1", "1e10 steps per trajectory"]);
     }
 }
 
 /// A Δt-halving pair naming one run twice would compare the run with itself: refused.
 #[test]
 fn a_halving_pair_of_one_run_is_refused() {
-    let dir = TempDir::new("budget-bad");
     let text = scene_text(GOOD_FULL)
         .replace(
             "checks = [\"force-strain\"]",
@@ -370,25 +336,10 @@ fn a_halving_pair_of_one_run_is_refused() {
             "sample_every_tau1 = 0.05",
             "sample_every_tau1 = 0.05\nhalving = [\"metropolis\", \"metropolis\"]",
         );
-    let path = write_scene(&dir, "bad", text.as_bytes());
-    let args = [
-        "verify",
-        "--scene",
-        path.to_str().unwrap(),
-        "--out",
-        &dir.join_str("out"),
-    ];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
-    let err = stderr_of(&o);
-    for want in [
-        "bad.toml",
-        "compression.halving[1]",
-        "metropolis",
-        "another run",
-    ] {
-        assert!(err.contains(want), "{want:?} not in: {err}");
-    }
+    assert_text_refused(
+        &text,
+        &["compression.halving[1]", "metropolis", "another run"],
+    );
 }
 
 #[test]
@@ -424,24 +375,9 @@ fn bad_step_searches_are_refused_naming_the_key() {
         "unless target_std_error",
     );
     // Only for the Metropolis scheme (exact at any dt).
-    let dir = TempDir::new("budget-bad");
     let text = scene_text(&with("max_dt_tau1 = 0.32, min_acceptance = 0.6"))
         .replace("metropolis-crank-nicolson", "crank-nicolson");
-    let path = write_scene(&dir, "bad", text.as_bytes());
-    let args = [
-        "verify",
-        "--scene",
-        path.to_str().unwrap(),
-        "--out",
-        &dir.join_str("out"),
-    ];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
-    let err = stderr_of(&o);
-    assert!(
-        err.contains("runs[0].full.max_dt_tau1") && err.contains("exact at any dt"),
-        "{err}"
-    );
+    assert_text_refused(&text, &["runs[0].full.max_dt_tau1", "exact at any dt"]);
 }
 
 /// A target in a linear scene is refused (budgets by target precision are for
@@ -458,13 +394,5 @@ fn a_target_in_a_linear_scene_is_refused() {
         full_line,
         "full = { trajectories = 4, target_std_error = 0.05, pilot_tau1 = 5.0, max_duration_tau1 = 40.0 }",
     );
-    let dir = TempDir::new("budget-linear");
-    let path = write_scene(&dir, "lin", text.as_bytes());
-    let out = dir.join_str("out");
-    let args = ["verify", "--scene", path.to_str().unwrap(), "--out", &out];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
-    let err = stderr_of(&o);
-    assert!(err.contains("full.target_std_error"), "{err}");
-    assert!(err.contains("model = \"compression\""), "{err}");
+    assert_text_refused(&text, &["full.target_std_error", "model = \"compression\""]);
 }

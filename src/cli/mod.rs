@@ -121,6 +121,16 @@ fn parse_list<T: FromStr>(flag: &str, text: &str, allowed: &str) -> Result<Vec<T
         .collect()
 }
 
+/// [`parse_list`] of `text` if the flag was given, else `default`.
+fn parse_list_or<T: FromStr + Clone>(
+    flag: &str,
+    text: Option<&str>,
+    default: &[T],
+    allowed: &str,
+) -> Result<Vec<T>> {
+    text.map_or_else(|| Ok(default.to_vec()), |t| parse_list(flag, t, allowed))
+}
+
 /// Loads one scene given by name (in `scene_dir`) or path.
 fn resolve_scene(name: &str, scene_dir: &Path) -> Result<Scene> {
     let path = resolve_scenes(&[name.to_string()], scene_dir)?

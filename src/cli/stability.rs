@@ -1,7 +1,7 @@
 //! `langevin-fem stability`: stability map (integrator × Δt·λ_max × element count) and
 //! the measured per-mode stationary bias against each integrator's exact formula.
 
-use super::{parse_list, resolve_scene};
+use super::{parse_list_or, resolve_scene};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -70,14 +70,18 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
             })
             .collect::<Result<_>>()?,
     };
-    let elements = match &args.elements {
-        None => DEFAULT_ELEMENTS.to_vec(),
-        Some(t) => parse_list("--elements", t, "comma-separated integers")?,
-    };
-    let dt_lambda_max = match &args.dt_lambda_max {
-        None => DEFAULT_DT_LAMBDA_MAX.to_vec(),
-        Some(t) => parse_list("--dt-lambda-max", t, "comma-separated numbers")?,
-    };
+    let elements = parse_list_or(
+        "--elements",
+        args.elements.as_deref(),
+        &DEFAULT_ELEMENTS,
+        "comma-separated integers",
+    )?;
+    let dt_lambda_max = parse_list_or(
+        "--dt-lambda-max",
+        args.dt_lambda_max.as_deref(),
+        &DEFAULT_DT_LAMBDA_MAX,
+        "comma-separated numbers",
+    )?;
     let scene = resolve_scene(&args.scene, &args.scene_dir)?;
     let s = run_stability(&StabilityOptions {
         scene,

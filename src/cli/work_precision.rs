@@ -1,7 +1,7 @@
 //! `langevin-fem work-precision`: error in ⟨w²(L/2)⟩ against wall time for every
 //! integrator and noise model, with the projected cost of reaching a tolerance.
 
-use super::{parse_list, resolve_scene};
+use super::{parse_list_or, resolve_scene};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -79,14 +79,18 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         None => DEFAULT_METHODS.to_vec(),
         Some(t) => t.split(',').map(parse_method).collect::<Result<_>>()?,
     };
-    let dt_tau1 = match &args.dt_tau1 {
-        None => DEFAULT_DT_TAU1.to_vec(),
-        Some(t) => parse_list("--dt-tau1", t, "comma-separated numbers")?,
-    };
-    let em_fractions = match &args.em_fractions {
-        None => DEFAULT_EM_FRACTIONS.to_vec(),
-        Some(t) => parse_list("--em-fractions", t, "comma-separated numbers")?,
-    };
+    let dt_tau1 = parse_list_or(
+        "--dt-tau1",
+        args.dt_tau1.as_deref(),
+        &DEFAULT_DT_TAU1,
+        "comma-separated numbers",
+    )?;
+    let em_fractions = parse_list_or(
+        "--em-fractions",
+        args.em_fractions.as_deref(),
+        &DEFAULT_EM_FRACTIONS,
+        "comma-separated numbers",
+    )?;
     let scene = resolve_scene(&args.scene, &args.scene_dir)?;
     let s = run_work_precision(&WorkPrecisionOptions {
         scene,

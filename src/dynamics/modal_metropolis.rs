@@ -148,7 +148,7 @@ impl<'m> ModalMetropolis<'m> {
             proposed: 0,
             accepted: 0,
         };
-        let mut cur = std::mem::replace(&mut chain.current, chain.proposal.clone());
+        let mut cur = std::mem::take(&mut chain.current);
         chain.evaluate(&mut cur);
         if cur.force > model.beam().params().euler_load() && !chain.pairs.is_empty() {
             chain.start_buckled(&mut cur);
@@ -552,21 +552,7 @@ mod tests {
                         (&lhs - &rhs).amax()
                     );
                 }
-                let c_inv = c.clone().try_inverse().unwrap();
-                let log_q = |a: &[Vec<f64>], b: &[Vec<f64>]| {
-                    let f = m.compressive_force(m.stored_length(a));
-                    let h = &k - &g * f;
-                    let am = &c + &h * (0.5 * dt);
-                    let bm = &c - &h * (0.5 * dt);
-                    let mut norm = 0.0;
-                    for (ac, bc) in a.iter().zip(b) {
-                        let r = &am * DVector::from_column_slice(bc)
-                            - &bm * DVector::from_column_slice(ac);
-                        norm += (r.transpose() * &c_inv * &r)[(0, 0)];
-                    }
-                    a.len() as f64 * am.determinant().ln() - 0.5 * norm / (2.0 * kt * dt)
-                };
-                let oracle = -(m.energy(&wp) - m.energy(&w)) / kt + log_q(&wp, &w) - log_q(&w, &wp);
+                let oracle = crate::dynamics::nonlinear::tests::dense_log_alpha(&m, dt, &w, &wp);
                 assert!(
                     (ln_alpha - oracle).abs() < 1e-6 * (1.0 + oracle.abs()),
                     "dims {dims} ratio {ratio}: ln alpha {ln_alpha} vs dense oracle {oracle}"

@@ -473,7 +473,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::fem::beam::BeamModel;
     use crate::fem::mesh::Mesh;
@@ -547,6 +547,41 @@ mod tests {
     /// −ΔU/kT + ln q(w'→w) − ln q(w→w') computed independently from dense matrices (the
     /// determinant of A_w included: without it the chain's ⟨F⟩ is off by up to 1 F_c0 at
     /// 40 elements, which the compression convergence study shows). Graded mesh,
+    /// An independent oracle of `ln α` for the Metropolis-adjusted Crank–Nicolson move
+    /// `w → wp` at step `dt`, from dense matrices: the proposal densities
+    /// `ln q(a → b) = d ln det A_a − ½ Σ_c |A_a b_c − B_a a_c|²_{C⁻¹}/(2kTΔt)`
+    /// (`A_a, B_a = C ± ½Δt(K − F(a) G)`) and the energy from
+    /// [`CompressedFilament::energy`].
+    pub(crate) fn dense_log_alpha(
+        m: &CompressedFilament,
+        dt: f64,
+        w: &[Vec<f64>],
+        wp: &[Vec<f64>],
+    ) -> f64 {
+        let beam = m.beam();
+        let kt = beam.params().kt;
+        let (k, c, g) = (
+            beam.stiffness().to_dense(),
+            beam.damping().to_dense(),
+            beam.geometric().to_dense(),
+        );
+        let c_inv = c.clone().try_inverse().unwrap();
+        let log_q = |a: &[Vec<f64>], b: &[Vec<f64>]| {
+            let f = m.compressive_force(m.stored_length(a));
+            let h = &k - &g * f;
+            let am = &c + &h * (0.5 * dt);
+            let bm = &c - &h * (0.5 * dt);
+            let mut norm = 0.0;
+            for (ac, bc) in a.iter().zip(b) {
+                let r = &am * nalgebra::DVector::from_column_slice(bc)
+                    - &bm * nalgebra::DVector::from_column_slice(ac);
+                norm += (r.transpose() * &c_inv * &r)[(0, 0)];
+            }
+            a.len() as f64 * am.determinant().ln() - 0.5 * norm / (2.0 * kt * dt)
+        };
+        -(m.energy(wp) - m.energy(w)) / kt + log_q(wp, w) - log_q(w, wp)
+    }
+
     /// 2D and 3D, in tension, near the Euler strain and buckled; states of a few kT, large
     /// Δt (0.05 τ1) so the F dependence of A_w matters. Tolerance: round-off (1e-9
     /// relative on the states, 1e-7 absolute on ln α, whose terms are O(100)).
@@ -593,33 +628,7 @@ mod tests {
                 let fwd = integ.log_acceptance(&cur, &prop, &zeta, &mut buf);
                 let rev = integ.log_acceptance(&prop, &cur, &zeta_r, &mut buf);
                 assert!(fwd.is_finite() && fwd != 0.0, "ln alpha {fwd}");
-                // An independent oracle: the proposal densities from dense matrices,
-                // ln q(a → b) = d ln det A_a − ½ Σ_c |A_a b_c − B_a a_c|²_{C⁻¹}/(2kTΔt),
-                // and the energy from CompressedFilament::energy.
-                let beam = m.beam();
-                let (k, c, g) = (
-                    beam.stiffness().to_dense(),
-                    beam.damping().to_dense(),
-                    beam.geometric().to_dense(),
-                );
-                let c_inv = c.clone().try_inverse().unwrap();
-                let log_q = |a: &[Vec<f64>], b: &[Vec<f64>]| {
-                    let f = m.compressive_force(m.stored_length(a));
-                    let h = &k - &g * f;
-                    let am = &c + &h * (0.5 * dt);
-                    let bm = &c - &h * (0.5 * dt);
-                    let mut norm = 0.0;
-                    for (ac, bc) in a.iter().zip(b) {
-                        let r = &am * nalgebra::DVector::from_column_slice(bc)
-                            - &bm * nalgebra::DVector::from_column_slice(ac);
-                        norm += (r.transpose() * &c_inv * &r)[(0, 0)];
-                    }
-                    a.len() as f64 * am.determinant().ln()
-                        - 0.5 * norm / (2.0 * m.beam().params().kt * dt)
-                };
-                let oracle = -(m.energy(&next) - m.energy(&w)) / m.beam().params().kt
-                    + log_q(&next, &w)
-                    - log_q(&w, &next);
+                let oracle = dense_log_alpha(&m, dt, &w, &next);
                 assert!(
                     (fwd - oracle).abs() < 1e-6 * (1.0 + oracle.abs()),
                     "dims {dims} ratio {ratio}: ln alpha {fwd} vs dense oracle {oracle}"

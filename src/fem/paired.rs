@@ -83,6 +83,28 @@ fn inf_norm(m: &super::SymBanded) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Adds the nodal vector of `deflection·s_k + rotation·c_k` to `out` (free DOFs of `beam`,
+/// `ne` elements): `deflection·sin(kπj/N)` to the deflection and `rotation·cos(kπj/N)` to
+/// the rotation of every node j that has them.
+fn add_wave(
+    beam: &BeamModel,
+    ne: usize,
+    k: usize,
+    deflection: f64,
+    rotation: f64,
+    out: &mut [f64],
+) {
+    for j in 0..=ne {
+        let arg = PI * (k * j) as f64 / ne as f64;
+        if let Some(idx) = beam.node_deflection_index(j) {
+            out[idx] += deflection * arg.sin();
+        }
+        if let Some(idx) = beam.node_rotation_index(j) {
+            out[idx] += rotation * arg.cos();
+        }
+    }
+}
+
 /// `residual ≤ RESIDUAL_TOLERANCE · scale` (false for NaN).
 fn within(residual: f64, scale: f64) -> bool {
     residual <= RESIDUAL_TOLERANCE * scale
@@ -146,19 +168,11 @@ impl PairedModes {
         let n = beam.n_dofs();
         let (km, cm, gm) = (beam.stiffness(), beam.damping(), beam.geometric());
         let mut buf = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        // s_k (sine deflections) or c_k (cosine rotations).
         let basis = |k: usize, sine: bool| -> Vec<f64> {
             let mut v = vec![0.0; n];
-            for j in 0..=ne {
-                let arg = PI * (k * j) as f64 / ne as f64;
-                let idx = if sine {
-                    beam.node_deflection_index(j).map(|i| (i, arg.sin()))
-                } else {
-                    beam.node_rotation_index(j).map(|i| (i, arg.cos()))
-                };
-                if let Some((i, val)) = idx {
-                    v[i] = val;
-                }
-            }
+            let (d, r) = if sine { (1.0, 0.0) } else { (0.0, 1.0) };
+            add_wave(beam, ne, k, d, r, &mut v);
             v
         };
         let mut pairs = Vec::with_capacity(ne.saturating_sub(1));
@@ -279,16 +293,14 @@ impl PairedModes {
     /// The nodal vector (over the free DOFs of `beam`) of mode `i` of block `b`.
     fn mode_vector(&self, beam: &BeamModel, b: &ModeBlock, i: usize) -> Vec<f64> {
         let mut v = vec![0.0; beam.n_dofs()];
-        let ne = self.elements;
-        for j in 0..=ne {
-            let arg = PI * (b.wavenumber * j) as f64 / ne as f64;
-            if let Some(idx) = beam.node_deflection_index(j) {
-                v[idx] = b.deflection[i] * arg.sin();
-            }
-            if let Some(idx) = beam.node_rotation_index(j) {
-                v[idx] = b.rotation[i] * arg.cos();
-            }
-        }
+        add_wave(
+            beam,
+            self.elements,
+            b.wavenumber,
+            b.deflection[i],
+            b.rotation[i],
+            &mut v,
+        );
         v
     }
 
@@ -350,15 +362,7 @@ impl PairedModes {
         for (b, x) in coords {
             let wk = b.deflection[0] * x[0] + b.deflection[1] * x[1];
             let tk = b.rotation[0] * x[0] + b.rotation[1] * x[1];
-            for j in 0..=ne {
-                let arg = PI * (b.wavenumber * j) as f64 / ne as f64;
-                if let Some(idx) = beam.node_deflection_index(j) {
-                    out[idx] += wk * arg.sin();
-                }
-                if let Some(idx) = beam.node_rotation_index(j) {
-                    out[idx] += tk * arg.cos();
-                }
-            }
+            add_wave(beam, ne, b.wavenumber, wk, tk, out);
         }
     }
 

@@ -523,9 +523,9 @@ impl CompressionRun {
         for k in (0..=doublings).rev() {
             let dt_tau1 = base * 2f64.powi(k);
             let plan = StepPlan::new(dt_tau1 * tau1, self.burn_in, self.sample_interval, self.dt);
+            let steps = PROBE_STEPS.div_ceil(plan.sample_every) * plan.sample_every;
             let (mut proposed, mut accepted) = (0, 0);
             for j in 0..trajectories.max(1) {
-                let steps = PROBE_STEPS.div_ceil(plan.sample_every) * plan.sample_every;
                 let mut rng = trajectory_rng(seed(k as usize), j as u64);
                 let rec = self.simulate_plan(point, plan, &mut rng, steps)?;
                 proposed += rec.proposed;
