@@ -28,8 +28,10 @@
 
 use langevin_fem::FilamentParams;
 use langevin_fem::dynamics::{
-    Components, Integrator, IntegratorKind, Trajectory, build_integrator,
+    BatchTrajectory, ComponentBatch, Components, Integrator, IntegratorKind, ThetaBatch,
+    Trajectory, build_integrator,
 };
+use langevin_fem::fem::banded::LANES;
 use langevin_fem::fem::modal::{GeneralizedModes, generalized_modes};
 use langevin_fem::fem::{BeamModel, Mesh, NoiseGenerator, NoiseModel};
 use langevin_fem::rng::{TrajectoryRng, trajectory_rng};
@@ -60,6 +62,11 @@ enum Work {
         buf: Vec<f64>,
         rng: TrajectoryRng,
     },
+    /// One step of [`LANES`] trajectories in lockstep.
+    Batch {
+        batch: Box<ComponentBatch>,
+        rngs: Vec<TrajectoryRng>,
+    },
 }
 
 impl Work {
@@ -67,6 +74,23 @@ impl Work {
         Work::Step {
             filament: Components::at_rest(integ, 1, n_dofs),
             rng: trajectory_rng(SEED, stream),
+        }
+    }
+
+    fn batch(integ: ThetaBatch, stream: u64) -> Self {
+        Work::Batch {
+            batch: Box::new(ComponentBatch::at_rest(integ, 1)),
+            rngs: (0..LANES as u64)
+                .map(|l| trajectory_rng(SEED, stream * 8 + l))
+                .collect(),
+        }
+    }
+
+    /// Trajectory-steps per call.
+    fn lanes(&self) -> usize {
+        match self {
+            Work::Batch { rngs, .. } => rngs.len(),
+            Work::Step { .. } | Work::Normals { .. } => 1,
         }
     }
 
@@ -94,6 +118,11 @@ impl Work {
                     black_box(buf.as_mut_slice());
                 }
             }
+            Work::Batch { batch, rngs } => {
+                for _ in 0..iters {
+                    black_box(&mut *batch).step(rngs);
+                }
+            }
         }
         t.elapsed()
     }
@@ -112,15 +141,17 @@ impl Work {
         }
     }
 
-    /// ns per call of one loop of `iters` calls.
+    /// ns per trajectory-step (per call, over the lanes of a batch) of one loop of
+    /// `iters` calls.
     fn sample(&mut self, iters: u64) -> f64 {
-        self.run(iters).as_secs_f64() * 1e9 / iters as f64
+        self.run(iters).as_secs_f64() * 1e9 / (iters * self.lanes() as u64) as f64
     }
 
     fn state_is_finite(&self) -> bool {
         match self {
             Work::Step { filament, .. } => filament.is_finite(),
             Work::Normals { .. } => true,
+            Work::Batch { batch, rngs } => (0..rngs.len()).all(|l| batch.lane_is_finite(l)),
         }
     }
 }
@@ -190,7 +221,9 @@ struct Row {
     elements: usize,
     kind: IntegratorKind,
     noise: NoiseModel,
-    /// `None` if skipped.
+    /// Trajectories stepped in lockstep (1, or [`LANES`] for [`ComponentBatch`]).
+    lanes: usize,
+    /// `None` if skipped (per trajectory-step).
     step_ns: Option<f64>,
     normals: usize,
     normals_ns: f64,
@@ -224,6 +257,7 @@ fn measure_theta_schemes(sizes: &[usize]) -> (Vec<Row>, Baselines, Vec<(BeamMode
     struct Case {
         elements: usize,
         kind: Option<IntegratorKind>,
+        lanes: usize,
         noise: NoiseModel,
         normals: usize,
     }
@@ -240,6 +274,7 @@ fn measure_theta_schemes(sizes: &[usize]) -> (Vec<Row>, Baselines, Vec<(BeamMode
             cases.push(Case {
                 elements: ne,
                 kind: None,
+                lanes: 1,
                 noise,
                 normals,
             });
@@ -254,10 +289,22 @@ fn measure_theta_schemes(sizes: &[usize]) -> (Vec<Row>, Baselines, Vec<(BeamMode
                 cases.push(Case {
                     elements: ne,
                     kind: Some(kind),
+                    lanes: 1,
                     noise,
                     normals,
                 });
                 works.push(Work::step(integ, b.n_dofs(), stream(ne, kind, noise)));
+                let batch = ThetaBatch::build(kind, &b, noise, dt, max_rate)
+                    .expect("batched θ-scheme")
+                    .expect("lane sweeps serve the Hermite band");
+                cases.push(Case {
+                    elements: ne,
+                    kind: Some(kind),
+                    lanes: LANES,
+                    noise,
+                    normals,
+                });
+                works.push(Work::batch(batch, stream(ne, kind, noise)));
             }
         }
         beams.push((b, max_rate));
@@ -293,6 +340,7 @@ fn measure_theta_schemes(sizes: &[usize]) -> (Vec<Row>, Baselines, Vec<(BeamMode
                     elements: c.elements,
                     kind,
                     noise: c.noise,
+                    lanes: c.lanes,
                     step_ns: Some(m),
                     normals,
                     normals_ns,
@@ -365,6 +413,7 @@ fn measure_exact_modal(
                 elements: ne,
                 kind: IntegratorKind::ExactModal,
                 noise,
+                lanes: 1,
                 step_ns,
                 normals,
                 normals_ns,
@@ -379,7 +428,7 @@ fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: us
     let order = |r: &Row| {
         let k = IntegratorKind::LINEAR.iter().position(|&k| k == r.kind);
         let z = NOISES.iter().position(|&z| z == r.noise);
-        (r.elements, k, z)
+        (r.elements, k, z, r.lanes)
     };
     rows.sort_by_key(order);
 
@@ -394,10 +443,10 @@ fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: us
     );
     println!();
     println!(
-        "| elements | integrator | noise | ns/step | ns/element/step | normals/step \
+        "| elements | integrator | noise | lockstep | ns/step | ns/element/step | normals/step \
          | ns normals alone | step/normals |"
     );
-    println!("|---:|---|---|---:|---:|---:|---:|---:|");
+    println!("|---:|---|---|---:|---:|---:|---:|---:|---:|");
     for r in &rows {
         let (step, per_elem, ratio) = match r.step_ns {
             Some(s) => (
@@ -412,15 +461,15 @@ fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: us
             ),
         };
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.0} | {} |",
-            r.elements, r.kind, r.noise, step, per_elem, r.normals, r.normals_ns, ratio
+            "| {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |",
+            r.elements, r.kind, r.noise, r.lanes, step, per_elem, r.normals, r.normals_ns, ratio
         );
     }
     println!();
 
-    let per_elem = |ne: usize, k: IntegratorKind, z: NoiseModel| {
+    let per_elem = |ne: usize, k: IntegratorKind, z: NoiseModel, lanes: usize| {
         rows.iter()
-            .find(|r| r.elements == ne && r.kind == k && r.noise == z)
+            .find(|r| r.elements == ne && r.kind == k && r.noise == z && r.lanes == lanes)
             .and_then(|r| r.step_ns.map(|s| s / ne as f64))
     };
     if sizes.contains(&1000) {
@@ -428,17 +477,20 @@ fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: us
             "Linearity of the theta-schemes: ns/element/step at 1000 over at 100 (1 = linear)"
         );
         println!();
-        println!("| integrator | noise | ratio 1000/100 |");
-        println!("|---|---|---:|");
+        println!("| integrator | noise | lockstep | ratio 1000/100 |");
+        println!("|---|---|---:|---:|");
         for kind in IntegratorKind::LINEAR
             .into_iter()
             .filter(|k| k.theta().is_some())
         {
             for noise in NOISES {
-                if let (Some(a), Some(b)) =
-                    (per_elem(1000, kind, noise), per_elem(100, kind, noise))
-                {
-                    println!("| {kind} | {noise} | {:.2} |", a / b);
+                for lanes in [1, LANES] {
+                    if let (Some(a), Some(b)) = (
+                        per_elem(1000, kind, noise, lanes),
+                        per_elem(100, kind, noise, lanes),
+                    ) {
+                        println!("| {kind} | {noise} | {lanes} | {:.2} |", a / b);
+                    }
                 }
             }
         }
@@ -450,7 +502,12 @@ fn report(mut rows: Vec<Row>, sizes: &[usize], setup_notes: &[String], cores: us
         .filter(|r| r.kind == IntegratorKind::CrankNicolson && r.noise == NoiseModel::Consistent)
     {
         if let Some(s) = r.step_ns {
-            println!("  {:>5} elements: {:.2}", r.elements, s / r.normals_ns);
+            println!(
+                "  {:>5} elements, {} in lockstep: {:.2}",
+                r.elements,
+                r.lanes,
+                s / r.normals_ns
+            );
         }
     }
 }

@@ -21,18 +21,16 @@
 //! ([`NonlinearStep`]) all components at once; [`Components`] and [`NonlinearState`]
 //! make trajectories of them.
 //!
-//! # Batched ensembles (design)
+//! # Batched ensembles
 //!
-//! An ensemble can later be stepped as a batch — the states of many trajectories stored
-//! structure-of-arrays and advanced together, still one random stream per trajectory
-//! drawn in the same order, so every trajectory stays bit-identical to its serial run —
-//! without changing observers or the per-trajectory callers: the batched entry point
-//! will take a batch type (holding the trajectories of indices `first..first + n`, with
-//! `n` streams) that steps all members at once and exposes each member as the same
-//! system type an observer sees today; the driver then checks finiteness per member and
-//! calls the observer with each member's trajectory index, which is why every callback
-//! carries one. [`Driver::run`] is the batch of one.
+//! [`Driver::run_batch`] advances up to [`LANES`](crate::fem::banded::LANES) trajectories
+//! of a [`BatchTrajectory`] in lockstep (their states structure-of-arrays, one random
+//! stream per trajectory drawn in the same order as alone, so every trajectory stays
+//! bit-identical to its serial run), checks finiteness per lane and calls each lane's
+//! observer with the lane's trajectory index and a [`LaneOf`] view: the same schedule and
+//! callbacks as [`Driver::run`], which is the batch of one.
 
+use super::batch::{BatchTrajectory, LaneOf};
 use super::integrator::Integrator;
 use super::nonlinear::NonlinearStep;
 use crate::error::{Error, Result};
@@ -128,6 +126,85 @@ impl Driver {
     }
 }
 
+impl Driver {
+    /// Runs the lanes `0..rngs.len()` of `batch` (trajectories `first + l`, lane `l`
+    /// drawing from `rngs[l]` and observed by `observers[l]`, which sees it as a
+    /// [`LaneOf`]) through the schedule in lockstep: the batched form of [`Self::run`],
+    /// with the same callbacks in the same order per lane. A lane whose state becomes
+    /// non-finite gets [`Error::diverged`] (its step, detail `detail(batch)`) and is no
+    /// longer observed; the others go on. One result per lane.
+    ///
+    /// # Panics
+    /// If `observers` and `rngs` differ in length.
+    pub fn run_batch<B, O>(
+        &self,
+        first: usize,
+        batch: &mut B,
+        rngs: &mut [TrajectoryRng],
+        observers: &mut [O],
+        detail: impl Fn(&B) -> String,
+    ) -> Vec<Result<()>>
+    where
+        B: BatchTrajectory + ?Sized,
+        O: for<'a> Observer<LaneOf<'a, B>>,
+    {
+        assert_eq!(
+            rngs.len(),
+            observers.len(),
+            "run_batch: one observer per lane"
+        );
+        let mut results: Vec<Result<()>> = rngs.iter().map(|_| Ok(())).collect();
+        let mut alive = vec![true; rngs.len()];
+        for (lane, o) in observers.iter_mut().enumerate() {
+            o.on_start(
+                first + lane,
+                &LaneOf {
+                    batch: &*batch,
+                    lane,
+                },
+            );
+        }
+        for step in 1..=self.total() {
+            if !alive.contains(&true) {
+                break;
+            }
+            batch.step(rngs);
+            let sample = (step > self.burn_in && (step - self.burn_in).is_multiple_of(self.every))
+                .then(|| step - self.burn_in);
+            for (lane, o) in observers.iter_mut().enumerate() {
+                if !alive[lane] {
+                    continue;
+                }
+                if !batch.lane_is_finite(lane) {
+                    results[lane] = Err(Error::diverged(step, self.dt, detail(batch)));
+                    alive[lane] = false;
+                    continue;
+                }
+                let view = LaneOf {
+                    batch: &*batch,
+                    lane,
+                };
+                o.on_step(first + lane, step, &view);
+                if let Some(since) = sample {
+                    o.on_sample(first + lane, since, &view);
+                }
+            }
+        }
+        for (lane, o) in observers.iter_mut().enumerate() {
+            if alive[lane] {
+                o.on_finish(
+                    first + lane,
+                    &LaneOf {
+                        batch: &*batch,
+                        lane,
+                    },
+                );
+            }
+        }
+        results
+    }
+}
+
 /// A linear filament's trajectory: the transverse components `states` (one free-DOF
 /// vector each), advanced in order by the same `integrator`.
 pub struct Components<I> {
@@ -211,6 +288,59 @@ mod tests {
         }
         fn on_finish(&mut self, _: usize, c: &Counter) {
             self.events.push(('f', c.steps));
+        }
+    }
+
+    /// Three scalar lanes in lockstep, lane `l` non-finite from step `blow_up[l]`.
+    struct Lanes3 {
+        steps: u64,
+        blow_up: [u64; 3],
+    }
+
+    impl BatchTrajectory for Lanes3 {
+        fn step(&mut self, rngs: &mut [TrajectoryRng]) {
+            assert_eq!(rngs.len(), 3);
+            self.steps += 1;
+        }
+        fn lane_is_finite(&self, lane: usize) -> bool {
+            self.steps < self.blow_up[lane]
+        }
+    }
+
+    impl Observer<LaneOf<'_, Lanes3>> for Log {
+        fn on_start(&mut self, _: usize, _: &LaneOf<'_, Lanes3>) {
+            self.events.push(('s', 0));
+        }
+        fn on_sample(&mut self, t: usize, since: u64, v: &LaneOf<'_, Lanes3>) {
+            assert_eq!(t, 10 + v.lane);
+            self.events.push(('x', since));
+        }
+        fn on_finish(&mut self, _: usize, v: &LaneOf<'_, Lanes3>) {
+            self.events.push(('f', v.batch.steps));
+        }
+    }
+
+    /// A batch follows the schedule of [`Driver::run`] per lane; a lane that goes
+    /// non-finite gets its own divergence error (its step) and no further callbacks,
+    /// while the other lanes run to the end.
+    #[test]
+    fn batch_schedule_and_per_lane_divergence() {
+        let d = Driver::new(0.5, 3, 7, 2);
+        let mut rngs: Vec<_> = (0..3).map(|j| trajectory_rng(1, j)).collect();
+        let mut logs: Vec<Log> = (0..3).map(|_| Log::default()).collect();
+        let mut b = Lanes3 {
+            steps: 0,
+            blow_up: [u64::MAX, 6, u64::MAX],
+        };
+        let results = d.run_batch(10, &mut b, &mut rngs, &mut logs, |_| "lane".into());
+        let full = vec![('s', 0), ('x', 2), ('x', 4), ('x', 6), ('f', 10)];
+        assert_eq!(logs[0].events, full);
+        assert_eq!(logs[2].events, full);
+        assert_eq!(logs[1].events, vec![('s', 0), ('x', 2)]);
+        assert!(results[0].is_ok() && results[2].is_ok());
+        match &results[1] {
+            Err(Error::Diverged { step, time, .. }) => assert_eq!((*step, *time), (6, 3.0)),
+            r => panic!("{r:?}"),
         }
     }
 

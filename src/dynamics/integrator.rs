@@ -22,6 +22,10 @@ impl<I: Integrator + ?Sized> Integrator for Box<I> {
     }
 }
 
+/// The stable integrators named when an explicit step is refused.
+pub(super) const THETA_SUGGESTION: &str =
+    "crank-nicolson (O(n), exact stationary variance) or exact-modal";
+
 /// The step-size refusal shared by the linear and the nonlinear integrators (with
 /// [`check_stability`]): `dt` must be finite and positive.
 ///
@@ -220,7 +224,7 @@ pub fn build_integrator(
     modes: Option<&GeneralizedModes>,
 ) -> Result<Box<dyn Integrator>> {
     check_dt(dt)?;
-    let suggestion = "crank-nicolson (O(n), exact stationary variance) or exact-modal";
+    let suggestion = THETA_SUGGESTION;
     Ok(match kind.family() {
         Family::Metropolis => {
             return Err(Error::invalid(

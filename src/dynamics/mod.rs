@@ -33,12 +33,14 @@
 //! hinged mesh `metropolis-crank-nicolson` runs in the paired modal form
 //! ([`modal_metropolis`], O(n) per step with 2×2 solves).
 
+pub mod batch;
 pub mod driver;
 pub mod ensemble;
 mod integrator;
 pub mod modal_metropolis;
 pub mod nonlinear;
 
+pub use batch::{BatchTrajectory, ComponentBatch, LaneOf, ThetaBatch};
 pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};

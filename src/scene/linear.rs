@@ -11,20 +11,23 @@
 //! 2kTL³/(π⁴n⁴EI), rate λ_n, profile kT x²(L−x)²/(3EI L), eq. 4).
 
 use crate::dynamics::{
-    Components, Driver, Integrator, IntegratorKind, Observer, Trajectory, build_integrator,
+    BatchTrajectory, ComponentBatch, Components, Driver, Integrator, IntegratorKind, LaneOf,
+    Observer, ThetaBatch, Trajectory, build_integrator, par_indexed,
 };
 use crate::error::{Error, Result};
+use crate::fem::banded::LANES;
 use crate::fem::beam::BeamModel;
 use crate::fem::modal::{
     GeneralizedModes, discrete_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::rng::TrajectoryRng;
+use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
 use crate::spectral::simulator::ModalSimulator;
 use crate::stats;
 use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
 
 /// Exact references for one mode of one run.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,9 +149,8 @@ pub fn add_slope_squares(beam: &BeamModel, state: &[f64], acc: &mut [f64]) {
     }
 }
 
-/// A filament being simulated ([`Trajectory`]: advances all its transverse components by
-/// one step) that reports the observables.
-trait Sampler: Trajectory {
+/// The observables of one simulated filament, as the observers record them.
+trait Observables {
     /// Modal amplitudes, component-major: `out[c * n_modes + i]`.
     fn modes(&self, out: &mut [f64]);
     /// Deflections at `xs`, component-major: `out[c * xs.len() + j]`.
@@ -156,6 +158,69 @@ trait Sampler: Trajectory {
     /// Adds θ² of every node (slope w'; summed over components) to `acc`, if the model
     /// carries nodal rotations (the finite-element model does, the spectral one not).
     fn add_slope_squares(&self, _acc: &mut [f64]) {}
+}
+
+/// A filament being simulated ([`Trajectory`]: advances all its transverse components by
+/// one step) that reports the observables.
+trait Sampler: Trajectory + Observables {}
+
+impl<S: Trajectory + Observables + ?Sized> Sampler for S {}
+
+/// The modal amplitudes of one component's state `s`, `out[i] = Σ_j P_ij s_j`.
+fn project_modes(projector: &DMatrix<f64>, s: &[f64], out: &mut [f64]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = projector.row(i).iter().zip(s).map(|(p, w)| p * w).sum();
+    }
+}
+
+/// [`LANES`] finite-element trajectories of a θ-scheme in lockstep ([`ComponentBatch`]);
+/// each lane reports its observables as [`FemSampler`] does, from the lane's state
+/// gathered into `lane` (so every lane is bit-identical to its one-trajectory run).
+struct FemBatch<'a> {
+    beam: &'a BeamModel,
+    projector: &'a DMatrix<f64>,
+    filament: ComponentBatch,
+    lane: RefCell<Vec<f64>>,
+}
+
+impl BatchTrajectory for FemBatch<'_> {
+    fn step(&mut self, rngs: &mut [TrajectoryRng]) {
+        self.filament.step(rngs);
+    }
+    fn lane_is_finite(&self, lane: usize) -> bool {
+        self.filament.lane_is_finite(lane)
+    }
+}
+
+impl FemBatch<'_> {
+    /// Calls `f(c, state)` with the state of every component `c` of lane `lane`.
+    fn each_component(&self, lane: usize, mut f: impl FnMut(usize, &[f64])) {
+        let mut s = self.lane.borrow_mut();
+        for c in 0..self.filament.states.len() {
+            self.filament.lane_state(c, lane, &mut s);
+            f(c, &s);
+        }
+    }
+}
+
+impl Observables for LaneOf<'_, FemBatch<'_>> {
+    fn modes(&self, out: &mut [f64]) {
+        let m = self.batch.projector.nrows();
+        self.batch.each_component(self.lane, |c, s| {
+            project_modes(self.batch.projector, s, &mut out[c * m..(c + 1) * m]);
+        });
+    }
+    fn deflections(&self, xs: &[f64], out: &mut [f64]) {
+        self.batch.each_component(self.lane, |c, s| {
+            for (j, &x) in xs.iter().enumerate() {
+                out[c * xs.len() + j] = self.batch.beam.deflection_at(s, x);
+            }
+        });
+    }
+    fn add_slope_squares(&self, acc: &mut [f64]) {
+        self.batch
+            .each_component(self.lane, |_, s| add_slope_squares(self.batch.beam, s, acc));
+    }
 }
 
 struct FemSampler<'a> {
@@ -173,19 +238,11 @@ impl Trajectory for FemSampler<'_> {
     }
 }
 
-impl Sampler for FemSampler<'_> {
+impl Observables for FemSampler<'_> {
     fn modes(&self, out: &mut [f64]) {
         let m = self.projector.nrows();
         for (c, s) in self.filament.states.iter().enumerate() {
-            for i in 0..m {
-                out[c * m + i] = self
-                    .projector
-                    .row(i)
-                    .iter()
-                    .zip(s)
-                    .map(|(p, w)| p * w)
-                    .sum();
-            }
+            project_modes(self.projector, s, &mut out[c * m..(c + 1) * m]);
         }
     }
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
@@ -220,7 +277,7 @@ impl Trajectory for SpectralSampler {
     }
 }
 
-impl Sampler for SpectralSampler {
+impl Observables for SpectralSampler {
     fn modes(&self, out: &mut [f64]) {
         for (c, s) in self.sims.iter().enumerate() {
             out[c * self.n_modes..(c + 1) * self.n_modes]
@@ -245,7 +302,7 @@ struct TraceObserver<'r> {
     out: Vec<Vec<f64>>,
 }
 
-impl<S: Sampler + ?Sized> Observer<S> for TraceObserver<'_> {
+impl<S: Observables + ?Sized> Observer<S> for TraceObserver<'_> {
     fn on_sample(&mut self, _: usize, _: u64, sampler: &S) {
         sampler.modes(&mut self.m);
         sampler.deflections(self.profile_x, &mut self.p);
@@ -295,7 +352,7 @@ impl<'r> Recorder<'r> {
     }
 }
 
-impl<S: Sampler + ?Sized> Observer<S> for Recorder<'_> {
+impl<S: Observables + ?Sized> Observer<S> for Recorder<'_> {
     fn on_step(&mut self, _: usize, step: u64, sampler: &S) {
         let tt = &self.run.reference.two_time;
         for (j, q) in tt.iter().enumerate() {
@@ -800,6 +857,94 @@ impl LinearRun {
         sampled_steps: u64,
     ) -> Result<TrajectoryRecord> {
         let mut sampler = self.sampler()?;
+        let mut recorder = Recorder::new(self, sampled_steps);
+        self.schedule(sampled_steps)
+            .run(0, &mut *sampler, rng, &mut recorder, |_| {
+                self.divergence_detail()
+            })?;
+        Ok(recorder.rec)
+    }
+
+    /// [`Self::simulate`] for the trajectories `first..first + count` of the ensemble
+    /// seeded `seed` (trajectory `j` draws from `trajectory_rng(seed, j)`), in parallel,
+    /// in index order; `done(k)` is called as `k` more trajectories finish. The
+    /// finite-element θ-schemes step [`LANES`] trajectories in lockstep
+    /// ([`ComponentBatch`]); every record is bit-identical to that of
+    /// [`Self::simulate`], whatever the batching and the thread count.
+    ///
+    /// # Errors
+    /// The error of the smallest failing trajectory index, as [`Self::simulate`] gives it.
+    pub fn simulate_ensemble(
+        &self,
+        seed: u64,
+        first: u64,
+        count: u64,
+        sampled_steps: u64,
+        done: impl Fn(u64) + Sync,
+    ) -> Result<Vec<TrajectoryRecord>> {
+        let batches = count.div_ceil(LANES as u64);
+        let per_batch = par_indexed(batches, |b| {
+            let start = first + b * LANES as u64;
+            let end = (start + LANES as u64).min(first + count);
+            let mut rngs: Vec<TrajectoryRng> =
+                (start..end).map(|j| trajectory_rng(seed, j)).collect();
+            let records: Vec<Result<TrajectoryRecord>> = match self.batch()? {
+                Some(mut batch) => {
+                    let mut recorders: Vec<Recorder> = rngs
+                        .iter()
+                        .map(|_| Recorder::new(self, sampled_steps))
+                        .collect();
+                    self.schedule(sampled_steps)
+                        .run_batch(
+                            start as usize,
+                            &mut batch,
+                            &mut rngs,
+                            &mut recorders,
+                            |_| self.divergence_detail(),
+                        )
+                        .into_iter()
+                        .zip(recorders)
+                        .map(|(r, rec)| r.map(|()| rec.rec))
+                        .collect()
+                }
+                None => rngs
+                    .iter_mut()
+                    .map(|rng| self.simulate(rng, sampled_steps))
+                    .collect(),
+            };
+            done(end - start);
+            Ok(records)
+        })?;
+        per_batch.into_iter().flatten().collect()
+    }
+
+    /// The lockstep batch of this run, if its model is the finite-element one and its
+    /// integrator a θ-scheme the lane sweeps serve ([`ThetaBatch::build`]).
+    fn batch(&self) -> Result<Option<FemBatch<'_>>> {
+        let Model::Fem {
+            beam,
+            projector,
+            noise,
+            integrator,
+            ..
+        } = &self.model
+        else {
+            return Ok(None);
+        };
+        let r = &self.reference;
+        let batch = ThetaBatch::build(*integrator, beam, *noise, r.dt, r.max_rate)?;
+        Ok(batch.map(|t| FemBatch {
+            beam,
+            projector,
+            filament: ComponentBatch::at_rest(t, self.components),
+            lane: RefCell::new(vec![0.0; beam.n_dofs()]),
+        }))
+    }
+
+    /// The schedule of [`Self::simulate`]: the burn-in (at least up to the largest
+    /// two-time η; only that without sampled steps), then `sampled_steps` at the gcd of
+    /// the series' cadences.
+    fn schedule(&self, sampled_steps: u64) -> Driver {
         let r = &self.reference;
         let last_tt = r.two_time.iter().map(|q| q.eta_step).max().unwrap_or(0);
         let burn_in = if sampled_steps == 0 {
@@ -812,21 +957,17 @@ impl LinearRun {
             .mode_every
             .iter()
             .fold(self.profile_every, |g, &e| gcd(g, e));
-        let mut recorder = Recorder::new(self, sampled_steps);
-        Driver::new(r.dt, burn_in, sampled_steps, every).run(
-            0,
-            &mut *sampler,
-            rng,
-            &mut recorder,
-            |_| {
-                format!(
-                    "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
-                    self.spec.integrator,
-                    r.dt,
-                    r.max_rate * r.dt
-                )
-            },
-        )?;
-        Ok(recorder.rec)
+        Driver::new(r.dt, burn_in, sampled_steps, every)
+    }
+
+    /// The detail of a divergence error of this run.
+    fn divergence_detail(&self) -> String {
+        let r = &self.reference;
+        format!(
+            "non-finite deflection with {} (dt = {:e}, lambda_max*dt = {:.3e})",
+            self.spec.integrator,
+            r.dt,
+            r.max_rate * r.dt
+        )
     }
 }

@@ -37,13 +37,12 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 
-use crate::dynamics::par_indexed;
 use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
-use crate::rng::{derive_seed, trajectory_rng};
+use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
@@ -1045,9 +1044,7 @@ fn simulate_value(
 ) -> Result<(Vec<Estimate>, Vec<TrajectoryRecord>)> {
     let seed = derive_seed(s.seed, &format!("{run_name}/converge/{}={v}", over.name()));
     let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-    let records = par_indexed(ensemble.trajectories as u64, |j| {
-        lr.simulate(&mut trajectory_rng(seed, j), steps)
-    })?;
+    let records = lr.simulate_ensemble(seed, 0, ensemble.trajectories as u64, steps, |_| {})?;
     Ok((estimates(lr, &records)?, records))
 }
 

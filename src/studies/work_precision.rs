@@ -27,7 +27,7 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
 use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
-use crate::rng::{derive_seed, trajectory_rng};
+use crate::rng::derive_seed;
 use crate::scene::linear::LinearRun;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
@@ -387,9 +387,7 @@ fn run_point(opts: &WorkPrecisionOptions, (method, dt, s, lr): &PreparedPoint) -
     let duration = s.runs[0].quick.duration_tau1;
     let steps = lr.sampled_steps(duration * s.filament.tau1());
     let t0 = Instant::now();
-    let records = crate::dynamics::par_indexed(opts.trajectories as u64, |j| {
-        lr.simulate(&mut trajectory_rng(seed, j), steps)
-    })?;
+    let records = lr.simulate_ensemble(seed, 0, opts.trajectories as u64, steps, |_| {})?;
     let wall = t0.elapsed().as_secs_f64();
     let (est, se) = lr.profile_square_estimate(&records, 0)?;
     let cont = lr.reference.profile_continuum[0];

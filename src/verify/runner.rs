@@ -16,11 +16,10 @@
 //!   runs), `force-strain.svg`, and `fig2.svg` under `--out` with the first run of every
 //!   compression scene so far (one per dimension).
 
-use crate::dynamics::par_indexed;
 use crate::error::Result;
 use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
 use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
-use crate::rng::{derive_seed, trajectory_rng};
+use crate::rng::derive_seed;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
     StepChoice, force_estimates_diagnosed, targeted_duration,
@@ -752,18 +751,18 @@ fn simulate_linear(
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let seed = derive_seed(scene.seed, &run.spec.name);
     let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
-    let records = par_indexed(e.trajectories as u64, |j| {
-        let rec = run.simulate(&mut trajectory_rng(seed, j), steps);
-        bar.inc(1);
-        rec
-    })
-    .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-    let extra = par_indexed(e.two_time_trajectories as u64, |j| {
-        let rec = run.simulate(&mut trajectory_rng(seed, e.trajectories as u64 + j), 0);
-        bar.inc(1);
-        rec.map(|r| r.two_time)
-    })
-    .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let full = e.trajectories as u64;
+    let records = run
+        .simulate_ensemble(seed, 0, full, steps, |k| bar.inc(k))
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let extra: Vec<Vec<f64>> = run
+        .simulate_ensemble(seed, full, e.two_time_trajectories as u64, 0, |k| {
+            bar.inc(k)
+        })
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?
+        .into_iter()
+        .map(|r| r.two_time)
+        .collect();
     let two_time = records
         .iter()
         .map(|r| r.two_time.clone())
