@@ -17,8 +17,10 @@ use langevin_fem::FilamentParams;
 use langevin_fem::fem::{BeamModel, Mesh};
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::theory::{
-    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, QuadratureOptions, StoredLengthLaw, Tail,
+    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_QUADRATURE_WORK, PERSISTENCE_RATIO_RANGE,
+    QuadratureOptions, STRAIN_RATIO_SCALE, STRETCH_BEND_RATIO_RANGE, StoredLengthLaw, Tail,
     buckling_load_discrete, continuum_tail_log_char_bound, discrete_buckling_loads,
+    max_strain_ratio,
 };
 use nalgebra::Complex;
 use rand::RngExt;
@@ -967,5 +969,402 @@ fn exact_continuum_tail_matches_brute_force() {
                 assert!(diff < 1e-13, "{dims:?} M = {m}, r = {r}: {diff:e}");
             }
         }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The documented ranges of `theory compression` (issue #12): the ends are answered, fast
+// (bounded work) and right (closed forms and asymptotes that do not use the code's
+// Hurwitz-zeta tail); outside, the CLI refuses with exit 2.
+
+/// `Σ_{n≥1} 1/(n² − y)` for y < 1 in closed form: `(1 − π√y cot π√y)/(2y)`, or with coth for
+/// y < 0 (the partial fractions of the cotangent), `π²/6` at 0.
+fn inverse_square_shifted_sum(y: f64) -> f64 {
+    if y > 1e-8 {
+        let q = PI * y.sqrt();
+        (1.0 - q / q.tan()) / (2.0 * y)
+    } else if y < -1e-8 {
+        let q = PI * (-y).sqrt();
+        (q / q.tanh() - 1.0) / (-2.0 * y)
+    } else {
+        // series in y: Σ 1/n² + y Σ 1/n⁴
+        PI * PI / 6.0 + y * PI.powi(4) / 90.0
+    }
+}
+
+/// The Gaussian mean-field force ratio y = F_mf/F_c0 of the continuum from its closed form:
+/// with κ = S/P² the saddle equation `ψ′(η) + η/EA = ε` reads
+/// `(dκ/2π⁴) Σ_n 1/(n² − y) + y = ε/ε_c0`, solved by bisection on y < 1.
+fn mean_field_ratio_closed_form(kappa: f64, strain_ratio: f64, dims: Dims) -> f64 {
+    let d = dims.copies() as f64;
+    let g = |y: f64| d * kappa / (2.0 * PI.powi(4)) * inverse_square_shifted_sum(y) + y;
+    let (mut lo, mut hi) = (-1e12_f64, 1.0 - 1e-15);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) > strain_ratio {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Filament parameters with L = kT = ξ = 1, EI = P, EA = S (the CLI's units).
+fn dimensionless(persistence_ratio: f64, stretch_ratio: f64) -> FilamentParams {
+    FilamentParams {
+        length: 1.0,
+        bending_rigidity: persistence_ratio,
+        stretch_rigidity: stretch_ratio,
+        drag: 1.0,
+        kt: 1.0,
+    }
+}
+
+/// The corners of the documented box: κ = S/P² at both ends, each with the strain ratios
+/// 0, 1 and the largest allowed, 100√κ.
+fn range_corners() -> Vec<(f64, f64)> {
+    let (k_lo, k_hi) = STRETCH_BEND_RATIO_RANGE;
+    let mut corners = Vec::new();
+    for kappa in [k_lo, k_hi] {
+        for r in [0.0, 1.0, STRAIN_RATIO_SCALE * kappa.sqrt()] {
+            corners.push((kappa, r));
+        }
+    }
+    corners
+}
+
+/// What: every corner of the documented ranges (κ = S/P² at 10⁻² and 10¹², strain ratios
+/// 0, 1 and 100√κ; 2D and 3D; continuum, 1 and 2000 elements) is evaluated, with a bounded
+/// quadrature work.
+/// Reference: the work measure `quadrature_work` (nodes × modes per node, ≈ 10⁸ per
+/// second), not a timing.
+/// Set-up: P = 100 (the result depends on S/P² only: `force_ratio_depends_on_s_over_p2_only`).
+/// Tolerance: work ≤ 10⁸ (≈ 1 s) at each corner (observed ≤ 5·10⁶); before the ranges were set, κ = 10²⁶ ran
+/// for minutes and ε/ε_c0 = 10⁵ at κ = 100 took seconds.
+#[test]
+fn range_corners_are_answered_with_bounded_work() {
+    let p = 100.0;
+    for (kappa, r) in range_corners() {
+        let params = dimensionless(p, kappa * p * p);
+        for dims in [Dims::Two, Dims::Three] {
+            for kind in [
+                Kind::Continuum(DEFAULT_CONTINUUM_MODES),
+                Kind::Discrete(1),
+                Kind::Discrete(2000),
+            ] {
+                let th = theory(&params, dims, kind);
+                let eps = r * params.euler_strain();
+                let work = th.quadrature_work(eps).unwrap();
+                println!("kappa {kappa:e}, r {r:e}, {dims:?} {kind:?}: work {work:.3e}");
+                assert!(
+                    work <= 1e8,
+                    "kappa {kappa:e} r {r:e} {dims:?} {kind:?}: {work:e}"
+                );
+                assert!(th.force_ratio(r).unwrap().is_finite());
+            }
+        }
+    }
+}
+
+/// What: ⟨F⟩/F_c0 depends on P and S only through κ = S/P² (every weight scales as 1/P;
+/// `s = s̃/P` maps the problem onto itself), so the ends of the persistence-ratio range
+/// give the same numbers as P = 100. Checks that P = 10⁻³ and 10⁶ are far from overflow
+/// and underflow (at P = 10¹⁰⁰ the result drifted by 10⁻⁷, at 10⁻³⁰ it was NaN).
+/// Reference: the exact scaling property of the model.
+/// Set-up: κ at both ends and at 100, the corner strains, 2D and 3D continuum, 10 elements.
+/// Tolerance: 10⁻¹¹ relative (rounding of different intermediate magnitudes).
+#[test]
+fn force_ratio_depends_on_s_over_p2_only() {
+    let (p_lo, p_hi) = PERSISTENCE_RATIO_RANGE;
+    let mut cases = range_corners();
+    cases.extend([(100.0, 0.0), (100.0, 3.0), (100.0, 1000.0)]);
+    for (kappa, r) in cases {
+        for dims in [Dims::Two, Dims::Three] {
+            for kind in [Kind::Continuum(DEFAULT_CONTINUUM_MODES), Kind::Discrete(10)] {
+                let at = |p: f64| {
+                    theory(&dimensionless(p, kappa * p * p), dims, kind)
+                        .force_ratio(r)
+                        .unwrap()
+                };
+                let reference = at(100.0);
+                for p in [p_lo, p_hi] {
+                    let v = at(p);
+                    assert!(
+                        (v / reference - 1.0).abs() < 1e-11,
+                        "kappa {kappa:e} r {r} {dims:?} {kind:?} P {p:e}: {v} vs {reference}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// What: the small-κ end (κ = S/P² = 10⁻²) is the Euler limit. Below buckling the
+/// Gaussian mean field is exact to O(κ); far beyond it, 2D approaches F_c0 from above as
+/// `F/F_c0 − 1 ≈ ½/(π⁴(r − 1)/κ − 3d/8)` (the 2D asymptote of
+/// `large_compression_limit_2d_from_above_3d_from_below` in these units: r̄ = (3/4)d c₁) and
+/// 3D sits at F_c0.
+/// Reference: the mean-field closed form `(dκ/2π⁴)Σ1/(n² − y) + y = r` (cotangent partial
+/// fractions, not the code's zeta series) and that asymptote.
+/// Set-up: continuum, P = 100, ε/ε_c0 = 0, 0.5 and the largest allowed, 10.
+/// Tolerance: 10⁻³ relative for the mean field (observed 6·10⁻⁵ at r = 0: the fluctuation
+/// correction is ≈ 0.6κ); 1% of F − F_c0 for the 2D asymptote (as in the paper's case);
+/// 3D within 10⁻⁶ below F_c0.
+#[test]
+fn smallest_stretch_bend_ratio_is_the_euler_limit() {
+    let kappa = STRETCH_BEND_RATIO_RANGE.0;
+    let p = 100.0;
+    let params = dimensionless(p, kappa * p * p);
+    let r_max = max_strain_ratio(p, kappa * p * p);
+    assert!((r_max - 10.0).abs() < 1e-12);
+    for dims in [Dims::Two, Dims::Three] {
+        let th = theory(&params, dims, Kind::Continuum(DEFAULT_CONTINUUM_MODES));
+        for r in [0.0, 0.5] {
+            let exact = th.force_ratio(r).unwrap();
+            let mf = mean_field_ratio_closed_form(kappa, r, dims);
+            assert!(
+                (exact / mf - 1.0).abs() < 1e-3,
+                "{dims:?} r {r}: {exact} vs mean field {mf}"
+            );
+        }
+        let top = th.force_ratio(r_max).unwrap();
+        let d = dims.copies() as f64;
+        match dims {
+            Dims::Two => {
+                let predicted = 0.5 / (PI.powi(4) * (r_max - 1.0) / kappa - 3.0 * d / 8.0);
+                let ratio = (top - 1.0) / predicted;
+                assert!(
+                    (ratio - 1.0).abs() < 0.01,
+                    "2D at r_max: {top}, ratio {ratio}"
+                );
+            }
+            Dims::Three => assert!(top <= 1.0 + 1e-12 && top > 1.0 - 1e-6, "3D: {top}"),
+        }
+    }
+}
+
+/// What: the large-κ end (κ = S/P² = 10¹²) is the large-tension limit: at every allowed
+/// strain (up to 100√κ = 10⁸ ε_c0) the filament is under a tension of order
+/// `(dκ/4π³)^{2/3} F_c0`, where the Gaussian mean field is the leading term and the exact
+/// force differs from it by a relative O(κ^{−1/3}).
+/// Reference: the mean-field closed form `(dκ/2π⁴)Σ1/(n² − y) + y = r` with the
+/// hyperbolic cotangent (not the code's zeta series).
+/// Set-up: continuum, P = 100, ε/ε_c0 = 0, 1 and 10⁸; κ = 10¹⁰ and 10¹² at r = 0 for the
+/// rate.
+/// Tolerance: 3·10⁻⁴ relative at r ≤ 1 (observed 1.1·10⁻⁴ in 2D, 4·10⁻⁵ in 3D), 5% at
+/// r = 10⁸ (observed 2.4%: the tension is only 6·10³ F_c0 there); the relative
+/// difference falls by 100^{1/3} ≈ 4.6 (± 15%) from κ = 10¹⁰ to 10¹².
+#[test]
+fn largest_stretch_bend_ratio_is_the_large_tension_limit() {
+    let kappa = STRETCH_BEND_RATIO_RANGE.1;
+    let p = 100.0;
+    for dims in [Dims::Two, Dims::Three] {
+        let rel = |kappa: f64, r: f64| {
+            let th = theory(
+                &dimensionless(p, kappa * p * p),
+                dims,
+                Kind::Continuum(DEFAULT_CONTINUUM_MODES),
+            );
+            let exact = th.force_ratio(r).unwrap();
+            let mf = mean_field_ratio_closed_form(kappa, r, dims);
+            assert!(exact < 0.0 && mf < 0.0, "{dims:?} kappa {kappa:e} r {r}");
+            (exact / mf - 1.0).abs()
+        };
+        for r in [0.0, 1.0] {
+            let e = rel(kappa, r);
+            assert!(e < 3e-4, "{dims:?} r {r}: relative difference {e:e}");
+        }
+        let e_top = rel(kappa, STRAIN_RATIO_SCALE * kappa.sqrt());
+        assert!(e_top < 0.05, "{dims:?} at r_max: {e_top:e}");
+        let rate = rel(1e10, 0.0) / rel(kappa, 0.0);
+        assert!(
+            (rate / 100f64.cbrt() - 1.0).abs() < 0.15,
+            "{dims:?}: rate {rate}"
+        );
+    }
+}
+
+/// What: no jumps and no stuck values across the documented κ range: on a grid of κ = S/P²
+/// from 10⁻² to 10¹² (steps of 10^{1/4}) the exact force at ε = 0 over the closed-form mean
+/// field changes smoothly; at ε = 3ε_c0 every value moves when the strain moves by 10⁻⁶
+/// relative (not stuck at one value), by a plausible amount; and the quadrature work at the
+/// largest allowed strain stays bounded over the whole grid.
+/// Reference: the mean-field closed form (a smooth function of κ).
+/// Set-up: continuum and 10 elements, 2D, P = 100.
+/// Tolerance: |ln q_{i+1}/q_i| < 0.25 for q = exact/mean field at ε = 0 (q stays within 10%
+/// of 1, observed steps ≤ 0.02; a factor-50 jump is ln 50 ≈ 3.9); |F(3(1+10⁻⁶)) −
+/// F(3(1−10⁻⁶))| between 10⁻¹² and 10⁻⁵ F_c0 (dF/dε is at most ≈ EA, i.e. dF/F_c0 ≤ dr);
+/// work ≤ 10⁸ at ε/ε_c0 = 100√κ.
+#[test]
+fn force_ratio_is_continuous_across_the_range() {
+    let p = 100.0;
+    let (k_lo, k_hi) = STRETCH_BEND_RATIO_RANGE;
+    let steps = (4.0 * (k_hi / k_lo).log10()).round() as i32;
+    for kind in [Kind::Continuum(DEFAULT_CONTINUUM_MODES), Kind::Discrete(10)] {
+        let mut prev: Option<f64> = None;
+        let (mut worst_step, mut worst_work) = (0.0_f64, 0.0_f64);
+        for i in 0..=steps {
+            let kappa = k_lo * 10f64.powf(i as f64 / 4.0);
+            let th = theory(&dimensionless(p, kappa * p * p), Dims::Two, kind);
+            let q =
+                th.force_ratio(0.0).unwrap() / mean_field_ratio_closed_form(kappa, 0.0, Dims::Two);
+            if let Some(prev) = prev {
+                let step = (q / prev).ln().abs();
+                worst_step = worst_step.max(step);
+                assert!(step < 0.25, "{kind:?} kappa {kappa:e}: {prev} -> {q}");
+            }
+            prev = Some(q);
+            let up = th.force_ratio(3.0 * (1.0 + 1e-6)).unwrap();
+            let down = th.force_ratio(3.0 * (1.0 - 1e-6)).unwrap();
+            let diff = (up - down).abs();
+            assert!(
+                diff > 1e-12 && diff < 1e-5,
+                "{kind:?} kappa {kappa:e}: F(r±) differ by {diff:e}"
+            );
+            let r_max = STRAIN_RATIO_SCALE * kappa.sqrt();
+            let work = th
+                .quadrature_work(r_max * th.params().euler_strain())
+                .unwrap();
+            worst_work = worst_work.max(work);
+            assert!(
+                work <= 1e8,
+                "{kind:?} kappa {kappa:e} at r_max: work {work:e}"
+            );
+        }
+        println!("{kind:?}: largest step {worst_step:.3}, largest work {worst_work:.3e}");
+    }
+}
+
+/// What: the library refuses what the CLI's ranges exclude with a numerical error instead
+/// of hanging: κ = 10²⁶ (the exact tail would sum ≈ 10⁸ modes one by one; before, minutes)
+/// and ε/ε_c0 = 10⁸ at κ = 100 (≈ 10¹⁰ mode evaluations; before, a timeout).
+/// Reference: the caps `MAX_QUADRATURE_WORK` and the tail-mode cap.
+/// Set-up: P = 100, continuum, 2D.
+/// Tolerance: exact (an `Error::Numerical` naming the routine).
+#[test]
+fn library_caps_refuse_instead_of_hanging() {
+    let p = 100.0;
+    let th = theory(
+        &dimensionless(p, 1e26 * p * p),
+        Dims::Two,
+        Kind::Continuum(DEFAULT_CONTINUUM_MODES),
+    );
+    let err = th.force_ratio(0.0).unwrap_err();
+    assert!(
+        matches!(err, langevin_fem::Error::Numerical { .. }) && err.to_string().contains("modes"),
+        "{err}"
+    );
+    let th = theory(
+        &dimensionless(p, 100.0 * p * p),
+        Dims::Two,
+        Kind::Continuum(DEFAULT_CONTINUUM_MODES),
+    );
+    let work = th
+        .quadrature_work(1e8 * th.params().euler_strain())
+        .unwrap();
+    assert!(work > MAX_QUADRATURE_WORK, "{work:e}");
+    let err = th.force_ratio(1e8).unwrap_err();
+    assert!(
+        matches!(err, langevin_fem::Error::Numerical { .. })
+            && err.to_string().contains("trapezoid nodes"),
+        "{err}"
+    );
+}
+
+/// What: the CLI accepts the ends of every documented range and refuses values just
+/// outside with exit 2, a message naming the flag, the value as typed (full precision) and
+/// the range; no stdout. The bounds printed for --stretch-ratio and --strain-ratio are
+/// accepted when copied back (compared and printed exactly).
+/// Reference: the documented ranges (`--help`, README): P in [10⁻³, 10⁶], S/P² in
+/// [10⁻², 10¹²], ε/ε_c0 in [0, 100√S/P].
+/// Set-up: default P = 100, S = 10⁶ unless given; continuum 2D.
+/// Tolerance: exact (exit codes and substrings).
+#[test]
+fn cli_enforces_the_documented_ranges() {
+    let ok: [&[&str]; 6] = [
+        &["--persistence-ratio", "1e-3", "--stretch-ratio", "1e-8"],
+        &["--persistence-ratio", "1e6", "--stretch-ratio", "1e10"],
+        &["--persistence-ratio", "1e6", "--stretch-ratio", "1e24"],
+        &["--stretch-ratio", "100"],
+        &["--stretch-ratio", "1e16", "--strain-ratio", "0,1e8"],
+        &["--strain-ratio", "0,1000"],
+    ];
+    for extra in ok {
+        let mut args = vec!["--dims", "2"];
+        if !extra.contains(&"--strain-ratio") {
+            args.extend(["--strain-ratio", "0,1"]);
+        }
+        args.extend(extra);
+        let out = run_cli(&args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // (arguments, flag, value as printed, range as printed)
+    let bad: [(&[&str], &str, &str, &str); 7] = [
+        (
+            &["--persistence-ratio", "9.99e-4"],
+            "--persistence-ratio",
+            "9.99e-4",
+            "[1e-3, 1e6]",
+        ),
+        (
+            &[
+                "--persistence-ratio",
+                "1000000.1",
+                "--stretch-ratio",
+                "1e12",
+            ],
+            "--persistence-ratio",
+            "1.0000001e6",
+            "[1e-3, 1e6]",
+        ),
+        (
+            &["--persistence-ratio", "1e-30"],
+            "--persistence-ratio",
+            "1e-30",
+            "[1e-3, 1e6]",
+        ),
+        (
+            &["--stretch-ratio", "99.99999"],
+            "--stretch-ratio",
+            "9.999999e1",
+            "[1e2, 1e16]",
+        ),
+        (
+            &["--stretch-ratio", "1.0000001e16"],
+            "--stretch-ratio",
+            "1.0000001e16",
+            "[1e2, 1e16]",
+        ),
+        (
+            &["--persistence-ratio", "1e6"],
+            "--stretch-ratio",
+            "1e6",
+            "[1e10, 1e24] at --persistence-ratio 1e6",
+        ),
+        (
+            &["--strain-ratio", "1,1000.0000001"],
+            "--strain-ratio",
+            "1000.0000001",
+            "[0, 1e3]",
+        ),
+    ];
+    for (extra, flag, value, range) in bad {
+        let mut args = vec!["--dims", "2"];
+        if !extra.contains(&"--strain-ratio") {
+            args.extend(["--strain-ratio", "0,1"]);
+        }
+        args.extend(extra);
+        let out = run_cli(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for part in [flag, value, range] {
+            assert!(err.contains(part), "{args:?}: {err:?} lacks {part:?}");
+        }
+        assert!(out.stdout.is_empty());
     }
 }

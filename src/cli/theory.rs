@@ -5,7 +5,8 @@ use langevin_fem::FilamentParams;
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
 use langevin_fem::spectral::HingedBeam;
 use langevin_fem::theory::{
-    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS, StoredLengthLaw,
+    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS,
+    PERSISTENCE_RATIO_RANGE, STRETCH_BEND_RATIO_RANGE, StoredLengthLaw, max_strain_ratio,
 };
 use serde_json::json;
 
@@ -92,49 +93,85 @@ enum Query {
     },
     /// Exact equilibrium mean compressive force ⟨F⟩/F_c0 of a hinged filament at imposed
     /// strains ε/ε_c0 (the paper's Fig. 2; no mean-field approximation). Units
-    /// L = kT = ξ = 1, so EI = P and EA = S.
+    /// L = kT = ξ = 1, so EI = P and EA = S. The result depends on P and S only through
+    /// S/P², which must lie in [1e-2, 1e12]: below, the filament is at the Euler limit
+    /// min(ε/ε_c0, 1) and the quadrature work grows as 1/√(S/P²); above, it is under a large
+    /// tension at every strain and the exact mode sum grows as (S/P²)^(1/3).
     Compression {
         /// Spatial dimension: 2 (planar) or 3.
         #[arg(long, allow_negative_numbers = true)]
         dims: i64,
-        /// Comma-separated strain ratios ε/ε_c0, each finite and >= 0.
+        /// Comma-separated strain ratios ε/ε_c0, each in [0, 100·√S/P] (10 at the smallest
+        /// S/P², 10⁸ at the largest; the work grows with ε/ε_c0).
         #[arg(long, allow_hyphen_values = true)]
         strain_ratio: String,
         /// Number of Hermite-cubic elements (the discretized filament), in [1, 2000];
         /// without it, the continuum.
         #[arg(long, allow_negative_numbers = true)]
         elements: Option<i64>,
-        /// Persistence ratio P = EI/(kT·L), > 0.
+        /// Persistence ratio P = EI/(kT·L), in [1e-3, 1e6] (with S/P² in [1e-2, 1e12]).
         #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
         persistence_ratio: f64,
-        /// Stretch ratio S = EA·L/kT, > 0.
+        /// Stretch ratio S = EA·L/kT, with S/P² in [1e-2, 1e12], i.e. S in
+        /// [1e-2·P², 1e12·P²].
         #[arg(long, default_value_t = 1.0e6, allow_negative_numbers = true)]
         stretch_ratio: f64,
     },
 }
 
-/// Parses `--strain-ratio`: a non-empty comma-separated list of finite numbers >= 0.
-fn parse_strain_ratios(list: &str) -> Result<Vec<f64>> {
-    const ALLOWED: &str = "a non-empty comma-separated list of finite numbers >= 0";
+/// Parses `--strain-ratio`: a non-empty comma-separated list of numbers in `[0, max]`
+/// (`max` = [`max_strain_ratio`] of the already validated P and S, `context` names them).
+fn parse_strain_ratios(list: &str, max: f64, context: &str) -> Result<Vec<f64>> {
+    let allowed =
+        || format!("a non-empty comma-separated list of numbers in [0, {max:e}] {context}");
     let items: Vec<&str> = list.split(',').map(str::trim).collect();
     if items.iter().all(|s| s.is_empty()) {
         return Err(Error::invalid(
             "--strain-ratio",
             format!("{list:?}"),
-            ALLOWED,
+            allowed(),
         ));
     }
     items
         .iter()
         .map(|item| match item.parse::<f64>() {
-            Ok(r) if r.is_finite() && r >= 0.0 => Ok(r),
+            Ok(r) if r.is_finite() && (0.0..=max).contains(&r) => Ok(r),
             _ => Err(Error::invalid(
                 "--strain-ratio",
                 format!("{item:?}"),
-                ALLOWED,
+                allowed(),
             )),
         })
         .collect()
+}
+
+/// Checks `--persistence-ratio` and `--stretch-ratio` against [`PERSISTENCE_RATIO_RANGE`]
+/// and [`STRETCH_BEND_RATIO_RANGE`] (the latter as bounds on S at the given P, compared and
+/// printed exactly, so that a bound copied from the message is accepted).
+fn check_ratios(persistence_ratio: f64, stretch_ratio: f64) -> Result<()> {
+    let (p_lo, p_hi) = PERSISTENCE_RATIO_RANGE;
+    if !(persistence_ratio.is_finite() && persistence_ratio >= p_lo && persistence_ratio <= p_hi) {
+        return Err(Error::invalid(
+            "--persistence-ratio",
+            format!("{persistence_ratio:e}"),
+            format!("in [{p_lo:e}, {p_hi:e}]"),
+        ));
+    }
+    let (k_lo, k_hi) = STRETCH_BEND_RATIO_RANGE;
+    let p2 = persistence_ratio * persistence_ratio;
+    let (s_lo, s_hi) = (k_lo * p2, k_hi * p2);
+    if !(stretch_ratio.is_finite() && stretch_ratio >= s_lo && stretch_ratio <= s_hi) {
+        return Err(Error::invalid(
+            "--stretch-ratio",
+            format!("{stretch_ratio:e}"),
+            format!(
+                "in [{s_lo:e}, {s_hi:e}] at --persistence-ratio {persistence_ratio:e} (S/P² in \
+                 [{k_lo:e}, {k_hi:e}]: the force ratio depends on S/P² only; outside, the \
+                 exact theory is too slow or at a known limit, see --help)"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The compression query: validates the flags and evaluates the exact theory.
@@ -149,8 +186,7 @@ fn compression(
         2 | 3 => Dims::from_u32(dims as u32)?,
         _ => return Err(Error::invalid("--dims", dims, "2 or 3")),
     };
-    require_positive("--persistence-ratio", persistence_ratio)?;
-    require_positive("--stretch-ratio", stretch_ratio)?;
+    check_ratios(persistence_ratio, stretch_ratio)?;
     let elements = match elements {
         None => None,
         Some(n) if n >= 1 && n <= MAX_DISCRETE_ELEMENTS as i64 => Some(n as usize),
@@ -162,7 +198,14 @@ fn compression(
             ));
         }
     };
-    let ratios = parse_strain_ratios(strain_ratio)?;
+    let ratios = parse_strain_ratios(
+        strain_ratio,
+        max_strain_ratio(persistence_ratio, stretch_ratio),
+        &format!(
+            "(100·√S/P at --persistence-ratio {persistence_ratio:e} and --stretch-ratio \
+             {stretch_ratio:e})"
+        ),
+    )?;
     let params = FilamentParams {
         length: 1.0,
         bending_rigidity: persistence_ratio,

@@ -211,6 +211,44 @@ pub const DEFAULT_CONTINUUM_MODES: usize = 64;
 /// [`buckling_load_discrete`] (the generalized eigenproblem is solved densely, `O(N³)`).
 pub const MAX_DISCRETE_ELEMENTS: usize = 2000;
 
+/// Range of the persistence ratio `P = EI/(kT·L)` over which the theory is verified
+/// (`theory compression --persistence-ratio`). The force ratio ⟨F⟩/F_c0 depends on P and
+/// `S = EA·L/kT` only through `S/P²` (with `L = kT = 1`, every weight `c_i` scales as
+/// `1/P`; substituting `s = s̃/P` leaves `A(s − ε)² = (S/2P²)(s̃ − rπ²P²/S)²`), so this range
+/// only keeps the intermediate quantities (`c₁ ∝ 1/P`, `A ∝ S`, their powers in the series)
+/// far from overflow and underflow: at `P = 10¹⁰⁰` the power sums of the small modes
+/// underflow and ⟨F⟩ drifts by 10⁻⁷ relative; at `P = 10⁻³⁰` the quadrature overflows.
+/// Values below `P ≈ 1` are outside the small-slope (von Kármán) model anyway: the RMS
+/// slope of the free filament is `√(d/(6P))`.
+pub const PERSISTENCE_RATIO_RANGE: (f64, f64) = (1e-3, 1e6);
+
+/// Range of `κ = S/P² = EA·L³·kT/EI²` (stretch ratio over persistence ratio squared), the
+/// one combination of P and S that ⟨F⟩/F_c0 depends on (see [`PERSISTENCE_RATIO_RANGE`]).
+/// For a rod of radius of gyration r_g, `κ = (L/r_g)²/P`: the paper's filament has κ = 100,
+/// microtubules to DNA ≈ 10³ … 10⁸. The ends: at κ = 10⁻² (stiff, nearly inextensible in
+/// bending terms) the force is the Euler limit `min(ε/ε_c0, 1)·F_c0` up to a thermal
+/// correction of order κ (10⁻⁴ relative; 5·10⁻³ within the crossover ε ≈ ε_c0), and the
+/// quadrature work grows as `(ε/ε_c0)/√κ`; at κ = 10¹² (floppy) the filament is under a
+/// tension of `≈ (dκ/4π³)^{2/3} F_c0` at every allowed strain, the saddle point sits at
+/// `2c₁|η̂| ≈ 10⁸` and the exact tail sums `≈ 4√(2c₁|η|)` modes one by one (the work grows
+/// as `κ^{1/3}`; at κ = 10²⁶ it runs for minutes).
+pub const STRETCH_BEND_RATIO_RANGE: (f64, f64) = (1e-2, 1e12);
+
+/// The largest strain ratio ε/ε_c0 accepted is this times `√κ = √S/P`
+/// ([`max_strain_ratio`]): the trapezoid step must resolve the tilted law of the stored
+/// length, whose width at large compression is ≈ ε, within a Gaussian range `√(4A·50)`, so
+/// the number of nodes grows as `ε√S ∝ (ε/ε_c0)/√κ`; at this bound the work
+/// ([`CompressionTheory::quadrature_work`]) stays below 3·10⁷ mode evaluations (≈ 0.3 s)
+/// over the whole κ range (tested). At the smallest κ the bound is 10 ε_c0, where ⟨F⟩ is
+/// within 10⁻⁵ of F_c0; at κ = 100 (the paper) it is 10³ ε_c0.
+pub const STRAIN_RATIO_SCALE: f64 = 100.0;
+
+/// The largest strain ratio ε/ε_c0 verified at persistence ratio `p` and stretch ratio `s`:
+/// [`STRAIN_RATIO_SCALE`]`·√s/p`.
+pub fn max_strain_ratio(persistence_ratio: f64, stretch_ratio: f64) -> f64 {
+    STRAIN_RATIO_SCALE * stretch_ratio.sqrt() / persistence_ratio
+}
+
 /// Terms of the power series used for the small modes.
 const SERIES_TERMS: usize = 30;
 /// Modes with `b τ_max` at most this go into the power series.
@@ -223,6 +261,16 @@ const MAX_FOURIER_TERMS: usize = 200_000;
 const KERNEL_ANCHOR: i64 = 8;
 /// Extra exponent for the Gaussian range of the quadrature.
 const RANGE_MARGIN: f64 = 10.0;
+/// Cap on the work of one quadrature, trapezoid nodes times modes evaluated per node
+/// ([`CompressionTheory::quadrature_work`]); about 10 s. Inside the ranges the CLI accepts
+/// ([`STRETCH_BEND_RATIO_RANGE`], [`max_strain_ratio`]) the work stays below 10⁸.
+pub const MAX_QUADRATURE_WORK: f64 = 2e9;
+/// Cap on the number of continuum tail modes summed one by one in one evaluation of the
+/// exact tail at a real argument (`2c₁|η|` up to `(cap/4)²`); about 40 ms each.
+const MAX_TAIL_MODES: usize = 4_000_000;
+/// Cap on the Newton/bisection iterations of the saddle point (bisection alone halves a
+/// bracket of 2¹⁰²⁴ to rounding in ≈ 1100 steps; Newton converges in ≈ 10).
+const MAX_SADDLE_ITERATIONS: usize = 300;
 
 fn numerical(routine: &str, detail: impl Into<String>) -> Error {
     Error::Numerical {
@@ -1044,6 +1092,11 @@ impl Contour {
         )
     }
 
+    /// Modes (explicit, plus the power-series terms) evaluated per node.
+    fn modes_per_node(&self) -> usize {
+        self.explicit.len() + self.series.len()
+    }
+
     /// `φ_η(τ) e^{−iτm}`.
     fn shifted(&self, tau: f64) -> Complex<f64> {
         let l = self.log_phi(tau);
@@ -1201,6 +1254,20 @@ impl CompressionTheory {
         let g = |eta: f64| self.psi1(eta) + eta * inv2a - strain;
         let mean = self.mean;
         let mut lo = (2.0 * self.a * (strain - mean)).min(0.0) - 1.0;
+        // η̂ ≥ lo: the exact tail at η̂ sums at most this many modes one by one
+        let tail_modes = self.tail_modes_at(lo);
+        if tail_modes > MAX_TAIL_MODES {
+            return Err(numerical(
+                "compression saddle point",
+                format!(
+                    "strain {strain:e}: the saddle point may lie as far as eta = {lo:e}, where \
+                     the exact continuum tail would sum {tail_modes} modes one by one (cap \
+                     {MAX_TAIL_MODES}); EA*L^3*kT/EI^2 = {:e} is too large",
+                    self.params.stretch_rigidity * self.params.length.powi(3) * self.params.kt
+                        / self.params.bending_rigidity.powi(2)
+                ),
+            ));
+        }
         let emax = self.eta_max();
         let mut hi = if emax.is_finite() {
             let mut r = 0.5_f64;
@@ -1226,7 +1293,7 @@ impl CompressionTheory {
         // g is increasing and convex: Newton from the right converges monotonically; the
         // bracket guards against rounding.
         let mut eta = hi;
-        for _ in 0..300 {
+        for _ in 0..MAX_SADDLE_ITERATIONS {
             let gv = g(eta);
             let g_scale = strain.abs() + mean + eta.abs() * inv2a;
             if gv.abs() <= 1e-15 * g_scale {
@@ -1248,7 +1315,30 @@ impl CompressionTheory {
             }
             eta = next;
         }
-        Ok(eta)
+        Err(numerical(
+            "compression saddle point",
+            format!(
+                "no convergence at strain {strain:e} after {MAX_SADDLE_ITERATIONS} iterations \
+                 (bracket [{lo:e}, {hi:e}], residual {:e})",
+                g(eta)
+            ),
+        ))
+    }
+
+    /// Number of continuum tail modes the exact tail sums one by one at the real argument
+    /// `2c₁η` (0 without an [`Tail::InverseSquare`] tail).
+    fn tail_modes_at(&self, eta: f64) -> usize {
+        match &self.exact_tail {
+            Some(t) => {
+                let need = TAIL_BASE_FACTOR * (2.0 * t.c1 * eta).abs().sqrt();
+                if need.is_finite() {
+                    (need.ceil() as usize).saturating_sub(t.first())
+                } else {
+                    usize::MAX
+                }
+            }
+            None => 0,
+        }
     }
 
     /// Chernoff bounds `P(s_η − m > x_R) ≤ e^{−level}`, `P(s_η − m < −x_L) ≤ e^{−level}`
@@ -1266,7 +1356,11 @@ impl CompressionTheory {
             .map(|k| theta0 * 2f64.powf(k as f64 / 2.0))
             .collect();
         let (mut x_l, mut x_r) = (f64::INFINITY, f64::INFINITY);
-        for &th in &ladder {
+        // (far-left exponents whose exact tail would be too long only loosen the bound)
+        for &th in ladder
+            .iter()
+            .filter(|&&th| self.tail_modes_at(eta - th) <= MAX_TAIL_MODES)
+        {
             let v = (level + self.psi(eta - th) - p0 + th * m) / th;
             if v.is_finite() {
                 x_l = x_l.min(v);
@@ -1419,6 +1513,19 @@ impl CompressionTheory {
     fn evaluate(&self, strain: f64) -> Result<(Setup, Moments)> {
         let s = self.setup(strain)?;
         let c = self.contour(&s, s.tau_max);
+        let work = Self::work_of(&s, &c);
+        if work > MAX_QUADRATURE_WORK {
+            return Err(numerical(
+                "compression quadrature",
+                format!(
+                    "strain {strain:e} would need {:.3e} trapezoid nodes times {} modes = \
+                     {work:.3e} mode evaluations (cap {MAX_QUADRATURE_WORK:e}; the nodes grow \
+                     as the strain times sqrt(EA*L/kT))",
+                    s.tau_max / s.h,
+                    c.modes_per_node()
+                ),
+            ));
+        }
         let mo = self.moments(&s, &c);
         if !(mo.s0.is_finite() && mo.s0 > 0.0 && mo.s1.is_finite() && mo.s2.is_finite()) {
             return Err(numerical(
@@ -1430,6 +1537,25 @@ impl CompressionTheory {
             ));
         }
         Ok((s, mo))
+    }
+
+    /// Upper bound on the work of the quadrature: nodes up to `τ_max` times the modes
+    /// evaluated per node.
+    fn work_of(s: &Setup, c: &Contour) -> f64 {
+        (s.tau_max / s.h + 1.0) * c.modes_per_node() as f64
+    }
+
+    /// The work of the quadrature for ⟨F⟩ at strain ε, as the number of mode evaluations
+    /// (trapezoid nodes up to the range `τ_max`, an upper bound on those used, times the
+    /// explicit modes plus the power-series terms evaluated at each node). A deterministic
+    /// measure of the cost (≈ 10⁸ per second); above [`MAX_QUADRATURE_WORK`] the
+    /// evaluation is refused.
+    ///
+    /// # Errors
+    /// As [`Self::mean_force`], except for the cap itself.
+    pub fn quadrature_work(&self, strain: f64) -> Result<f64> {
+        let s = self.setup(strain)?;
+        Ok(Self::work_of(&s, &self.contour(&s, s.tau_max)))
     }
 
     fn mean_from(&self, s: &Setup, mo: &Moments) -> f64 {
