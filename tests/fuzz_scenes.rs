@@ -289,6 +289,17 @@ fn mutated_scenes_are_refused_or_bounded() {
         }
     }
     assert!(bases.len() >= 6, "expected the shipped scenes");
+    // The bases are valid, so that a mutant differs from a valid scene by its mutations.
+    for (name, _) in &bases {
+        let base = ["verification", "verification/extreme", "tests/scenes/good"]
+            .iter()
+            .map(|d| fixture(d).join(name))
+            .find(|p| p.is_file())
+            .expect("base file");
+        if let Err(e) = Scene::load(&base) {
+            panic!("base scene {name} is invalid: {e}");
+        }
+    }
     let dir = TempDir::new("fuzz");
     let (accepted, refused) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut runner = TestRunner::new(Config {
