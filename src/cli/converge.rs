@@ -2,7 +2,7 @@
 //! compression) over the element count or the time step, with fitted orders against the
 //! expected ones.
 
-use super::{parse_list, resolve_scene};
+use super::{parse_list, resolve_scene, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -43,8 +43,8 @@ pub struct ConvergeArgs {
     /// Ensemble budget of the run (trajectories and duration per value).
     #[arg(long, value_enum, default_value = "quick")]
     budget: BudgetArg,
-    /// Trajectories per value, instead of the budget's.
-    #[arg(long, value_name = "N")]
+    /// Trajectories per value, instead of the budget's (1 to 100000).
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 100_000>)]
     trajectories: Option<usize>,
     /// Sampled duration per trajectory (tau1), instead of the budget's.
     #[arg(long, value_name = "T", allow_hyphen_values = true)]

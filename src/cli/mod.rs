@@ -109,6 +109,32 @@ fn check_out_dir(out: &Path) -> Result<()> {
     })
 }
 
+/// A whole-number flag in `[LO, HI]`, as clap's value parser: any integer text is read
+/// (a negative one, or one beyond `u64`) so that the message names the flag (clap adds
+/// it), the value and the range, e.g. "invalid value '-3' for '--trajectories <N>': must
+/// be an integer in [2, 1024]".
+fn count_in<const LO: u64, const HI: u64>(text: &str) -> std::result::Result<u64, String> {
+    let fmt = |v: u64| {
+        // 100000000 reads better as 1e8.
+        let exponent = v.checked_ilog10().unwrap_or(0);
+        if v >= 1_000_000 && 10u64.pow(exponent) == v {
+            format!("1e{exponent}")
+        } else {
+            v.to_string()
+        }
+    };
+    let allowed = format!("must be an integer in [{}, {}]", fmt(LO), fmt(HI));
+    match text.trim().parse::<i128>() {
+        Ok(v) if v >= i128::from(LO) && v <= i128::from(HI) => Ok(v as u64),
+        _ => Err(allowed),
+    }
+}
+
+/// [`count_in`] for a `usize` flag.
+fn usize_in<const LO: u64, const HI: u64>(text: &str) -> std::result::Result<usize, String> {
+    count_in::<LO, HI>(text).and_then(|v| usize::try_from(v).map_err(|e| e.to_string()))
+}
+
 /// Parses a comma-separated list for `flag`; a bad item exits with code 2 naming the
 /// flag, the item and `allowed`.
 fn parse_list<T: FromStr>(flag: &str, text: &str, allowed: &str) -> Result<Vec<T>> {

@@ -1,13 +1,13 @@
 //! `langevin-fem stability`: stability map (integrator × Δt·λ_max × element count) and
 //! the measured per-mode stationary bias against each integrator's exact formula.
 
-use super::{parse_list_or, resolve_scene};
+use super::{count_in, parse_list_or, resolve_scene, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::studies::stability::{
-    DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, StabilityOptions, Status,
-    run_stability,
+    DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, ELEMENTS_RANGE, StabilityOptions,
+    Status, run_stability,
 };
 use std::path::PathBuf;
 
@@ -23,23 +23,23 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "I1,I2,...")]
     integrators: Option<String>,
     /// Comma-separated element counts (default 5,10,20,40).
-    #[arg(long, value_name = "N1,N2,...")]
+    #[arg(long, value_name = "N1,N2,...", allow_hyphen_values = true)]
     elements: Option<String>,
     /// Comma-separated normalized steps dt*lambda_max (default 0.1,1,1.9,2.1,10,1e3,1e5;
     /// the explicit limit is 2).
-    #[arg(long, value_name = "A1,A2,...")]
+    #[arg(long, value_name = "A1,A2,...", allow_hyphen_values = true)]
     dt_lambda_max: Option<String>,
-    /// Independent trajectories per cell.
-    #[arg(long, default_value_t = 4)]
+    /// Independent trajectories per cell (2 to 1024).
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = usize_in::<2, 1024>)]
     trajectories: usize,
-    /// Sampled steps per trajectory.
-    #[arg(long, default_value_t = 50_000)]
+    /// Sampled steps per trajectory (1000 to 1e8).
+    #[arg(long, default_value_t = 50_000, allow_negative_numbers = true, value_parser = count_in::<1000, 100_000_000>)]
     steps: u64,
-    /// Burn-in steps per trajectory (from rest).
-    #[arg(long, default_value_t = 5_000)]
+    /// Burn-in steps per trajectory, from rest (0 to 1e8).
+    #[arg(long, default_value_t = 5_000, allow_negative_numbers = true, value_parser = count_in::<0, 100_000_000>)]
     burn_in: u64,
     /// Family-wise significance level (Holm) of the bias and formula tests.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
@@ -74,13 +74,16 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         "--elements",
         args.elements.as_deref(),
         &DEFAULT_ELEMENTS,
-        "comma-separated integers",
+        &format!(
+            "comma-separated integers in [{}, {}]",
+            ELEMENTS_RANGE.0, ELEMENTS_RANGE.1
+        ),
     )?;
     let dt_lambda_max = parse_list_or(
         "--dt-lambda-max",
         args.dt_lambda_max.as_deref(),
         &DEFAULT_DT_LAMBDA_MAX,
-        "comma-separated numbers",
+        "comma-separated numbers in (0, 1e12]",
     )?;
     let scene = resolve_scene(&args.scene, &args.scene_dir)?;
     let s = run_stability(&StabilityOptions {

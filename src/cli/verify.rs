@@ -24,7 +24,7 @@ pub struct VerifyArgs {
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,
     /// Family-wise significance level per scene (Holm correction).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
 }
 

@@ -1,7 +1,7 @@
 //! `langevin-fem work-precision`: error in ⟨w²(L/2)⟩ against wall time for every
 //! integrator and noise model, with the projected cost of reaching a tolerance.
 
-use super::{parse_list_or, resolve_scene};
+use super::{parse_list_or, resolve_scene, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -25,24 +25,24 @@ pub struct WorkPrecisionArgs {
     methods: Option<String>,
     /// Comma-separated dt/tau1 of the unconditionally stable integrators (default
     /// 1e-2,3e-3,1e-3,3e-4).
-    #[arg(long, value_name = "D1,D2,...")]
+    #[arg(long, value_name = "D1,D2,...", allow_hyphen_values = true)]
     dt_tau1: Option<String>,
     /// Comma-separated fractions of the stability limit for euler-maruyama (default
     /// 0.9,0.45).
-    #[arg(long, value_name = "F1,F2,...")]
+    #[arg(long, value_name = "F1,F2,...", allow_hyphen_values = true)]
     em_fractions: Option<String>,
-    /// Trajectories per point.
-    #[arg(long, default_value_t = 8)]
+    /// Trajectories per point (2 to 1024).
+    #[arg(long, default_value_t = 8, allow_negative_numbers = true, value_parser = usize_in::<2, 1024>)]
     trajectories: usize,
     /// Sampled duration per trajectory, in units of tau1 (stable integrators).
-    #[arg(long, default_value_t = 400.0)]
+    #[arg(long, default_value_t = 400.0, allow_negative_numbers = true)]
     duration: f64,
     /// Sampled duration per trajectory of euler-maruyama, in units of tau1 (its step is
     /// bounded by the stability limit, about 1e5 steps per tau1 at 10 elements).
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
     em_duration: f64,
     /// Relative error whose projected cost is tabulated.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     tolerance: f64,
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
@@ -83,13 +83,13 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         "--dt-tau1",
         args.dt_tau1.as_deref(),
         &DEFAULT_DT_TAU1,
-        "comma-separated numbers",
+        "comma-separated numbers in [1e-12, 1]",
     )?;
     let em_fractions = parse_list_or(
         "--em-fractions",
         args.em_fractions.as_deref(),
         &DEFAULT_EM_FRACTIONS,
-        "comma-separated numbers",
+        "comma-separated numbers in (0, 1)",
     )?;
     let scene = resolve_scene(&args.scene, &args.scene_dir)?;
     let s = run_work_precision(&WorkPrecisionOptions {

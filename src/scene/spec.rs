@@ -18,11 +18,11 @@
 //! [sampling]
 //! burn_in_tau1 = 5.0             # from rest, before sampling starts (units of τ1)
 //! modes = 6                      # modes checked
-//! profile_points = [0.25, 0.5]   # x/L where ⟨w²(x)⟩ is checked
-//! two_time = [[0.5, 0.5, 0.05, 0.1]]  # (x/L, y/L, t/τ1, η/τ1) for eq. (4), from rest
+//! profile_points = [0.25, 0.5]   # x/L in (0, 1) where ⟨w²(x)⟩ is checked (at most 100)
+//! two_time = [[0.5, 0.5, 0.05, 0.1]]  # (x/L, y/L, t/τ1, η/τ1) for eq. (4), from rest (at most 100)
 //!
 //! [[runs]]
-//! name = "crank-nicolson"
+//! name = "crank-nicolson"        # [A-Za-z0-9_-], at most 64 characters (a file name)
 //! integrator = "crank-nicolson"  # euler-maruyama | backward-euler | crank-nicolson | exact-modal
 //! noise = "consistent"           # consistent | element-uniform
 //! dt_tau1 = 0.01                 # time step in units of τ1
@@ -36,9 +36,15 @@
 //! - `trajectories`: independent trajectories (per strain in a compression scene),
 //!   in [2, 100000];
 //! - `duration_tau1`: sampled duration of each trajectory after burn-in, in units of τ1
-//!   (a fixed budget; required unless `target_std_error` is given, and then left out);
+//!   (a fixed budget; required unless `target_std_error` is given, and then left out); at
+//!   most 1e6; linear scenes: at least 16 (32 samples of mode 1) and 256 steps
+//!   (`256·dt_tau1`), compression scenes: at least 16 samples (`16·sample_every_tau1`);
+//!   every run takes at most 1e10 steps per trajectory (burn-in included);
 //! - `two_time_trajectories`: extra short trajectories of the two-time check (linear
-//!   scenes only), default 0.
+//!   scenes only), in [0, 100000], default 0.
+//!
+//! The scene file's stem is the name of its output directory: `[A-Za-z0-9_-]`, at most
+//! 64 characters. A compression scene has at most 100 `strain_ratios`.
 //!
 //! **Budgets by target precision** (compression scenes only): instead of
 //! `duration_tau1`, give all three of
@@ -77,6 +83,7 @@
 //! optional-stopping bias). A strain whose main stage misses the target is reported as it
 //! is, not rerun.
 
+use super::validate::Num;
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
@@ -134,13 +141,17 @@ pub struct StepSearch {
     pub min_acceptance: f64,
 }
 
-/// A missing `duration_tau1` (NaN: not a valid duration, refused by validation unless
-/// `target_std_error` replaces it).
+/// The value of a `duration_tau1` that was left out: a NaN (not a valid duration, refused
+/// by validation unless `target_std_error` replaces it) with a payload of its own, so that
+/// validation can tell it from a `nan` written in the file ([`Ensemble::duration_given`]).
+const NOT_GIVEN: f64 = f64::from_bits(0x7FF8_0000_0000_0DA7);
+
+/// A missing `duration_tau1` ([`NOT_GIVEN`]).
 fn not_given() -> f64 {
-    f64::NAN
+    NOT_GIVEN
 }
 
-/// Whether a duration was left out ([`not_given`]).
+/// Whether a duration was left out (any NaN: a `nan` in the file is refused anyway).
 fn is_not_given(x: &f64) -> bool {
     x.is_nan()
 }
@@ -159,6 +170,12 @@ pub struct PrecisionTarget {
 }
 
 impl Ensemble {
+    /// Whether `duration_tau1` was written in the file (a `nan` written there counts as
+    /// given, so that validation reports it as NaN rather than as missing).
+    pub fn duration_given(&self) -> bool {
+        self.duration_tau1.to_bits() != NOT_GIVEN.to_bits()
+    }
+
     /// The budget by target precision, if this ensemble has one (all three keys given;
     /// validation refuses a partial set).
     pub fn precision_target(&self) -> Option<PrecisionTarget> {
@@ -445,23 +462,7 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] naming the file, key, value and allowed range.
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
-        let mut scene: Scene = toml::from_str(text).map_err(|e| {
-            let message = e.message().trim().to_string();
-            let key = match (e.span(), missing_field(&message)) {
-                (Some(s), Some(field)) => match table_at(text, s.start) {
-                    Some(t) => format!("{t}.{field}"),
-                    None => field.to_string(),
-                },
-                (Some(s), None) => key_at(text, s.start),
-                (None, Some(field)) => field.to_string(),
-                (None, None) => "-".to_string(),
-            };
-            Error::Scene {
-                file: path.to_path_buf(),
-                key,
-                message,
-            }
-        })?;
+        let mut scene: Scene = toml::from_str(text).map_err(|e| parse_error(text, path, &e))?;
         scene.path = path.to_path_buf();
         scene.name = path
             .file_stem()
@@ -474,8 +475,10 @@ impl Scene {
 
     /// Wraps an error raised while preparing or running run `run` of this scene so that
     /// the message names the scene file and the run's key (bad input, exit 2), unless it
-    /// already names them. A divergence (exit 3) keeps its kind and step and gains the
-    /// file and run.
+    /// already names them. A divergence or a numerical failure (exit 3: the run failed,
+    /// not the input) keeps its kind and gains the file and run. Values are printed in
+    /// full precision (shortest round trip), so that "must be < a, got b" never shows
+    /// a = b.
     pub fn run_error(&self, run: usize, what: &str, err: Error) -> Error {
         let tau1 = self.filament.tau1();
         let key = |k: &str| format!("runs[{run}].{k}");
@@ -499,9 +502,26 @@ impl Scene {
                 file: self.path.clone(),
                 key: key("dt_tau1"),
                 message: format!(
-                    "must be < {:.4e} (the stability limit 2/lambda_max of {integrator} for this mesh, in units of tau1), got {:.4e}; use a smaller dt_tau1 or a stable integrator such as {suggestion}",
-                    limit / tau1,
-                    dt / tau1
+                    "must be < {} (the stability limit 2/lambda_max of {integrator} for this mesh, in units of tau1), got {}; use a smaller dt_tau1 or a stable integrator such as {suggestion}",
+                    Num(limit / tau1),
+                    // The value as written in the file when it is the step that was
+                    // refused (dt/tau1 may differ from it in the last digit).
+                    Num(self
+                        .runs
+                        .get(run)
+                        .map(|r| r.dt_tau1)
+                        .filter(|g| (g * tau1 - dt).abs() <= 1e-12 * dt)
+                        .unwrap_or(dt / tau1))
+                ),
+            },
+            // A numerical failure while running (e.g. an estimator that finds no
+            // autocorrelation window) is the run's failure, not the user's (exit 3).
+            Error::Numerical { routine, detail } => Error::Numerical {
+                routine,
+                detail: format!(
+                    "{detail} ({}: runs[{run}] ({}))",
+                    self.path.display(),
+                    self.runs.get(run).map_or("?", |r| r.name.as_str())
                 ),
             },
             other => Error::Scene {
@@ -536,57 +556,178 @@ impl Scene {
     }
 }
 
+/// The [`Error::Scene`] of a file that is not valid TOML or does not fit the scene types:
+/// the dotted key at the error (`runs[1].quick`, `mesh.elements`, `-` if none), the
+/// parser's message in the words of the file (no Rust type names) and the line, column
+/// and text where it was found.
+fn parse_error(text: &str, path: &Path, e: &toml::de::Error) -> Error {
+    let raw = e.message().trim();
+    let at = e.span().map(|s| s.start.min(text.len()));
+    let key = match (at, missing_field(raw)) {
+        // A missing field of an inline table (`quick = { ... }`) is reported at its
+        // value; of a table, at the table (or the whole file at top level).
+        (Some(at), Some(field)) => match value_key(text, at) {
+            Some(k) => format!("{k}.{field}"),
+            None => {
+                table_at(text, at).map_or_else(|| field.to_string(), |t| format!("{t}.{field}"))
+            }
+        },
+        (Some(at), None) => key_at(text, at),
+        (None, Some(field)) => field.to_string(),
+        (None, None) => "-".to_string(),
+    };
+    let mut message = if raw == "duplicate key" {
+        let line = at.map_or("", |at| line_at(text, at).1);
+        match header_name(line) {
+            Some(name) => format!(
+                "a second [{name}] table: allowed is one [{name}] table per file (merge the two)"
+            ),
+            None => format!("duplicate key: `{key}` is given twice; each key may be given once"),
+        }
+    } else {
+        user_words(raw)
+    };
+    if let Some(at) = at {
+        let (start, line) = line_at(text, at);
+        let number = text[..start].matches('\n').count() + 1;
+        let column = text[start..at].chars().count() + 1;
+        // At most 80 characters, control characters escaped.
+        let mut snippet: String = line
+            .trim()
+            .chars()
+            .take(80)
+            .flat_map(|c| {
+                if c.is_control() {
+                    c.escape_unicode().collect::<Vec<_>>()
+                } else {
+                    vec![c]
+                }
+            })
+            .collect();
+        if line.trim().chars().count() > 80 {
+            snippet.push_str("...");
+        }
+        message.push_str(&format!(" (line {number}, column {column}: `{snippet}`)"));
+    }
+    Error::Scene {
+        file: path.to_path_buf(),
+        key,
+        message,
+    }
+}
+
+/// A serde message with the Rust type names replaced by what a scene file holds.
+fn user_words(message: &str) -> String {
+    let mut m = message
+        .replace("expected usize", "expected a whole number >= 0")
+        .replace(
+            "expected u64",
+            "expected a whole number in [0, 18446744073709551615]",
+        )
+        .replace("expected f64", "expected a number (such as 1.0 or 1e-3)")
+        .replace(
+            "expected struct Ensemble",
+            "expected an inline table such as { trajectories = 16, duration_tau1 = 40.0 }",
+        )
+        .replace("expected a sequence", "expected an array [...]")
+        .replace("invalid type: map", "invalid type: table")
+        .replace("invalid type: sequence", "invalid type: array");
+    if let Some(i) = m.find("expected struct ") {
+        let end = m[i + 16..]
+            .find(|c: char| !c.is_alphanumeric())
+            .map_or(m.len(), |j| i + 16 + j);
+        m.replace_range(i..end, "expected a table");
+    }
+    m
+}
+
 /// The field named by a serde "missing field `x`" message.
 fn missing_field(message: &str) -> Option<&str> {
     let rest = message.strip_prefix("missing field `")?;
     rest.split('`').next()
 }
 
+/// The start offset and text of the line holding byte `offset`.
+fn line_at(text: &str, offset: usize) -> (usize, &str) {
+    let offset = floor_char_boundary(text, offset.min(text.len()));
+    let start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    (start, &text[start..end])
+}
+
+/// The largest char boundary of `text` at or below `i`.
+fn floor_char_boundary(text: &str, mut i: usize) -> usize {
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// The table name of a header line `[t]` or `[[t]]` (a comment after it allowed); `None`
+/// for any other line, e.g. the continuation `[0.5, 0.5, 0.1, 0.2],` of an array.
+fn header_name(line: &str) -> Option<&str> {
+    let line = line.split('#').next().unwrap_or("").trim();
+    let inner = line.strip_prefix('[')?.strip_suffix(']')?;
+    let inner = inner
+        .strip_prefix('[')
+        .and_then(|i| i.strip_suffix(']'))
+        .unwrap_or(inner)
+        .trim();
+    let ok = inner
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_' || c == '"')
+        && !inner.contains(',');
+    ok.then_some(inner)
+}
+
 /// The table whose header (`[t]` or `[[t]]`) is on the line of byte `offset`, or the
-/// nearest header above it; `None` at top level (before any header).
+/// nearest header above it; `None` at top level (before any header). An element of an
+/// array of tables is named with its index, e.g. `runs[1]`.
 fn table_at(text: &str, offset: usize) -> Option<String> {
-    let offset = offset.min(text.len());
-    let line_end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
-    let lines: Vec<&str> = text[..line_end].lines().map(str::trim).collect();
-    let at = lines.iter().rposition(|l| l.starts_with('['))?;
-    let header = lines[at];
-    let name = header.trim_matches(|c| c == '[' || c == ']').to_string();
-    if header.starts_with("[[") {
-        // An array of tables: name the element, e.g. `runs[1]`.
-        let index = lines[..at].iter().filter(|l| **l == header).count();
+    let (start, line) = line_at(text, offset);
+    let lines: Vec<&str> = text[..start + line.len()].lines().collect();
+    let at = lines.iter().rposition(|l| header_name(l).is_some())?;
+    let name = header_name(lines[at])?;
+    if lines[at].trim_start().starts_with("[[") {
+        let index = lines[..at]
+            .iter()
+            .filter(|l| l.trim_start().starts_with("[[") && header_name(l) == Some(name))
+            .count();
         Some(format!("{name}[{index}]"))
     } else {
-        Some(name)
+        Some(name.to_string())
     }
 }
 
-/// The dotted key of the TOML entry around byte `offset`: the nearest `key =` on the
-/// line of the error, qualified by the table header above it.
+/// The key `k` of a line `k = value` (empty if the line has none).
+fn line_key(line: &str) -> &str {
+    match line.split_once('=') {
+        Some((k, _)) if header_name(line).is_none() => k.trim(),
+        _ => "",
+    }
+}
+
+/// The dotted key of the entry around byte `offset`: the header's table on a header
+/// line, else the `key =` of its line qualified by the table above it, else that table.
 fn key_at(text: &str, offset: usize) -> String {
-    let before = &text[..offset.min(text.len())];
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let line_end = text[line_start..]
-        .find('\n')
-        .map_or(text.len(), |i| line_start + i);
-    let line = &text[line_start..line_end];
-    let key = line.split('=').next().unwrap_or("").trim();
-    let table = before[..line_start]
-        .lines()
-        .rev()
-        .map(str::trim)
-        .find(|l| l.starts_with('['))
-        .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string());
-    let key = if line.contains('=') && !key.starts_with('[') {
-        key.to_string()
-    } else {
-        String::new()
-    };
-    match (table, key.is_empty()) {
-        (Some(t), false) => format!("{t}.{key}"),
+    let (_, line) = line_at(text, offset);
+    let table = table_at(text, offset);
+    let key = line_key(line);
+    match (table, header_name(line).is_some() || key.is_empty()) {
         (Some(t), true) => t,
-        (None, false) => key,
+        (Some(t), false) => format!("{t}.{key}"),
+        (None, false) => key.to_string(),
         (None, true) => "-".to_string(),
     }
+}
+
+/// The dotted key of the entry whose value holds byte `offset` (`offset` after the `=`
+/// of a `key = value` line), else `None`.
+fn value_key(text: &str, offset: usize) -> Option<String> {
+    let (start, line) = line_at(text, offset);
+    let eq = line.find('=')?;
+    (header_name(line).is_none() && offset > start + eq).then(|| key_at(text, offset))
 }
 
 /// Resolves `--scene` arguments (names or paths) against `scene_dir`.

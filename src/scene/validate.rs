@@ -4,7 +4,8 @@
 //! [`Scene::validate`] runs, in order:
 //!
 //! 1. the checks of every scene: its name (the file stem, a path component of the
-//!    outputs), filament, `dims`, `checks`, mesh and burn-in;
+//!    outputs: [`is_path_name`], at most [`MAX_NAME_LEN`] characters), filament, `dims`,
+//!    `checks`, mesh and burn-in;
 //! 2. the model's own tables: `[sampling]` of a linear scene, `[compression]` of a
 //!    compression scene;
 //! 3. ONE per-run check shared by both kinds of scene ([`Scene::validate`] →
@@ -14,8 +15,10 @@
 //!    shortest duration) is stated by the private `RunRules`;
 //! 4. the Δt-halving pair of a compression scene.
 //!
-//! Every error is an [`Error::Scene`] naming the file, the key, the value and the allowed
-//! range (exit code 2).
+//! Every error is an [`Error::Scene`] naming the file, the key, the value (numbers in
+//! full precision, [`Num`]) and the allowed range (exit code 2). Every count is bounded
+//! here, before anything is allocated or run: trajectories, list lengths
+//! ([`MAX_POINTS`]), durations and steps per trajectory (at most 1e10).
 
 use super::spec::{Budget, CheckKind, CompressionSpec, ModelKind, RunSpec, Sampling, Scene};
 use crate::dynamics::{Family, IntegratorKind};
@@ -26,8 +29,47 @@ use std::fmt::Display;
 /// Most trajectories (full or two-time) of a run at one budget.
 const MAX_TRAJECTORIES: usize = 100_000;
 
+/// Longest name that becomes a path component (scene file stem, run name), in
+/// characters: file names of the outputs add a suffix to it and must stay below the
+/// 255 bytes file systems allow.
+pub const MAX_NAME_LEN: usize = 64;
+
+/// Most entries of `sampling.profile_points`, `sampling.two_time` and
+/// `compression.strain_ratios` (each one multiplies the recorded series or the runs).
+pub const MAX_POINTS: usize = 100;
+
+/// Shortest sampled duration of a linear run, in units of τ1: mode 1 is sampled about
+/// every 0.5 τ1, and its estimators need at least 32 samples per trajectory.
+pub const MIN_LINEAR_DURATION_TAU1: f64 = 16.0;
+
+/// Fewest sampled steps of a linear run per trajectory (`duration_tau1 / dt_tau1`): below
+/// this the series of the stiff modes, sampled every step, are too short for their
+/// autocorrelation-aware estimators.
+pub const MIN_LINEAR_STEPS: f64 = 256.0;
+
+/// A number as the user wrote it: the shortest text that reads back as the same `f64`
+/// (so that "must be < a, got b" never shows a = b), in exponent form below 1e-3 and from
+/// 1e7 on (`1e300`, not 301 digits).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        let a = x.abs();
+        if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&a) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
 /// The allowed checks of a linear scene, for messages.
 const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time) for model \"fem\" or \"spectral\"";
+/// The allowed positions x/L of the profile and two-time checks, for messages: the
+/// hinges x/L = 0 and 1 have w = 0 exactly, so nothing fluctuates there to check.
+const INTERIOR: &str = "in (0, 1) (inside the filament: w = 0 at the hinges x/L = 0 and 1)";
 /// The allowed checks of a compression scene, for messages.
 const COMPRESSION_CHECKS: &str =
     "force-strain, force-distribution or dt-halving for model = \"compression\"";
@@ -54,7 +96,12 @@ pub fn is_path_name(name: &str) -> bool {
 /// name and the run names): [`is_path_name`], else an [`Error::Scene`] naming the file,
 /// `key` and the name.
 fn check_path_name(scene: &Scene, key: &str, name: &str) -> Result<()> {
-    if is_path_name(name) {
+    let chars = name.chars().count();
+    if chars > MAX_NAME_LEN {
+        let value = format!("a name of {chars} characters");
+        let allowed = format!("at most {MAX_NAME_LEN} characters of [A-Za-z0-9_-]");
+        Err(bad(scene, key, &value, &allowed))
+    } else if is_path_name(name) {
         Ok(())
     } else {
         Err(bad(
@@ -120,7 +167,7 @@ impl RunRules<'_> {
                 c.sample_every_tau1,
                 format!(
                     "in (0, compression.sample_every_tau1 = {}]",
-                    c.sample_every_tau1
+                    Num(c.sample_every_tau1)
                 ),
             ),
         }
@@ -134,16 +181,19 @@ impl RunRules<'_> {
         }
     }
 
-    /// `None` if `duration_tau1` is valid for a run at `dt_tau1`, else the allowed range.
-    fn duration_error(&self, duration_tau1: f64, dt_tau1: f64) -> Option<String> {
+    /// `None` if `duration_tau1` is valid for run `i` at `dt_tau1`, else the allowed
+    /// range. The steps per trajectory are bounded by `validate_run` (through `dt_tau1`).
+    fn duration_error(&self, i: usize, duration_tau1: f64, dt_tau1: f64) -> Option<String> {
         match self {
-            RunRules::Linear(s) => {
-                if !(duration_tau1.is_finite() && duration_tau1 > 0.0 && duration_tau1 <= 1e6) {
-                    return Some("in (0, 1e6]".to_string());
-                }
-                let steps = (s.burn_in_tau1 + duration_tau1) / dt_tau1;
-                (steps > 1e10).then(|| {
-                    "such that (burn_in_tau1 + duration_tau1)/dt_tau1 <= 1e10 steps".to_string()
+            RunRules::Linear(_) => {
+                let shortest = MIN_LINEAR_DURATION_TAU1.max(MIN_LINEAR_STEPS * dt_tau1);
+                let ok =
+                    duration_tau1.is_finite() && duration_tau1 >= shortest && duration_tau1 <= 1e6;
+                (!ok).then(|| {
+                    format!(
+                        "in [{MIN_LINEAR_DURATION_TAU1}, 1e6] and >= {MIN_LINEAR_STEPS} x runs[{i}].dt_tau1 = {} (at least 32 samples of mode 1, sampled about every 0.5 tau1, and {MIN_LINEAR_STEPS} steps per trajectory)",
+                        Num(MIN_LINEAR_STEPS * dt_tau1)
+                    )
                 })
             }
             RunRules::Compression(c) => {
@@ -152,7 +202,7 @@ impl RunRules<'_> {
                 (!ok).then(|| {
                     format!(
                         "<= 1e6 and >= 16 x sample_every_tau1 = {}",
-                        16.0 * c.sample_every_tau1
+                        Num(16.0 * c.sample_every_tau1)
                     )
                 })
             }
@@ -223,7 +273,7 @@ impl Scene {
             ("filament.kt", f.kt),
         ] {
             if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
-                return Err(bad(self, key, &v, "in [1e-30, 1e30]"));
+                return Err(bad(self, key, &Num(v), "in [1e-30, 1e30]"));
             }
         }
         if self.dims != 2 && self.dims != 3 {
@@ -242,11 +292,11 @@ impl Scene {
         }
         let g = self.mesh.grading;
         if !(g.is_finite() && (0.01..=100.0).contains(&g)) {
-            return Err(bad(self, "mesh.grading", &g, "in [0.01, 100]"));
+            return Err(bad(self, "mesh.grading", &Num(g), "in [0.01, 100]"));
         }
         let b = self.sampling.burn_in_tau1;
         if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
-            return Err(bad(self, "sampling.burn_in_tau1", &b, "in [0, 1e4]"));
+            return Err(bad(self, "sampling.burn_in_tau1", &Num(b), "in [0, 1e4]"));
         }
         Ok(())
     }
@@ -284,10 +334,19 @@ impl Scene {
             let allowed = format!("in [1, {}]", max_modes.min(50));
             return Err(bad(self, "sampling.modes", &s.modes, &allowed));
         }
+        for (key, n) in [
+            ("sampling.profile_points", s.profile_points.len()),
+            ("sampling.two_time", s.two_time.len()),
+        ] {
+            if n > MAX_POINTS {
+                let allowed = format!("a list of at most {MAX_POINTS} points");
+                return Err(bad(self, key, &format!("{n} points"), &allowed));
+            }
+        }
         for (i, &x) in s.profile_points.iter().enumerate() {
-            if !(x.is_finite() && (0.0..=1.0).contains(&x)) {
+            if !(x.is_finite() && x > 0.0 && x < 1.0) {
                 let key = format!("sampling.profile_points[{i}]");
-                return Err(bad(self, &key, &x, "in [0, 1]"));
+                return Err(bad(self, &key, &Num(x), INTERIOR));
             }
         }
         for (i, p) in s.two_time.iter().enumerate() {
@@ -309,33 +368,33 @@ impl Scene {
         Ok(())
     }
 
-    /// Two-time point `i`, `(x/L, y/L, t/τ1, η/τ1)`: positions in [0, 1],
-    /// 0 < t ≤ η ≤ burn-in.
+    /// Two-time point `i`, `(x/L, y/L, t/τ1, η/τ1)`: positions inside (0, 1) (w = 0 at
+    /// the hinges), 0 < t ≤ η ≤ burn-in.
     fn validate_two_time_point(&self, i: usize, p: &[f64; 4]) -> Result<()> {
         for (j, name) in ["x/L", "y/L"].iter().enumerate() {
-            if !(p[j].is_finite() && (0.0..=1.0).contains(&p[j])) {
+            if !(p[j].is_finite() && p[j] > 0.0 && p[j] < 1.0) {
                 let key = format!("sampling.two_time[{i}][{j}] ({name})");
-                return Err(bad(self, &key, &p[j], "in [0, 1]"));
+                return Err(bad(self, &key, &Num(p[j]), INTERIOR));
             }
         }
         if !(p[3].is_finite() && p[3] > 0.0) {
             let key = format!("sampling.two_time[{i}][3] (eta/tau1)");
-            return Err(bad(self, &key, &p[3], "finite and > 0"));
+            return Err(bad(self, &key, &Num(p[3]), "finite and > 0"));
         }
         if !(p[2].is_finite() && p[2] > 0.0 && p[2] <= p[3]) {
             let key = format!("sampling.two_time[{i}][2] (t/tau1)");
             return Err(bad(
                 self,
                 &key,
-                &p[2],
-                &format!("in (0, eta/tau1 = {}]", p[3]),
+                &Num(p[2]),
+                &format!("in (0, eta/tau1 = {}]", Num(p[3])),
             ));
         }
         let burn_in = self.sampling.burn_in_tau1;
         if p[3].is_nan() || p[3] > burn_in {
             let key = format!("sampling.two_time[{i}][3] (eta/tau1)");
-            let allowed = format!("<= sampling.burn_in_tau1 = {burn_in}");
-            return Err(bad(self, &key, &p[3], &allowed));
+            let allowed = format!("<= sampling.burn_in_tau1 = {}", Num(burn_in));
+            return Err(bad(self, &key, &Num(p[3]), &allowed));
         }
         Ok(())
     }
@@ -356,28 +415,39 @@ impl Scene {
             let allowed = "1 (uniform) for model = \"compression\"";
             return Err(bad(self, "mesh.grading", &self.mesh.grading, allowed));
         }
+        let n = c.strain_ratios.len();
+        if n > MAX_POINTS {
+            let allowed = format!("a list of at most {MAX_POINTS} strains");
+            let value = format!("{n} strains");
+            return Err(bad(self, "compression.strain_ratios", &value, &allowed));
+        }
         for (i, &r) in c.strain_ratios.iter().enumerate() {
             if !(r.is_finite() && (-1e3..=1e3).contains(&r)) {
                 let key = format!("compression.strain_ratios[{i}]");
-                return Err(bad(self, &key, &r, "finite, in [-1000, 1000]"));
+                return Err(bad(self, &key, &Num(r), "finite, in [-1000, 1000]"));
             }
         }
-        for (i, r) in c.distribution_strain_ratios.iter().enumerate() {
-            if !c.strain_ratios.contains(r) {
+        for (i, &r) in c.distribution_strain_ratios.iter().enumerate() {
+            if !c.strain_ratios.contains(&r) {
                 let key = format!("compression.distribution_strain_ratios[{i}]");
-                return Err(bad(self, &key, r, "one of compression.strain_ratios"));
+                return Err(bad(self, &key, &Num(r), "one of compression.strain_ratios"));
             }
         }
         let b = c.burn_in_tau1;
         if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
-            return Err(bad(self, "compression.burn_in_tau1", &b, "in [0, 1e4]"));
+            return Err(bad(
+                self,
+                "compression.burn_in_tau1",
+                &Num(b),
+                "in [0, 1e4]",
+            ));
         }
         let s = c.sample_every_tau1;
         if !(s.is_finite() && s > 0.0 && s <= 100.0) {
             return Err(bad(
                 self,
                 "compression.sample_every_tau1",
-                &s,
+                &Num(s),
                 "in (0, 100]",
             ));
         }
@@ -414,28 +484,33 @@ impl Scene {
         let (dt_max, dt_allowed) = rules.dt_limit();
         let dt = run.dt_tau1;
         if !(dt.is_finite() && dt > 0.0 && dt <= dt_max) {
-            return Err(bad(self, &key("dt_tau1"), &dt, &dt_allowed));
+            return Err(bad(self, &key("dt_tau1"), &Num(dt), &dt_allowed));
         }
-        if let RunRules::Compression(c) = rules {
-            // Steps per trajectory, at the longest duration any budget may run.
-            let longest = [Budget::Quick, Budget::Standard, Budget::Full]
-                .iter()
-                .map(|&b| {
-                    let e = run.ensemble(b);
-                    [e.duration_tau1, e.max_duration_tau1.unwrap_or(0.0)]
-                        .into_iter()
-                        .filter(|d| d.is_finite())
-                        .fold(0.0, f64::max)
-                })
-                .fold(0.0, f64::max)
-                .min(1e6);
-            let shortest_dt = (c.burn_in_tau1 + longest) / MAX_STEPS_PER_TRAJECTORY;
-            if dt < shortest_dt {
-                let allowed = format!(
-                    ">= (burn_in_tau1 + longest duration_tau1 = {longest})/1e10 = {shortest_dt:.3e}, at most 1e10 steps per trajectory"
-                );
-                return Err(bad(self, &key("dt_tau1"), &dt, &allowed));
-            }
+        // Steps per trajectory, at the longest duration any budget may run (durations
+        // above 1e6 are refused below, naming their key).
+        let longest = [Budget::Quick, Budget::Standard, Budget::Full]
+            .iter()
+            .map(|&b| {
+                let e = run.ensemble(b);
+                [e.duration_tau1, e.max_duration_tau1.unwrap_or(0.0)]
+                    .into_iter()
+                    .filter(|d| d.is_finite())
+                    .fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max)
+            .min(1e6);
+        let burn_in = match rules {
+            RunRules::Linear(s) => s.burn_in_tau1,
+            RunRules::Compression(c) => c.burn_in_tau1,
+        };
+        let shortest_dt = (burn_in + longest) / MAX_STEPS_PER_TRAJECTORY;
+        if dt < shortest_dt {
+            let allowed = format!(
+                ">= (burn_in_tau1 + longest duration_tau1 = {})/1e10 = {}, at most 1e10 steps per trajectory",
+                Num(burn_in + longest),
+                Num(shortest_dt)
+            );
+            return Err(bad(self, &key("dt_tau1"), &Num(dt), &allowed));
         }
         for budget in [Budget::Quick, Budget::Standard, Budget::Full] {
             let e = run.ensemble(budget);
@@ -475,29 +550,35 @@ impl Scene {
             ] {
                 if let Some(v) = v {
                     let allowed = "left out unless target_std_error is given";
-                    return Err(bad(self, &key(k), &v, allowed));
+                    return Err(bad(self, &key(k), &Num(v), allowed));
                 }
             }
-            if e.duration_tau1.is_nan() {
+            if !e.duration_given() {
                 let allowed = "given (sampled duration per trajectory in tau1), or replaced by target_std_error, pilot_tau1 and max_duration_tau1 (compression scenes)";
                 return Err(bad(self, &key("duration_tau1"), &"nothing", allowed));
             }
-            if let Some(allowed) = rules.duration_error(e.duration_tau1, dt) {
-                return Err(bad(self, &key("duration_tau1"), &e.duration_tau1, &allowed));
+            if let Some(allowed) = rules.duration_error(i, e.duration_tau1, dt) {
+                let value = Num(e.duration_tau1);
+                return Err(bad(self, &key("duration_tau1"), &value, &allowed));
             }
             return Ok(());
         };
         if let RunRules::Linear(_) = rules {
             let allowed = "left out for model \"fem\" or \"spectral\" (budgets by target precision are for model = \"compression\"); give duration_tau1";
-            return Err(bad(self, &key("target_std_error"), &target, allowed));
+            return Err(bad(self, &key("target_std_error"), &Num(target), allowed));
         }
         if !(target.is_finite() && target > 0.0 && target <= 1.0) {
             let allowed = "in (0, 1] (standard error of <F> in units of the Euler load F_c0)";
-            return Err(bad(self, &key("target_std_error"), &target, allowed));
+            return Err(bad(self, &key("target_std_error"), &Num(target), allowed));
         }
-        if !e.duration_tau1.is_nan() {
+        if e.duration_given() {
             let allowed = "left out when target_std_error is given (the duration is chosen per strain, at most max_duration_tau1)";
-            return Err(bad(self, &key("duration_tau1"), &e.duration_tau1, allowed));
+            return Err(bad(
+                self,
+                &key("duration_tau1"),
+                &Num(e.duration_tau1),
+                allowed,
+            ));
         }
         let mut given = [0.0; 2];
         for (slot, (k, v)) in given.iter_mut().zip([
@@ -509,15 +590,15 @@ impl Scene {
                     "given with target_std_error (a sampled duration per trajectory in tau1)";
                 return Err(bad(self, &key(k), &"nothing", allowed));
             };
-            if let Some(allowed) = rules.duration_error(v, dt) {
-                return Err(bad(self, &key(k), &v, &allowed));
+            if let Some(allowed) = rules.duration_error(i, v, dt) {
+                return Err(bad(self, &key(k), &Num(v), &allowed));
             }
             *slot = v;
         }
         let [pilot, max] = given;
         if pilot > max {
-            let allowed = format!("<= max_duration_tau1 = {max}");
-            return Err(bad(self, &key("pilot_tau1"), &pilot, &allowed));
+            let allowed = format!("<= max_duration_tau1 = {}", Num(max));
+            return Err(bad(self, &key("pilot_tau1"), &Num(pilot), &allowed));
         }
         self.validate_step_search(i, b, e)
     }
@@ -547,28 +628,36 @@ impl Scene {
                 "left out for integrator \"{}\" (a step search only for metropolis-crank-nicolson, whose stationary law is exact at any dt)",
                 run.integrator
             );
-            return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+            return Err(bad(self, &key("max_dt_tau1"), &Num(max_dt), &allowed));
         }
         if !(max_dt.is_finite() && max_dt >= run.dt_tau1 && max_dt <= 100.0) {
-            let allowed = format!("in [dt_tau1 = {}, 100] (tau1)", run.dt_tau1);
-            return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+            let allowed = format!("in [dt_tau1 = {}, 100] (tau1)", Num(run.dt_tau1));
+            return Err(bad(self, &key("max_dt_tau1"), &Num(max_dt), &allowed));
         }
         if !(min_acc > 0.0 && min_acc < 1.0) {
-            return Err(bad(self, &key("min_acceptance"), &min_acc, "in (0, 1)"));
+            return Err(bad(
+                self,
+                &key("min_acceptance"),
+                &Num(min_acc),
+                "in (0, 1)",
+            ));
         }
-        if let Some([first, second]) = self.compression.as_ref().and_then(|c| c.halving.as_ref()) {
+        // A pair naming one run twice is refused by `validate_halving`, naming the pair.
+        if let Some([first, second]) = self.compression.as_ref().and_then(|c| c.halving.as_ref())
+            && first != second
+        {
             if &run.name == second {
                 let allowed = format!(
                     "left out for the second run of compression.halving (it runs at half the steps that run \"{first}\" chose)"
                 );
-                return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+                return Err(bad(self, &key("max_dt_tau1"), &Num(max_dt), &allowed));
             }
             let later = |name: &str| self.runs.iter().position(|r| r.name == name);
             if &run.name == first && later(second).is_some_and(|j| j < i) {
                 let allowed = format!(
                     "left out, or run \"{second}\" listed after run \"{first}\" (the second run of compression.halving inherits the steps the first chose)"
                 );
-                return Err(bad(self, &key("max_dt_tau1"), &max_dt, &allowed));
+                return Err(bad(self, &key("max_dt_tau1"), &Num(max_dt), &allowed));
             }
         }
         Ok(())
