@@ -1,6 +1,15 @@
 //! The error type of the library. Every variant carries the context a user needs to fix
 //! the problem: the parameter or file and key, the offending value and the allowed range,
 //! or the step at which a run went unstable.
+//!
+//! # Exit codes
+//! [`Error::exit_code`] sorts every error into one of two classes, and never the other
+//! way round: **2, the user's input** ([`Error::InvalidParameter`], [`Error::Scene`],
+//! [`Error::UnstableTimeStep`]; found before any simulation wherever it can be) and
+//! **3, the run failed** ([`Error::Diverged`], [`Error::RunFailed`], [`Error::Numerical`],
+//! [`Error::Io`]). A failure of the simulator or of an estimator after a run started is
+//! never blamed on a key of the input: the runner turns it into [`Error::RunFailed`]
+//! naming the run and the observable ([`Error::run_failed`]).
 
 use std::path::PathBuf;
 
@@ -64,6 +73,24 @@ pub enum Error {
         /// What went wrong.
         detail: String,
     },
+    /// A run failed after it started: an estimator found no answer in the data (e.g. no
+    /// self-consistent autocorrelation window), an estimate was not finite, or a matrix
+    /// that should be positive definite could not be factorized. Not the user's input
+    /// (exit 3); the detail may suggest what to change.
+    #[error(
+        "run failed: {run}: {observable}{}: {detail}",
+        step.map_or(String::new(), |s| format!(" (at step {s})"))
+    )]
+    RunFailed {
+        /// The run: scene file, run index and name, e.g. `a.toml: runs[0] (crank-nicolson)`.
+        run: String,
+        /// The observable or stage, e.g. `mode-variance check of mode 1`.
+        observable: String,
+        /// The step at which it failed, where known.
+        step: Option<u64>,
+        /// What went wrong, and any advice.
+        detail: String,
+    },
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -98,6 +125,56 @@ impl Error {
         }
     }
 
+    /// `err`, raised by run `run` while computing `observable` after the run started, as
+    /// a run failure (exit 3): [`Error::RunFailed`] naming the run and the observable.
+    /// Input errors raised by an estimator on the run's data (too few samples, a constant
+    /// series) become run failures too: the input had passed validation. A
+    /// [`Error::RunFailed`] keeps its (more specific) observable and takes `run`;
+    /// [`Error::Diverged`] (which names its step) and [`Error::Io`] are kept as they are.
+    pub fn run_failed(run: impl Into<String>, observable: impl Into<String>, err: Error) -> Self {
+        let run = run.into();
+        match err {
+            Error::Io { .. } | Error::Diverged { .. } => err,
+            Error::RunFailed {
+                observable,
+                step,
+                detail,
+                ..
+            } => Error::RunFailed {
+                run,
+                observable,
+                step,
+                detail,
+            },
+            other => Error::RunFailed {
+                run,
+                observable: observable.into(),
+                step: None,
+                detail: other.to_string(),
+            },
+        }
+    }
+
+    /// `self` with `advice` appended to the detail of a [`Error::RunFailed`] (other
+    /// errors are returned unchanged).
+    #[must_use]
+    pub fn with_advice(self, advice: &str) -> Self {
+        match self {
+            Error::RunFailed {
+                run,
+                observable,
+                step,
+                detail,
+            } => Error::RunFailed {
+                run,
+                observable,
+                step,
+                detail: format!("{detail}; {advice}"),
+            },
+            other => other,
+        }
+    }
+
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
@@ -107,13 +184,17 @@ impl Error {
     }
 
     /// Process exit code for this error: 2 for bad input (parameters, scene files,
-    /// a time step above the stability limit), 3 for failures during a run.
+    /// a time step above the stability limit), 3 for failures during a run (see the
+    /// [module docs](self)).
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::InvalidParameter { .. }
             | Error::Scene { .. }
             | Error::UnstableTimeStep { .. } => 2,
-            Error::Diverged { .. } | Error::Numerical { .. } | Error::Io { .. } => 3,
+            Error::Diverged { .. }
+            | Error::RunFailed { .. }
+            | Error::Numerical { .. }
+            | Error::Io { .. } => 3,
         }
     }
 }

@@ -154,12 +154,13 @@ fn verify_scene(scene: &Path, out: &Path, threads: Option<usize>) -> Value {
     summary
 }
 
-/// `v` with every `wall_seconds` field removed (the only non-deterministic field).
+/// `v` with every `wall_seconds` and `run_id` field removed (the only non-deterministic
+/// fields).
 fn without_wall_seconds(v: &Value) -> Value {
     match v {
         Value::Object(m) => Value::Object(
             m.iter()
-                .filter(|(k, _)| k.as_str() != "wall_seconds")
+                .filter(|(k, _)| !matches!(k.as_str(), "wall_seconds" | "run_id"))
                 .map(|(k, v)| (k.clone(), without_wall_seconds(v)))
                 .collect(),
         ),

@@ -8,8 +8,10 @@ use std::fs;
 use std::path::Path;
 
 use langevin_fem::Error;
-use langevin_fem::output::{Figure, Series, write_atomic, write_csv, write_json};
-use langevin_fem::report::{render_index, write_index};
+use langevin_fem::output::{
+    Figure, Manifest, ReportRun, Series, write_atomic, write_csv, write_json,
+};
+use langevin_fem::report::{render_index, write_index, write_report};
 use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
 
 fn file_names(dir: &Path) -> Vec<String> {
@@ -288,6 +290,7 @@ fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
 
 fn sample_summary() -> Summary {
     Summary {
+        run_id: "20250101T120000Z-4242-1a2b3c4d".to_string(),
         budget: "quick".to_string(),
         alpha: 0.01,
         passed: false,
@@ -321,6 +324,12 @@ fn sample_summary() -> Summary {
                     check("msd/late-time", false, Some(1.234_567e-9)),
                 ],
             },
+        ],
+        files: vec![
+            "clamped_free/mode_variance.csv".to_string(),
+            "index.html".to_string(),
+            "manifest.json".to_string(),
+            "summary.json".to_string(),
         ],
     }
 }
@@ -359,6 +368,8 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
     assert!(html.contains("<td class=\"fail\">FAIL</td>"));
     assert!(html.contains("<tr class=\"pass\"><td>mode-variance/n=1</td>"));
     assert!(html.contains("Overall result: <span class=\"badge fail\">FAIL</span>"));
+    // The run id, as in summary.json.
+    assert!(html.contains("<code id=\"run-id\">20250101T120000Z-4242-1a2b3c4d</code>"));
     // Numbers to 4 significant digits, a dash where there is no value, Holm mentioned.
     assert!(html.contains(">0.1235<") && html.contains(">1.235e-9<"));
     assert!(html.contains(">—<"));
@@ -371,4 +382,196 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
     write_index(dir, &summary).expect("write index");
     assert_eq!(fs::read_to_string(dir.join("index.html")).unwrap(), html);
     assert_eq!(file_names(dir), vec!["index.html"]);
+}
+
+// ---------------------------------------------------------------------------------------
+// Report runs: run id, journal, consistency after interruption and reruns
+// (src/output/manifest.rs; issue #12)
+// ---------------------------------------------------------------------------------------
+
+/// Every regular file under `dir`, relative, with `/` separators, sorted.
+fn all_files(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for entry in fs::read_dir(dir).expect("read dir") {
+            let p = entry.expect("entry").path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                let rel = p.strip_prefix(root).expect("under root");
+                out.push(rel.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+fn journal(dir: &Path) -> Manifest {
+    serde_json::from_str(&fs::read_to_string(dir.join("manifest.json")).expect("journal"))
+        .expect("journal parses")
+}
+
+const ENTRIES: [&str; 2] = ["summary.json", "index.html"];
+
+/// A complete report run writing `files` (relative) in `dir`; returns its run id.
+fn complete_run(dir: &Path, files: &[&str]) -> String {
+    let run = ReportRun::begin(dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    for f in files {
+        run.write(&dir.join(f), f.as_bytes()).expect("write");
+    }
+    let id = run.run_id();
+    run.finish(&[
+        ("summary.json", id.as_bytes()),
+        ("index.html", id.as_bytes()),
+    ])
+    .expect("finish");
+    id
+}
+
+/// What: a rerun first invalidates the earlier report (journal replaced by an incomplete
+/// one naming the new run and the earlier files, then `summary.json` and `index.html`
+/// removed), and at its end removes the earlier run's files it did not write (a dropped
+/// scene, its then empty folder too), keeps every file it never wrote (a user's file, a
+/// `convergence/` folder), and lists exactly the files of the directory that are its own.
+/// Tolerance: exact (file sets).
+#[test]
+fn a_rerun_invalidates_the_old_report_first_and_removes_dropped_files() {
+    let tmp = TempDir::new("report-run");
+    let dir = tmp.path();
+    let first = complete_run(dir, &["a/x.csv", "b/y.csv", "b/y.svg", "fig2.svg"]);
+    fs::write(dir.join("notes.txt"), b"mine").unwrap();
+    fs::create_dir_all(dir.join("convergence")).unwrap();
+    fs::write(dir.join("convergence/index.html"), b"other command").unwrap();
+    let j = journal(dir);
+    assert!(j.complete && j.run_id == first && j.superseded.is_empty());
+
+    let run = ReportRun::begin(dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    assert!(!dir.join("summary.json").exists() && !dir.join("index.html").exists());
+    let j = journal(dir);
+    assert!(!j.complete && j.run_id == run.run_id() && j.run_id != first);
+    assert!(j.files.is_empty());
+    assert_eq!(
+        j.superseded,
+        [
+            "a/x.csv",
+            "b/y.csv",
+            "b/y.svg",
+            "fig2.svg",
+            "index.html",
+            "summary.json"
+        ]
+    );
+    run.write(&dir.join("a/x.csv"), b"new").expect("write");
+    run.write(&dir.join("a/z.csv"), b"new").expect("write");
+    // Write-ahead: the new file is in the journal on disk before the run finishes.
+    assert_eq!(journal(dir).files, ["a/x.csv", "a/z.csv"]);
+    let id = run.run_id();
+    let files = run.files();
+    run.finish(&[("summary.json", b"s"), ("index.html", b"i")])
+        .expect("finish");
+
+    assert!(!dir.join("b").exists(), "dropped scene's folder removed");
+    assert!(!dir.join("fig2.svg").exists());
+    assert_eq!(
+        all_files(dir),
+        [
+            "a/x.csv",
+            "a/z.csv",
+            "convergence/index.html",
+            "index.html",
+            "manifest.json",
+            "notes.txt",
+            "summary.json"
+        ]
+    );
+    let j = journal(dir);
+    assert!(j.complete && j.run_id == id && j.superseded.is_empty());
+    assert_eq!(j.files, files);
+    assert_eq!(
+        files,
+        [
+            "a/x.csv",
+            "a/z.csv",
+            "index.html",
+            "manifest.json",
+            "summary.json"
+        ]
+    );
+}
+
+/// What: a run killed after writing (journal incomplete, no entry point) leaves no file
+/// the journal does not name; the next run carries the files of both earlier runs and
+/// removes those it does not write. A journal entry pointing outside the directory is
+/// never followed, and a write outside the directory is refused.
+/// Tolerance: exact (file sets).
+#[test]
+fn an_interrupted_run_is_cleaned_up_by_the_next_and_nothing_outside_is_touched() {
+    let tmp = TempDir::new("report-killed");
+    let dir = tmp.path().join("out");
+    complete_run(&dir, &["a/x.csv"]);
+    let killed = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    killed
+        .write(&dir.join("c/new.csv"), b"half a run")
+        .expect("write");
+    drop(killed); // as if killed: no finish
+    let j = journal(&dir);
+    assert!(!j.complete);
+    assert!(!dir.join("summary.json").exists());
+    let named: Vec<&String> = j.files.iter().chain(&j.superseded).collect();
+    for f in all_files(&dir) {
+        assert!(
+            f == "manifest.json" || named.contains(&&f),
+            "{f} not attributable"
+        );
+    }
+
+    // A tampered journal naming a file outside the directory.
+    let outside = tmp.path().join("outside.txt");
+    fs::write(&outside, b"keep").unwrap();
+    let mut j = journal(&dir);
+    j.superseded.push("../outside.txt".to_string());
+    fs::write(
+        dir.join("manifest.json"),
+        serde_json::to_string(&j).unwrap(),
+    )
+    .unwrap();
+
+    let run = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    let err = run
+        .write(&tmp.path().join("escape.csv"), b"x")
+        .expect_err("outside the directory");
+    assert!(matches!(err, Error::Io { .. }), "{err:?}");
+    assert!(!tmp.path().join("escape.csv").exists());
+    run.write(&dir.join("a/x.csv"), b"x").expect("write");
+    run.finish(&[("summary.json", b"s"), ("index.html", b"i")])
+        .expect("finish");
+    assert_eq!(
+        all_files(&dir),
+        ["a/x.csv", "index.html", "manifest.json", "summary.json"]
+    );
+    assert!(outside.exists());
+}
+
+/// What: `write_report` writes `summary.json` and `index.html` last, with the same run id
+/// as the journal, and `summary.json` lists exactly the files of the directory.
+/// Tolerance: exact.
+#[test]
+fn write_report_puts_one_run_id_in_summary_index_and_journal() {
+    let tmp = TempDir::new("write-report");
+    let dir = tmp.path();
+    let run = ReportRun::begin(dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    run.write_csv(&dir.join("s/t.csv"), &["a"], &[vec![1.0]])
+        .expect("csv");
+    let mut summary = sample_summary();
+    summary.run_id = run.run_id();
+    summary.files = run.files();
+    write_report(run, &summary).expect("report");
+    let back: Summary =
+        serde_json::from_str(&fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(back.files, all_files(dir));
+    assert_eq!(back.run_id, journal(dir).run_id);
+    let html = fs::read_to_string(dir.join("index.html")).unwrap();
+    assert!(html.contains(&format!("<code id=\"run-id\">{}</code>", back.run_id)));
 }

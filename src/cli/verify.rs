@@ -2,7 +2,7 @@
 
 use clap::Args;
 use langevin_fem::error::{Error, Result};
-use langevin_fem::report::write_index;
+use langevin_fem::report::write_report;
 use langevin_fem::scene::{Budget, resolve_scenes};
 use langevin_fem::verify::{VerifyOptions, run_verification};
 use std::io::IsTerminal;
@@ -53,14 +53,14 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
             "a directory containing at least one scene (*.toml)",
         ));
     }
-    let summary = run_verification(&VerifyOptions {
+    let (summary, report) = run_verification(&VerifyOptions {
         scenes,
         budget,
         out: args.out.clone(),
         alpha: args.alpha,
         progress: std::io::stderr().is_terminal(),
     })?;
-    write_index(&args.out, &summary)?;
+    write_report(report, &summary)?;
     for scene in &summary.scenes {
         let failed: Vec<&str> = scene
             .checks
@@ -84,11 +84,12 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
         }
     }
     eprintln!(
-        "{} (budget {}, family-wise alpha {} per scene, Holm); report: {}",
+        "{} (budget {}, family-wise alpha {} per scene, Holm); report: {} (run {})",
         if summary.passed { "PASSED" } else { "FAILED" },
         summary.budget,
         summary.alpha,
-        args.out.join("index.html").display()
+        args.out.join("index.html").display(),
+        summary.run_id
     );
     Ok(if summary.passed { 0 } else { 1 })
 }

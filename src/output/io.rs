@@ -138,6 +138,14 @@ fn sync_dir(dir: &Path) {
 /// [`Error::InvalidParameter`] if the header is empty or a row's length differs from the
 /// header's (nothing is written then); [`Error::Io`] naming `path` if writing fails.
 pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<()> {
+    write_atomic(path, csv_text(path, header, rows)?.as_bytes())
+}
+
+/// The text [`write_csv`] writes to `path` (named in its errors).
+///
+/// # Errors
+/// As [`write_csv`], apart from writing.
+pub(crate) fn csv_text(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<String> {
     if header.is_empty() {
         return Err(Error::invalid(
             format!("CSV header of {}", path.display()),
@@ -174,7 +182,7 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<()> 
         }
         out.push('\n');
     }
-    write_atomic(path, out.as_bytes())
+    Ok(out)
 }
 
 fn push_csv_field(out: &mut String, field: &str) {
@@ -207,9 +215,17 @@ fn push_csv_number(out: &mut String, v: f64) {
 /// # Errors
 /// [`Error::Io`] naming `path` if serialization or writing fails.
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
+    write_atomic(path, json_text(path, value)?.as_bytes())
+}
+
+/// The text [`write_json`] writes to `path` (named in its errors).
+///
+/// # Errors
+/// [`Error::Io`] naming `path` if serialization fails.
+pub(crate) fn json_text<T: serde::Serialize>(path: &Path, value: &T) -> Result<String> {
     let mut text = serde_json::to_string_pretty(value).map_err(|e| Error::io(path, e.into()))?;
     text.push('\n');
-    write_atomic(path, text.as_bytes())
+    Ok(text)
 }
 
 #[cfg(test)]

@@ -5,6 +5,10 @@
 //!   destination directory and a rename, so an interrupted run never leaves a truncated
 //!   file; [`write_csv`] writes numbers with full round-trip precision; [`write_json`]
 //!   writes pretty-printed JSON (e.g. `summary.json`).
+//! - [`manifest`]: [`ReportRun`], a run id and a journal (`manifest.json`) of every file
+//!   a run writes, which keep a report directory consistent when a run is killed or a
+//!   rerun writes fewer files (old entry points removed first, dropped files removed,
+//!   entry points written last).
 //! - [`figure`]: [`Figure`] and [`Series`], rendered to SVG with `plotters` (SVG backend
 //!   only, no font files: text is emitted as SVG `<text>` and laid out by the viewer).
 //!   Rendering is deterministic, tolerates non-finite data and empty figures, and draws
@@ -12,6 +16,8 @@
 
 pub mod figure;
 pub mod io;
+pub mod manifest;
 
 pub use figure::{Figure, Series, SeriesStyle};
 pub use io::{remove_stale_temporaries, write_atomic, write_csv, write_json};
+pub use manifest::{Manifest, ReportRun, new_run_id};

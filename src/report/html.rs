@@ -3,16 +3,21 @@
 //! A single static, self-contained page: inline CSS, no scripts, no external resources.
 //! Figures are referenced by their relative paths (they live next to `index.html`), so
 //! the output directory can be moved or archived as a whole. All text from the summary
-//! is HTML-escaped. The wall times are the only content that differs between two runs
-//! with the same seeds.
+//! is HTML-escaped. The run id (also in `summary.json`) and the wall times are the only
+//! content that differs between two runs with the same seeds.
+//!
+//! [`write_report`] finishes a verification's [`ReportRun`]: `summary.json` and
+//! `index.html` are written last, after every other file of the run (see
+//! [`crate::output::manifest`]).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::Result;
+use crate::output::io::json_text;
+use crate::output::{ReportRun, write_atomic};
+use crate::verify::runner::ENTRY_POINTS;
 use crate::verify::summary::{CheckResult, SceneSummary, Summary};
-
-use crate::output::write_atomic;
 
 pub(crate) const CSS: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
@@ -41,7 +46,8 @@ code{font-size:.95em}
 
 /// Renders the HTML index page for `summary`.
 ///
-/// Content: the overall verdict, the budget and the family-wise significance level α
+/// Content: the overall verdict, the run id (every file of the report belongs to this
+/// run; `summary.json` lists them), the budget and the family-wise significance level α
 /// (Holm-corrected within each scene), a table of scenes, and per scene its notes, its
 /// figures embedded as `<img>` with the file name as caption, links to its CSV tables and
 /// the table of its checks (estimate, reference, standard error, raw and Holm-adjusted
@@ -83,6 +89,16 @@ pub fn render_index(summary: &Summary) -> String {
         plural(n_checks),
         fmt_seconds(total_wall)
     );
+    if !summary.run_id.is_empty() {
+        let _ = writeln!(
+            h,
+            "<p class=\"meta\">Run <code id=\"run-id\">{}</code>: every file of this \
+             report was written by this run; <a href=\"summary.json\">summary.json</a> \
+             lists them ({} files).</p>",
+            esc(&summary.run_id),
+            summary.files.len()
+        );
+    }
     let _ = writeln!(
         h,
         "<p>Budget: <b>{}</b>. Family-wise significance level α = {} per scene: the \
@@ -111,6 +127,31 @@ pub fn render_index(summary: &Summary) -> String {
 /// If `out_dir/convergence/index.html` exists (the reduced stability map of
 /// `make verify`, or `make converge`), a section linking it is added before `</body>`.
 pub fn write_index(out_dir: &Path, summary: &Summary) -> Result<()> {
+    write_atomic(
+        &out_dir.join("index.html"),
+        index_html(out_dir, summary).as_bytes(),
+    )
+}
+
+/// Finishes the verification's report run `run`: removes the files of earlier runs it did
+/// not rewrite, completes its journal, then writes `summary.json` and `index.html` (as
+/// [`write_index`]), in that order, atomically.
+///
+/// # Errors
+/// [`crate::Error::Io`] naming a file that cannot be removed or written.
+pub fn write_report(run: ReportRun, summary: &Summary) -> Result<()> {
+    let [summary_name, index_name] = ENTRY_POINTS;
+    let json = json_text(&run.dir().join(summary_name), summary)?;
+    let html = index_html(run.dir(), summary);
+    run.finish(&[
+        (summary_name, json.as_bytes()),
+        (index_name, html.as_bytes()),
+    ])
+}
+
+/// [`render_index`] of `summary`, with the link to `out_dir/convergence/index.html` if
+/// that exists.
+fn index_html(out_dir: &Path, summary: &Summary) -> String {
     let mut html = render_index(summary);
     if out_dir.join("convergence").join("index.html").exists()
         && let Some(i) = html.rfind("</body>")
@@ -120,7 +161,7 @@ pub fn write_index(out_dir: &Path, summary: &Summary) -> Result<()> {
             "<h2>Convergence and stability</h2>\n<p>Stability map, per-mode stationary bias against each integrator's exact formula (and, after <code>make converge</code>, the convergence studies, work–precision and extreme scenes): <a href=\"convergence/index.html\">convergence/index.html</a>.</p>\n",
         );
     }
-    write_atomic(&out_dir.join("index.html"), html.as_bytes())
+    html
 }
 
 fn scenes_table(h: &mut String, summary: &Summary) {

@@ -9,10 +9,10 @@
 //!
 //! Figures and files are written through the domain-free [`crate::output`] layer.
 //! Everything a report contains is a deterministic function of the run's results, except
-//! the wall-clock times.
+//! the run id and the wall-clock times.
 
 pub mod convergence;
 pub mod html;
 
 pub use convergence::write_convergence_index;
-pub use html::{render_index, write_index};
+pub use html::{render_index, write_index, write_report};

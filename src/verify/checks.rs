@@ -149,8 +149,9 @@ fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
 /// listed twice runs once.
 ///
 /// # Errors
-/// Propagates estimator errors (e.g. too few samples for the budget); a compression check
-/// kind is an error.
+/// An estimator's failure on the data (e.g. no self-consistent autocorrelation window, a
+/// constant series) as [`Error::RunFailed`] naming the run and the check (and mode); a
+/// compression check kind is [`Error::InvalidParameter`].
 pub fn linear_checks(
     run: &LinearRun,
     checks: &[CheckKind],
@@ -165,12 +166,14 @@ pub fn linear_checks(
         }
         seen.push(kind);
         match linear_step(run, kind)? {
-            Step::BeforeModes(f) => before.push(f),
-            Step::PerMode(rank, f) => per_mode.push((rank, f)),
-            Step::AfterModes(f) => after.push(f),
+            Step::BeforeModes(f) => before.push((kind, f)),
+            Step::PerMode(rank, f) => per_mode.push((rank, kind, f)),
+            Step::AfterModes(f) => after.push((kind, f)),
         }
     }
-    per_mode.sort_by_key(|(rank, _)| *rank);
+    per_mode.sort_by_key(|(rank, _, _)| *rank);
+    // An estimator's failure on the run's data is a run failure naming the observable.
+    let failed = |what: String, e: Error| Error::run_failed(run.spec.name.clone(), what, e);
     let mut ctx = LinearContext {
         run,
         records,
@@ -178,20 +181,38 @@ pub fn linear_checks(
         out: Vec::new(),
         est: LinearEstimates::default(),
     };
-    for f in before {
-        f(&mut ctx)?;
+    for (kind, f) in before {
+        f(&mut ctx).map_err(|e| failed(format!("{} check", kind_name(kind)), e))?;
     }
     for i in 0..run.reference.modes.len() {
         let mut mode = mode_data(run, records, i);
-        for (_, f) in &per_mode {
-            f(&mut ctx, &mut mode)?;
+        for (_, kind, f) in &per_mode {
+            f(&mut ctx, &mut mode).map_err(|e| {
+                let n = run.reference.modes[i].n;
+                failed(format!("{} check of mode {n}", kind_name(*kind)), e)
+            })?;
         }
         ctx.est.modes.push(mode.me);
     }
-    for f in after {
-        f(&mut ctx)?;
+    for (kind, f) in after {
+        f(&mut ctx).map_err(|e| failed(format!("{} check", kind_name(kind)), e))?;
     }
     Ok((ctx.out, ctx.est))
+}
+
+/// The name of a check kind as in scene files (`mode-variance`).
+fn kind_name(kind: CheckKind) -> &'static str {
+    match kind {
+        CheckKind::Profile => "profile",
+        CheckKind::ModeVariance => "mode-variance",
+        CheckKind::ModeDistribution => "mode-distribution",
+        CheckKind::DecayRate => "decay-rate",
+        CheckKind::Spectrum => "spectrum",
+        CheckKind::TwoTime => "two-time",
+        CheckKind::ForceStrain => "force-strain",
+        CheckKind::ForceDistribution => "force-distribution",
+        CheckKind::DtHalving => "dt-halving",
+    }
 }
 
 /// The series of mode `i` (one per trajectory and component), thinned so that the lag

@@ -1,9 +1,20 @@
-//! The verification runner: runs scenes, applies the family-wise correction, writes
-//! `summary.json` and the per-scene CSV tables and SVG figures; it returns the
-//! [`Summary`], from which the CLI writes `index.html` ([`crate::report`]).
+//! The verification runner: checks the input, runs scenes, applies the family-wise
+//! correction and writes the per-scene CSV tables and SVG figures through a
+//! [`ReportRun`]; it returns the [`Summary`] and the open report run, which
+//! [`crate::report::write_report`] finishes with `summary.json` and `index.html`.
+//!
+//! # Errors and exit codes
+//! Everything that can be checked before a simulation is (scene files, every run's
+//! set-up, the samples each check will get at the budget: [`Error::Scene`], exit 2), and
+//! the earlier report is left untouched then. A failure after the runs started — a
+//! divergence, an estimator that finds no answer in the data, a factorization that
+//! fails — is a run failure (exit 3) naming the run and the observable
+//! ([`Error::RunFailed`]), never an input error.
 //!
 //! # Outputs
-//! Under `--out`, `summary.json`, and for scene `<scene>` in `<scene>/`:
+//! Under `--out`: the entry points `summary.json` and `index.html`, the journal
+//! `manifest.json` ([`crate::output::manifest`]: run id and every file of the run), and
+//! for scene `<scene>` in `<scene>/`:
 //!
 //! - a linear scene, per run `<run>`: `<run>-modes.csv` and `.svg` (modal variance against
 //!   equipartition, when estimated), `<run>-mode-statistics.csv`, `<run>-rates.svg` (when
@@ -15,10 +26,14 @@
 //! - a compression scene: `force-strain.csv` (first run), `<run>-force-strain.csv` (other
 //!   runs), `force-strain.svg`, and `fig2.svg` under `--out` with the first run of every
 //!   compression scene so far (one per dimension).
+//!
+//! A rerun removes the files of the earlier run that it does not write again (e.g. of a
+//! scene left out); an interrupted run leaves no entry point (see
+//! [`crate::output::manifest`]).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
-use crate::output::{Figure, Series, SeriesStyle, write_csv, write_json};
+use crate::output::{Figure, ReportRun, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
@@ -54,12 +69,22 @@ const NOISE_STUDY_ELEMENTS: [usize; 6] = [5, 10, 20, 40, 80, 160];
 /// Modes of the element-uniform noise study (the columns `mode1` … `mode6`).
 const NOISE_STUDY_MODES: usize = 6;
 
-/// Runs every scene and writes the reports.
+/// File name of the journal of a verification report ([`crate::output::manifest`]).
+pub const MANIFEST: &str = "manifest.json";
+/// The entry points of a verification report, in the order they are written, last.
+pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
+
+/// Checks every scene, then runs them and writes their tables and figures; returns the
+/// summary (with the run id and every file of the report) and the report run, to be
+/// finished by [`crate::report::write_report`]. The earlier report in `opts.out` is
+/// invalidated only once the input has passed every check.
 ///
 /// # Errors
-/// Bad scene files ([`crate::Error::Scene`]), time steps above a stability limit,
-/// diverging runs, I/O failures.
-pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
+/// Input (exit 2): bad scene files, a time step above a stability limit, a budget that
+/// gives a check fewer samples than its estimator needs ([`Error::Scene`]). Run failures
+/// (exit 3): diverging runs ([`Error::Diverged`]), estimator or set-up failures
+/// ([`Error::RunFailed`]), I/O failures.
+pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes: Vec<Scene> = opts
         .scenes
         .iter()
@@ -67,27 +92,144 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<Summary> {
         .collect::<Result<_>>()?;
     // Prepare every run first so that bad input is reported before any long work.
     let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
+    for (scene, work) in scenes.iter().zip(&prepared) {
+        if let Prepared::Linear(runs) = work {
+            for (k, run) in runs.iter().enumerate() {
+                check_sample_counts(scene, k, run, opts.budget)?;
+            }
+        }
+    }
+    let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
     let bar = progress_bar(trajectory_count(&scenes, opts.budget), opts.progress);
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
     for (scene, work) in scenes.iter().zip(&prepared) {
         bar.set_message(scene.name.clone());
         summaries.push(match work {
-            Prepared::Linear(runs) => run_scene(scene, runs, opts, &bar)?,
+            Prepared::Linear(runs) => run_scene(scene, runs, opts, &report, &bar)?,
             Prepared::Compression(theory, runs) => {
-                run_compression_scene(scene, theory, runs, opts, &bar, &mut curves)?
+                run_compression_scene(scene, theory, runs, opts, &report, &bar, &mut curves)?
             }
         });
     }
     bar.finish_and_clear();
     let summary = Summary {
+        run_id: report.run_id(),
         budget: opts.budget.name().to_string(),
         alpha: opts.alpha,
         passed: summaries.iter().all(|s| s.passed),
         scenes: summaries,
+        files: report.files(),
     };
-    write_json(&opts.out.join("summary.json"), &summary)?;
-    Ok(summary)
+    Ok((summary, report))
+}
+
+/// The run `k` of `scene` as named in a run failure: file, index and name.
+fn run_label(scene: &Scene, k: usize) -> String {
+    format!(
+        "{}: runs[{k}] ({})",
+        scene.path.display(),
+        scene.runs.get(k).map_or("?", |r| r.name.as_str())
+    )
+}
+
+/// An error of run `k` while it simulates: a time step above a stability limit is input
+/// (exit 2, naming `runs[k].dt_tau1`); a divergence names the run and step; anything
+/// else is a run failure of the simulation (exit 3).
+fn simulation_error(scene: &Scene, k: usize, err: Error) -> Error {
+    match err {
+        Error::UnstableTimeStep { .. } | Error::Diverged { .. } | Error::Scene { .. } => {
+            scene.run_error(k, "dt_tau1", err)
+        }
+        other => Error::run_failed(run_label(scene, k), "simulation", other),
+    }
+}
+
+/// An estimator's failure on the data of run `k` (after the run): a run failure naming
+/// the observable, with the advice to raise `budget_key` (the input passed every check
+/// made before the run, so this is not an input error).
+fn estimation_error(
+    scene: &Scene,
+    k: usize,
+    observable: &str,
+    budget_key: &str,
+    err: Error,
+) -> Error {
+    Error::run_failed(run_label(scene, k), observable, err).with_advice(&format!(
+        "the data did not support the estimate; if the series are short compared with \
+         their correlation time, raising runs[{k}].{budget_key} may help"
+    ))
+}
+
+/// An error preparing run `k` (before any simulation): a numerical failure of the
+/// set-up (a factorization of a matrix that should be positive definite, an
+/// eigensolver) is a run failure (exit 3); anything else is input, named by
+/// [`Scene::run_error`].
+fn prepare_error(scene: &Scene, k: usize, err: Error) -> Error {
+    match err {
+        Error::Numerical { .. } => Error::run_failed(
+            run_label(scene, k),
+            "set-up (matrices, modes, references)",
+            err,
+        ),
+        other => scene.run_error(k, "integrator", other),
+    }
+}
+
+/// Refuses, before anything runs, linear run `k` of `scene` if at `budget` a check would
+/// get fewer samples than its estimator accepts: at least
+/// [`stats::moments::MIN_SERIES_LEN`] samples per profile series (profile check) and per mode
+/// series (mode-variance check), and two values per two-time point (two-time check).
+/// Whether a series that long is also long enough for its correlation time shows only
+/// in the data: that is then a run failure with advice ([`estimation_error`]).
+///
+/// # Errors
+/// [`Error::Scene`] naming `runs[k].<budget>.duration_tau1` (or `.trajectories`), the
+/// value, the samples it gives and the smallest value that is enough.
+fn check_sample_counts(scene: &Scene, k: usize, run: &LinearRun, budget: Budget) -> Result<()> {
+    let e = run.spec.ensemble(budget);
+    let checks = run.spec.checks(scene);
+    let tau1 = scene.filament.tau1();
+    let dt_tau1 = run.reference.dt / tau1;
+    let steps = run.sampled_steps(e.duration_tau1 * tau1);
+    let key = |k2: &str| format!("runs[{k}].{}.{k2}", budget.name());
+    let min = stats::moments::MIN_SERIES_LEN as u64;
+    let mut series: Vec<(String, u64)> = Vec::new();
+    if checks.contains(&CheckKind::Profile) && !run.reference.profile_x.is_empty() {
+        series.push(("each profile series".to_string(), run.profile_every));
+    }
+    if checks.contains(&CheckKind::ModeVariance) {
+        for (m, &every) in run.reference.modes.iter().zip(&run.mode_every) {
+            series.push((format!("mode {}", m.n), every));
+        }
+    }
+    // The sparsest series gets the fewest samples: it sets the duration needed.
+    if let Some((what, every)) = series.into_iter().max_by_key(|(_, every)| *every) {
+        let samples = steps / every;
+        if samples < min {
+            return Err(Error::Scene {
+                file: scene.path.clone(),
+                key: key("duration_tau1"),
+                message: format!(
+                    "must be >= {} (at least {min} samples of {what}, one every {every} steps of dt_tau1 = {dt_tau1}), got {}, which gives {samples}; raise it, or lower runs[{k}].dt_tau1",
+                    (min * every) as f64 * dt_tau1,
+                    e.duration_tau1
+                ),
+            });
+        }
+    }
+    let values = (e.trajectories + e.two_time_trajectories) * run.components;
+    if checks.contains(&CheckKind::TwoTime) && !run.reference.two_time.is_empty() && values < 2 {
+        return Err(Error::Scene {
+            file: scene.path.clone(),
+            key: key("trajectories"),
+            message: format!(
+                "must give at least 2 values per two-time point (trajectories + two_time_trajectories, times {} components), got {} trajectories and {} two-time trajectories",
+                run.components, e.trajectories, e.two_time_trajectories
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The prepared work of one scene.
@@ -105,7 +247,7 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
             .iter()
             .enumerate()
             .map(|(i, spec)| {
-                LinearRun::prepare(scene, spec).map_err(|e| scene.run_error(i, "integrator", e))
+                LinearRun::prepare(scene, spec).map_err(|e| prepare_error(scene, i, e))
             })
             .collect::<Result<_>>()?;
         return Ok(Prepared::Linear(runs));
@@ -115,12 +257,17 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
         .iter()
         .enumerate()
         .map(|(i, spec)| {
-            CompressionRun::prepare(scene, comp, spec)
-                .map_err(|e| scene.run_error(i, "integrator", e))
+            CompressionRun::prepare(scene, comp, spec).map_err(|e| prepare_error(scene, i, e))
         })
         .collect::<Result<_>>()?;
-    let theory = CompressionTheoryTable::new(scene, comp)
-        .map_err(|e| scene.run_error(0, "integrator", e))?;
+    let theory = CompressionTheoryTable::new(scene, comp).map_err(|e| match e {
+        Error::Numerical { .. } => Error::run_failed(
+            scene.path.display().to_string(),
+            "exact compression theory (before any run)",
+            e,
+        ),
+        other => scene.run_error(0, "integrator", other),
+    })?;
     Ok(Prepared::Compression(theory, runs))
 }
 
@@ -163,8 +310,11 @@ fn progress_bar(total: u64, show: bool) -> ProgressBar {
     bar
 }
 
-/// What a scene produces, each list in the order of `summary.json`.
-struct SceneOutputs {
+/// What a scene produces, each list in the order of `summary.json`, and the report run
+/// its files are written through.
+struct SceneOutputs<'r> {
+    /// The report run.
+    report: &'r ReportRun,
     /// The checks, before the family-wise correction.
     checks: Vec<CheckResult>,
     /// Figures written.
@@ -175,9 +325,10 @@ struct SceneOutputs {
     notes: Vec<String>,
 }
 
-impl SceneOutputs {
-    fn new(scene: &Scene) -> Self {
+impl<'r> SceneOutputs<'r> {
+    fn new(scene: &Scene, report: &'r ReportRun) -> Self {
         SceneOutputs {
+            report,
             checks: Vec::new(),
             figures: Vec::new(),
             tables: Vec::new(),
@@ -187,14 +338,14 @@ impl SceneOutputs {
 
     /// Writes `fig` to `path` (SVG) and lists it among the scene's figures.
     fn write_figure(&mut self, fig: &Figure, path: PathBuf) -> Result<()> {
-        fig.write_svg(&path)?;
+        self.report.write_svg(&path, fig)?;
         self.figures.push(path);
         Ok(())
     }
 
     /// Writes `rows` under `header` to `path` (CSV) and lists it among the scene's tables.
     fn write_table(&mut self, path: PathBuf, header: &[&str], rows: &[Vec<f64>]) -> Result<()> {
-        write_csv(&path, header, rows)?;
+        self.report.write_csv(&path, header, rows)?;
         self.tables.push(path);
         Ok(())
     }
@@ -223,12 +374,13 @@ fn run_compression_scene(
     theory: &CompressionTheoryTable,
     runs: &[CompressionRun],
     opts: &VerifyOptions,
+    report: &ReportRun,
     bar: &ProgressBar,
     curves: &mut Vec<Curve>,
 ) -> Result<SceneSummary> {
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
-    let mut outputs = SceneOutputs::new(scene);
+    let mut outputs = SceneOutputs::new(scene, report);
     let mut estimates = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     let mut fig = force_strain_figure(scene, theory);
@@ -282,12 +434,14 @@ fn run_compression_scene(
         }
         estimates.push(est);
     }
-    if let Some((check, note)) = scene_halving_check(scene, runs, &estimates)? {
+    let halving = scene_halving_check(scene, runs, &estimates)
+        .map_err(|e| Error::run_failed(scene.path.display().to_string(), "dt-halving check", e))?;
+    if let Some((check, note)) = halving {
         outputs.checks.push(check);
         outputs.notes.push(note);
     }
     outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
-    outputs.figures.push(write_fig2(&opts.out, curves)?);
+    outputs.figures.push(write_fig2(report, &opts.out, curves)?);
     let mut summary = finish_scene(scene, outputs, start, opts)?;
     if let Some((what, slope)) = largest_slope {
         summary
@@ -327,7 +481,7 @@ fn run_compression(
     run: &CompressionRun,
     opts: &VerifyOptions,
     bar: &ProgressBar,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<(ForceEstimates, Option<RmsSlope>, Option<Vec<f64>>)> {
     let e = run.spec.ensemble(opts.budget);
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
@@ -339,7 +493,7 @@ fn run_compression(
                 .collect();
             let records = run
                 .simulate_ensemble_per_point(seed, e.trajectories, &steps, || bar.inc(1))
-                .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+                .map_err(|e| simulation_error(scene, k, e))?;
             (records, None, run)
         }
         Some(target) => {
@@ -348,7 +502,7 @@ fn run_compression(
             let run = searched.as_ref().unwrap_or(run);
             let records = run
                 .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || bar.inc(1))
-                .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+                .map_err(|e| simulation_error(scene, k, e))?;
             (records, Some(plan), run)
         }
     };
@@ -356,11 +510,12 @@ fn run_compression(
         None => format!("{}.duration_tau1", opts.budget.name()),
         Some(_) => format!("{}.max_duration_tau1", opts.budget.name()),
     };
-    let est = force_estimates_diagnosed(&records, &scene.filament)
-        .map_err(|e| scene.run_error(k, &budget_key, e))?;
+    let est = force_estimates_diagnosed(&records, &scene.filament).map_err(|e| {
+        estimation_error(scene, k, "force estimates <F> per strain", &budget_key, e)
+    })?;
     outputs.checks.extend(
         compression_checks(run, run.spec.checks(scene), theory, &records, &est)
-            .map_err(|e| scene.run_error(k, &budget_key, e))?,
+            .map_err(|e| estimation_error(scene, k, "compression checks", &budget_key, e))?,
     );
     let slope = run.largest_rms_slope(&records);
     outputs
@@ -415,7 +570,7 @@ fn targeted_plan(
                 let seed = |c: usize| derive_seed(scene.seed, &format!("{name}/probe/{i}/{c}"));
                 run.search_step(i, search, e.trajectories, seed)
             })
-            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+            .map_err(|e| simulation_error(scene, k, e))?;
             let dts: Vec<f64> = choices.iter().map(|c| c.dt_tau1).collect();
             (Some(choices), Some(run.with_steps(&dts)?))
         }
@@ -431,10 +586,10 @@ fn targeted_plan(
             &pilot_steps,
             || bar.inc(1),
         )
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        .map_err(|e| simulation_error(scene, k, e))?;
     let pilot_key = format!("{}.pilot_tau1", budget.name());
     let pilot_est = force_estimates_diagnosed(&pilot, &scene.filament)
-        .map_err(|e| scene.run_error(k, &pilot_key, e))?;
+        .map_err(|e| estimation_error(scene, k, "pilot force estimates", &pilot_key, e))?;
     let pilot_tau1 = pilot_steps[0] as f64 * run.dt_at(0) / tau1;
     let pilot_std_error: Vec<f64> = pilot_est.force.iter().map(|f| f.1).collect();
     let main_steps: Vec<u64> = pilot_std_error
@@ -611,7 +766,7 @@ fn scene_halving_check(
 
 /// The paper's Fig. 2: ⟨F⟩/F_c0 against ε/ε_c0 in 2D and 3D, exact theory (discrete:
 /// solid, continuum: dashed) and simulated points with error bars.
-fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
+fn write_fig2(report: &ReportRun, out: &Path, curves: &[Curve]) -> Result<PathBuf> {
     let mut fig = Figure::new(
         "Fig. 2: thermally fluctuating hinged filament under imposed compression",
         "strain / Euler strain",
@@ -641,7 +796,7 @@ fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
             );
     }
     let path = out.join("fig2.svg");
-    fig.write_svg(&path)?;
+    report.write_svg(&path, &fig)?;
     Ok(path)
 }
 
@@ -649,11 +804,12 @@ fn write_fig2(out: &Path, curves: &[Curve]) -> Result<PathBuf> {
 /// paths of its outputs relative to `opts.out`.
 fn finish_scene(
     scene: &Scene,
-    outputs: SceneOutputs,
+    outputs: SceneOutputs<'_>,
     start: Instant,
     opts: &VerifyOptions,
 ) -> Result<SceneSummary> {
     let SceneOutputs {
+        report: _,
         mut checks,
         figures,
         tables,
@@ -692,11 +848,12 @@ fn run_scene(
     scene: &Scene,
     runs: &[LinearRun],
     opts: &VerifyOptions,
+    report: &ReportRun,
     bar: &ProgressBar,
 ) -> Result<SceneSummary> {
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
-    let mut outputs = SceneOutputs::new(scene);
+    let mut outputs = SceneOutputs::new(scene, report);
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     // The element-count study of the paper's noise: once per fem scene, after the first
     // element-uniform run.
@@ -709,8 +866,9 @@ fn run_scene(
     for (k, run) in runs.iter().enumerate() {
         let e = run.spec.ensemble(opts.budget);
         let (records, two_time) = simulate_linear(scene, k, run, &e, bar)?;
+        let budget_key = format!("{}.duration_tau1", opts.budget.name());
         let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)
-            .map_err(|e| scene.run_error(k, &format!("{}.duration_tau1", opts.budget.name()), e))?;
+            .map_err(|e| estimation_error(scene, k, "checks", &budget_key, e))?;
         outputs.checks.extend(run_checks);
         if let Some(slope) = run.measured_rms_slope(&records)
             && largest_slope.as_ref().is_none_or(|(_, s)| slope.0 > s.0)
@@ -754,12 +912,12 @@ fn simulate_linear(
     let full = e.trajectories as u64;
     let records = run
         .simulate_ensemble(seed, 0, full, steps, |k| bar.inc(k))
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        .map_err(|e| simulation_error(scene, k, e))?;
     let extra: Vec<Vec<f64>> = run
         .simulate_ensemble(seed, full, e.two_time_trajectories as u64, 0, |k| {
             bar.inc(k)
         })
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?
+        .map_err(|e| simulation_error(scene, k, e))?
         .into_iter()
         .map(|r| r.two_time)
         .collect();
@@ -792,7 +950,7 @@ fn write_run_outputs(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     if est.modes.iter().any(|m| m.variance.1 > 0.0) {
         write_mode_variances(dir, run, est, outputs)?;
@@ -813,7 +971,7 @@ fn write_mode_variances(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let name = &run.spec.name;
     let modes: Vec<_> = run.reference.modes.iter().zip(&est.modes).collect();
@@ -872,7 +1030,7 @@ fn write_mode_statistics(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let name = &run.spec.name;
     let stats_path = dir.join(format!("{name}-mode-statistics.csv"));
@@ -938,7 +1096,7 @@ fn write_profile(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let r = &run.reference;
     let path = dir.join(format!("{}-profile.csv", run.spec.name));
@@ -967,7 +1125,7 @@ fn write_two_time(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let path = dir.join(format!("{}-two-time.csv", run.spec.name));
     let rows: Vec<Vec<f64>> = run
@@ -1000,7 +1158,7 @@ fn write_spectra(
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
-    outputs: &mut SceneOutputs,
+    outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let name = &run.spec.name;
     let spectra: Vec<_> = est
@@ -1048,7 +1206,7 @@ fn write_spectra(
 /// ([`element_uniform_variance_ratios`]). Writes `element-uniform-vs-elements.csv`
 /// (`elements, mode1, …, mode6`) and `.svg` (1 − ratio against element count) and
 /// returns the note (the ratios at 10 elements and the observed order of the deficit).
-fn write_noise_study(scene: &Scene, dir: &Path, outputs: &mut SceneOutputs) -> Result<String> {
+fn write_noise_study(scene: &Scene, dir: &Path, outputs: &mut SceneOutputs<'_>) -> Result<String> {
     let ratios =
         element_uniform_variance_ratios(&scene.filament, &NOISE_STUDY_ELEMENTS, NOISE_STUDY_MODES)?;
     let rows: Vec<Vec<f64>> = NOISE_STUDY_ELEMENTS

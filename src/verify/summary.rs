@@ -1,4 +1,6 @@
-//! The machine-readable result of a verification run (`summary.json`).
+//! The machine-readable result of a verification run (`summary.json`): the run id and
+//! every file of the report (see [`crate::output::manifest`]), the budget, the scenes and
+//! their checks.
 
 use serde::{Deserialize, Serialize};
 
@@ -87,6 +89,10 @@ pub struct SceneSummary {
 /// The result of a verification run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
+    /// The run that wrote the report ([`crate::output::new_run_id`]); `index.html` shows
+    /// the same id. Empty for a summary not written by a run.
+    #[serde(default)]
+    pub run_id: String,
     /// Budget name: `quick`, `standard` or `full`.
     pub budget: String,
     /// Family-wise significance level used in each scene.
@@ -95,4 +101,11 @@ pub struct Summary {
     pub passed: bool,
     /// The scenes.
     pub scenes: Vec<SceneSummary>,
+    /// Every file of the report, relative to the output directory with `/` separators,
+    /// sorted: the figures and tables of the scenes, `fig2.svg` if written,
+    /// `summary.json`, `index.html` and the run's journal `manifest.json`. Nothing else
+    /// in the directory belongs to this run (a `convergence/` folder is another
+    /// command's).
+    #[serde(default)]
+    pub files: Vec<String>,
 }
