@@ -158,21 +158,11 @@ impl Error {
     /// `self` with `advice` appended to the detail of a [`Error::RunFailed`] (other
     /// errors are returned unchanged).
     #[must_use]
-    pub fn with_advice(self, advice: &str) -> Self {
-        match self {
-            Error::RunFailed {
-                run,
-                observable,
-                step,
-                detail,
-            } => Error::RunFailed {
-                run,
-                observable,
-                step,
-                detail: format!("{detail}; {advice}"),
-            },
-            other => other,
+    pub fn with_advice(mut self, advice: &str) -> Self {
+        if let Error::RunFailed { detail, .. } = &mut self {
+            *detail = format!("{detail}; {advice}");
         }
+        self
     }
 
     /// Shorthand for [`Error::Io`].

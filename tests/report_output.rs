@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::TempDir;
+use common::{TempDir, all_files};
 use std::fs;
 use std::path::Path;
 
@@ -388,25 +388,6 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
 // Report runs: run id, journal, consistency after interruption and reruns
 // (src/output/manifest.rs; issue #12)
 // ---------------------------------------------------------------------------------------
-
-/// Every regular file under `dir`, relative, with `/` separators, sorted.
-fn all_files(dir: &Path) -> Vec<String> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
-        for entry in fs::read_dir(dir).expect("read dir") {
-            let p = entry.expect("entry").path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).expect("under root");
-                out.push(rel.to_string_lossy().replace('\\', "/"));
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(dir, dir, &mut out);
-    out.sort();
-    out
-}
 
 fn journal(dir: &Path) -> Manifest {
     serde_json::from_str(&fs::read_to_string(dir.join("manifest.json")).expect("journal"))

@@ -17,7 +17,7 @@
 
 mod common;
 
-use common::{TempDir, command, describe, fixture, run, stderr_of, write_scene};
+use common::{TempDir, all_files, command, describe, fixture, run, stderr_of, write_scene};
 use langevin_fem::Error;
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::scene::Scene;
@@ -41,25 +41,6 @@ fn tiny_with_duration(duration: &str) -> String {
         quick,
         &format!("quick = {{ trajectories = 4, duration_tau1 = {duration}"),
     )
-}
-
-/// Every regular file under `dir`, relative with `/` separators, sorted.
-fn all_files(dir: &Path) -> Vec<String> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
-        for entry in std::fs::read_dir(dir).expect("read dir") {
-            let p = entry.expect("entry").path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).expect("under root");
-                out.push(rel.to_string_lossy().replace('\\', "/"));
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(dir, dir, &mut out);
-    out.sort();
-    out
 }
 
 fn json(path: &Path) -> Value {

@@ -183,3 +183,22 @@ pub fn assert_no_panic(args: &[&str], o: &Output) {
 pub fn hinged_profile_variance(x: f64, l: f64, ei: f64, kt: f64) -> f64 {
     kt * x * x * (l - x) * (l - x) / (3.0 * ei * l)
 }
+
+/// Every regular file under `dir`, relative with `/` separators, sorted.
+pub fn all_files(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).expect("read dir") {
+            let p = entry.expect("entry").path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                let rel = p.strip_prefix(root).expect("under root");
+                out.push(rel.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
