@@ -416,8 +416,11 @@ fn study_json(args: &[&str], tag: &str) -> serde_json::Value {
         .unwrap()
         .filter_map(|e| e.ok())
         .map(|e| e.path())
-        .find(|p| p.extension().is_some_and(|x| x == "json"))
-        .expect("a json summary");
+        .find(|p| {
+            let name = p.file_name().unwrap().to_string_lossy();
+            name.ends_with(".json") && !name.ends_with(".manifest.json")
+        })
+        .expect("a json summary (not the journal)");
     assert!(out.join("index.html").exists(), "index page rebuilt");
     serde_json::from_str(&std::fs::read_to_string(stem).unwrap()).unwrap()
 }

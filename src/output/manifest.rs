@@ -8,10 +8,11 @@
 //! of earlier runs not yet removed. Its *entry points* (`summary.json`, `index.html`) are
 //! what a reader opens first. [`ReportRun`] keeps them consistent:
 //!
-//! 1. [`ReportRun::begin`] replaces the journal, atomically, by one naming the new run as
-//!    incomplete and carrying every file the earlier journal listed (`superseded`); then
-//!    it removes the entry points. From then on no entry point describes a file of this
-//!    run, and no file of an earlier run is forgotten.
+//! 1. [`ReportRun::begin`] removes the entry points, then replaces the journal,
+//!    atomically, by one naming the new run as incomplete and carrying every file the
+//!    earlier journal listed (`superseded`). An entry point on disk therefore always
+//!    carries the run id of the journal beside it, no entry point describes a file of
+//!    this run before it is complete, and no file of an earlier run is forgotten.
 //! 2. [`ReportRun::write`] (and the CSV, JSON and SVG forms) lists a file in the journal
 //!    *before* writing it (write-ahead), so a run killed at any moment leaves no file the
 //!    journal does not name; every file is written atomically ([`write_atomic`]).
@@ -19,6 +20,15 @@
 //!    scenes): only files named in our own journal, only below the directory, never
 //!    directories that are not empty. Then it completes the journal and writes the entry
 //!    points last, each atomically.
+//!
+//! A directory shared by runs of several kinds (the studies' `reports/convergence/`) has
+//! one journal per output set (e.g. `<stem>.manifest.json`). A run's entry points are
+//! then its own summary and the directory's shared index: [`ReportRun::begin`] removes
+//! both, [`ReportRun::complete`] writes the summary *before* marking the journal complete
+//! (a complete journal always has its summary), and the caller rebuilds the index from
+//! every complete journal afterwards. Runs sharing a directory write disjoint file names
+//! (the shared index apart): a rerun removes the files its own earlier journal named, and
+//! never reads another journal.
 //!
 //! The temporary files of killed writers are removed by the next run
 //! ([`super::remove_stale_temporaries`]). Files the journal never named (e.g. the
@@ -93,6 +103,14 @@ fn civil_from_days(days: u64) -> (u64, u64, u64) {
     (yoe + era * 400 + u64::from(m <= 2), m, d)
 }
 
+/// The journal at `path`, if it exists and reads as a [`Manifest`]; `None` otherwise (a
+/// missing, unreadable or foreign file is never attributed to a run).
+pub fn read_manifest(path: &Path) -> Option<Manifest> {
+    fs::read(path)
+        .ok()
+        .and_then(|b| serde_json::from_slice(&b).ok())
+}
+
 /// `rel` if it is a plain relative path below the directory (no root, no `..`, no `.`,
 /// not empty); `None` otherwise. Journal entries that fail this are never touched.
 fn safe_relative(rel: &str) -> Option<&Path> {
@@ -118,19 +136,16 @@ pub struct ReportRun {
 impl ReportRun {
     /// Starts run `command` in `dir` (created if missing), with its journal `journal` and
     /// entry points `entry_points` (file names in `dir`): reads the earlier journal, if
-    /// any, writes the new one (incomplete, the earlier files as `superseded`) and removes
-    /// the entry points. An unreadable earlier journal is treated as absent (its files are
-    /// then never removed: they cannot be attributed).
+    /// any, removes the entry points and then writes the new journal (incomplete, the
+    /// earlier files as `superseded`). An unreadable earlier journal is treated as absent
+    /// (its files are then never removed: they cannot be attributed).
     ///
     /// # Errors
     /// [`Error::Io`] naming the directory, the journal or an entry point that cannot be
     /// created, written or removed.
     pub fn begin(dir: &Path, command: &str, journal: &str, entry_points: &[&str]) -> Result<Self> {
         fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let journal_path = dir.join(journal);
-        let earlier: Option<Manifest> = fs::read(&journal_path)
-            .ok()
-            .and_then(|b| serde_json::from_slice(&b).ok());
+        let earlier = read_manifest(&dir.join(journal));
         let superseded: BTreeSet<String> = earlier
             .map(|m| m.files.into_iter().chain(m.superseded).collect())
             .unwrap_or_default();
@@ -149,13 +164,16 @@ impl ReportRun {
                     .collect(),
             }),
         };
-        run.persist(&run.lock())?;
+        // Entry points first: an entry point on disk always names the run of the journal
+        // beside it (killed in between, the earlier journal stays, without its entry
+        // points: nothing describes a file wrongly).
         for name in &run.entry_points {
             let path = dir.join(name);
             if fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
                 fs::remove_file(&path).map_err(|e| Error::io(&path, e))?;
             }
         }
+        run.persist(&run.lock())?;
         Ok(run)
     }
 
@@ -225,8 +243,28 @@ impl ReportRun {
     /// [`Error::Io`] naming a file that cannot be removed or written; an entry that is not
     /// an entry point of the run ([`Error::Io`], nothing written).
     pub fn finish(self, entries: &[(&str, &[u8])]) -> Result<()> {
-        if let Some((name, _)) = entries
+        self.close(&[], entries)
+    }
+
+    /// Completes the run in a directory shared with other runs, each with its own
+    /// journal: removes the superseded files it did not write, writes `entries` — its own
+    /// entry points, in order, atomically — and then marks the journal complete. So a
+    /// complete journal always has its entries on disk. The entry points that describe
+    /// the whole directory (an index of every complete journal there) are not among
+    /// `entries`: the caller rebuilds them from the journals once this returns.
+    ///
+    /// # Errors
+    /// As [`Self::finish`].
+    pub fn complete(self, entries: &[(&str, &[u8])]) -> Result<()> {
+        self.close(entries, &[])
+    }
+
+    /// Removes the superseded files this run did not write, writes `before`, marks the
+    /// journal complete and writes `after` (entry points, each atomically).
+    fn close(self, before: &[(&str, &[u8])], after: &[(&str, &[u8])]) -> Result<()> {
+        if let Some((name, _)) = before
             .iter()
+            .chain(after)
             .find(|(n, _)| !self.entry_points.iter().any(|e| e == n))
         {
             let path = self.dir.join(name);
@@ -251,6 +289,9 @@ impl ReportRun {
         for rel in &stale {
             self.remove_superseded(rel)?;
         }
+        for (name, bytes) in before {
+            write_atomic(&self.dir.join(name), bytes)?;
+        }
         {
             let mut state = self.lock();
             state.complete = true;
@@ -258,7 +299,7 @@ impl ReportRun {
             state.superseded.clear();
             self.persist(&state)?;
         }
-        for (name, bytes) in entries {
+        for (name, bytes) in after {
             write_atomic(&self.dir.join(name), bytes)?;
         }
         Ok(())
@@ -357,6 +398,49 @@ mod tests {
         );
         assert_eq!(parts[1], std::process::id().to_string());
         assert_eq!(parts[2].len(), 8, "{a}");
+    }
+
+    /// Two output sets sharing a directory: `complete` writes the set's own entry point
+    /// before marking its journal complete and leaves the shared index to the caller; a
+    /// rerun removes both entry points first and then only its own dropped files.
+    #[test]
+    fn runs_sharing_a_directory_keep_each_others_files() {
+        let dir = std::env::temp_dir().join(format!("lfem-shared-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let entries = ["s.json", "index.html"];
+        let other = ReportRun::begin(&dir, "other", "o.manifest.json", &["o.json", "index.html"])
+            .expect("begin");
+        other.write(&dir.join("o.csv"), b"o").expect("write");
+        other.complete(&[("o.json", b"{}")]).expect("complete");
+
+        let run = ReportRun::begin(&dir, "s", "s.manifest.json", &entries).expect("begin");
+        run.write(&dir.join("a.csv"), b"a").expect("write");
+        run.write(&dir.join("b.svg"), b"b").expect("write");
+        run.complete(&[("s.json", b"{}")]).expect("complete");
+        let journal = read_manifest(&dir.join("s.manifest.json")).expect("journal");
+        assert!(journal.complete);
+        assert_eq!(
+            journal.files,
+            ["a.csv", "b.svg", "index.html", "s.json", "s.manifest.json"]
+        );
+        assert!(dir.join("s.json").exists() && !dir.join("index.html").exists());
+        fs::write(dir.join("index.html"), b"index").unwrap(); // the caller's index
+
+        let rerun = ReportRun::begin(&dir, "s", "s.manifest.json", &entries).expect("begin");
+        assert!(!dir.join("s.json").exists() && !dir.join("index.html").exists());
+        rerun.write(&dir.join("a.csv"), b"a2").expect("write");
+        let bad = rerun.complete(&[("a.csv", b"x")]);
+        assert!(bad.is_err(), "only entry points are entries");
+        assert_eq!(fs::read(dir.join("a.csv")).unwrap(), b"a2");
+
+        let rerun = ReportRun::begin(&dir, "s", "s.manifest.json", &entries).expect("begin");
+        rerun.write(&dir.join("a.csv"), b"a3").expect("write");
+        rerun.complete(&[("s.json", b"{}")]).expect("complete");
+        assert!(!dir.join("b.svg").exists(), "dropped file removed");
+        for kept in ["a.csv", "s.json", "o.csv", "o.json", "o.manifest.json"] {
+            assert!(dir.join(kept).exists(), "{kept}");
+        }
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

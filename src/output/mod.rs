@@ -8,7 +8,8 @@
 //! - [`manifest`]: [`ReportRun`], a run id and a journal (`manifest.json`) of every file
 //!   a run writes, which keep a report directory consistent when a run is killed or a
 //!   rerun writes fewer files (old entry points removed first, dropped files removed,
-//!   entry points written last).
+//!   entry points written last); several journals may share one directory, one per
+//!   output set (the studies' convergence folder).
 //! - [`figure`]: [`Figure`] and [`Series`], rendered to SVG with `plotters` (SVG backend
 //!   only, no font files: text is emitted as SVG `<text>` and laid out by the viewer).
 //!   Rendering is deterministic, tolerates non-finite data and empty figures, and draws
@@ -20,4 +21,4 @@ pub mod manifest;
 
 pub use figure::{Figure, Series, SeriesStyle};
 pub use io::{remove_stale_temporaries, write_atomic, write_csv, write_json};
-pub use manifest::{Manifest, ReportRun, new_run_id};
+pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};

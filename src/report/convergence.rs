@@ -1,12 +1,19 @@
 //! The index page of the convergence reports (`reports/convergence/index.html`): the
 //! convergence studies, the work–precision study, the stability map and the extreme
-//! scenes, rebuilt from the JSON summaries present in the directory each time one of
-//! `converge`, `work-precision` or `stability` writes there.
+//! scenes, rebuilt each time one of `converge`, `work-precision` or `stability` has
+//! written there.
+//!
+//! The page lists exactly the studies whose journal (`<stem>.manifest.json`, see
+//! [`crate::studies::output`]) says complete and whose summary `<stem>.json` carries the
+//! journal's run id, each with that run id; a study whose journal is incomplete (killed
+//! while writing, or still writing) is named as not listed. Summaries without a journal
+//! (written before journals existed) are not listed: nothing attributes them to a run.
 
 use super::html::{CSS, esc, url_path};
 use crate::error::{Error, Result};
-use crate::output::write_atomic;
+use crate::output::{Manifest, read_manifest, write_atomic};
 use crate::studies::converge::{ConvergeSummary, OrderFit};
+use crate::studies::output::{INDEX, STUDY_COMMANDS, stem_of_journal, summary_name};
 use crate::studies::stability::{Cell, StabilitySummary, Status};
 use crate::studies::work_precision::WorkPrecisionSummary;
 use serde::Serialize;
@@ -71,7 +78,7 @@ fn files(h: &mut String, list: &[String]) {
 }
 
 /// The heading, the table of observables and the consistency line of one study.
-fn convergence_section(h: &mut String, v: &ConvergeSummary) {
+fn convergence_section(h: &mut String, journal: &str, v: &ConvergeSummary) {
     let _ = writeln!(
         h,
         "<h3>{} / {} ({} noise, {}) over {}</h3>\n<p class=\"meta\">h = {}; {}; errors against the {}; budget {}: {} trajectories x {} tau1 per value; {:.1} s.</p>",
@@ -88,6 +95,7 @@ fn convergence_section(h: &mut String, v: &ConvergeSummary) {
         json(&v.duration_tau1),
         v.wall_seconds
     );
+    run_line(h, journal, &v.run_id);
     h.push_str("<table><tr><th>observable</th><th>expected order</th><th>observed order (95 % CI)</th><th>agrees</th><th>exact-error order</th><th>sampling floor at</th><th>why / note</th></tr>\n");
     for o in &v.observables {
         let e = &o.expected;
@@ -151,7 +159,7 @@ fn convergence_section(h: &mut String, v: &ConvergeSummary) {
 }
 
 /// The work–precision heading and its table of methods.
-fn work_precision_section(h: &mut String, v: &WorkPrecisionSummary) {
+fn work_precision_section(h: &mut String, journal: &str, v: &WorkPrecisionSummary) {
     let _ = writeln!(
         h,
         "<h2>Work–precision ({})</h2>\n<p class=\"meta\">Error in &lt;w²(L/2)&gt; against the continuum, {} elements, {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {}. Projected wall time to reach a relative error of {} with 95 % confidence (bias + 2 s.e.), from the measured cost and standard error (s.e. ∝ T<sup>-1/2</sup>); {} points disagree with their exact discrete value by more than 3 s.e.</p>",
@@ -165,6 +173,7 @@ fn work_precision_section(h: &mut String, v: &WorkPrecisionSummary) {
         num(v.tolerance),
         v.inconsistent_points
     );
+    run_line(h, journal, &v.run_id);
     h.push_str("<table><tr><th>integrator</th><th>noise</th><th>projected time (s)</th><th>best dt/tau1</th><th>cost vs fastest</th><th>smallest exact bias</th><th>note</th></tr>\n");
     for m in &v.methods {
         let _ = writeln!(
@@ -181,6 +190,18 @@ fn work_precision_section(h: &mut String, v: &WorkPrecisionSummary) {
     }
     h.push_str("</table>\n");
     files(h, &v.files);
+}
+
+/// The run id of a listed study, with a link to its journal.
+fn run_line(h: &mut String, journal: &str, run_id: &str) {
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\">Run <code class=\"run-id\" data-journal=\"{}\">{}</code> (journal <a href=\"{}\">{}</a>).</p>",
+        esc(journal),
+        esc(run_id),
+        url_path(journal),
+        esc(journal)
+    );
 }
 
 /// Pushes `x` onto `list` unless it is already there (first-seen order).
@@ -211,7 +232,7 @@ fn stability_cell(h: &mut String, c: Option<&Cell>) {
 
 /// The stability heading and the map: one row per integrator and element count, one
 /// column per dt·λ_max.
-fn stability_section(h: &mut String, v: &StabilitySummary) {
+fn stability_section(h: &mut String, journal: &str, v: &StabilitySummary) {
     let _ = writeln!(
         h,
         "<h2>Stability map ({})</h2>\n<p class=\"meta\">Consistent noise, {} trajectories x {} steps after {} burn-in steps per cell. <b>unstable</b>: |m| ≥ 1, refused before running and, forced, overflowing; <b>biased</b>: the stationary variance of a checked mode differs from kT/λ beyond its error (Holm over the map, α = {}); <b>stable</b>: no bias resolved. Exact per-mode formulas: {} of {} comparisons rejected; stability predictions {}.</p>",
@@ -228,6 +249,7 @@ fn stability_section(h: &mut String, v: &StabilitySummary) {
             "did NOT all hold"
         }
     );
+    run_line(h, journal, &v.run_id);
     let mut integrators: Vec<&str> = Vec::new();
     let mut steps: Vec<f64> = Vec::new();
     let mut elements: Vec<usize> = Vec::new();
@@ -264,47 +286,117 @@ fn read<T: DeserializeOwned>(dir: &Path, name: &str) -> Option<T> {
     serde_json::from_str(&text).ok()
 }
 
-/// Rebuilds `index.html` in `dir` from the JSON summaries there (convergence studies
-/// `*-elements.json` / `*-dt.json`, `work-precision.json`, `stability.json`) and links
-/// the extreme-scene report `extreme/index.html` if present.
-///
-/// # Errors
-/// I/O failures naming the path.
-pub fn write_convergence_index(dir: &Path) -> Result<()> {
+/// A study's summary, by the command that wrote it.
+enum Study {
+    Stability(StabilitySummary),
+    WorkPrecision(WorkPrecisionSummary),
+    Converge(Box<ConvergeSummary>),
+}
+
+impl Study {
+    /// The summary of `journal`'s output set, if it reads as its command's summary and
+    /// carries the journal's run id.
+    fn read(dir: &Path, stem: &str, journal: &Manifest) -> Option<Study> {
+        let name = summary_name(stem);
+        let study = match journal.command.as_str() {
+            "stability" => Study::Stability(read(dir, &name)?),
+            "work-precision" => Study::WorkPrecision(read(dir, &name)?),
+            "converge" => Study::Converge(Box::new(read(dir, &name)?)),
+            _ => return None,
+        };
+        let run_id = match &study {
+            Study::Stability(v) => &v.run_id,
+            Study::WorkPrecision(v) => &v.run_id,
+            Study::Converge(v) => &v.run_id,
+        };
+        (*run_id == journal.run_id).then_some(study)
+    }
+
+    /// The order of the sections: the stability map, work–precision, then the
+    /// convergence studies.
+    fn rank(&self) -> u8 {
+        match self {
+            Study::Stability(_) => 0,
+            Study::WorkPrecision(_) => 1,
+            Study::Converge(_) => 2,
+        }
+    }
+}
+
+/// The studies of `dir`, from their journals (sorted by journal name): the listed ones
+/// (complete, with a summary of the same run) as (journal, summary), and the others as
+/// (journal, run id).
+type Journals = (Vec<(String, Study)>, Vec<(String, String)>);
+
+/// Reads every study journal in `dir` (see [`Journals`]).
+fn journals(dir: &Path) -> Result<Journals> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .map_err(|e| Error::io(dir, e))?
         .filter_map(|e| e.ok())
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".json"))
+        .filter(|n| stem_of_journal(n).is_some())
         .collect();
     names.sort();
+    let mut listed = Vec::new();
+    let mut other = Vec::new();
+    for name in names {
+        let Some(journal) = read_manifest(&dir.join(&name)) else {
+            continue;
+        };
+        if !STUDY_COMMANDS.contains(&journal.command.as_str()) {
+            continue;
+        }
+        let stem = stem_of_journal(&name).unwrap_or_default();
+        match Study::read(dir, stem, &journal).filter(|_| journal.complete) {
+            Some(study) => listed.push((name, study)),
+            None => other.push((name, journal.run_id)),
+        }
+    }
+    listed.sort_by_key(|(_, s)| s.rank());
+    Ok((listed, other))
+}
+
+/// Rebuilds `index.html` in `dir` from the complete study journals there and their
+/// summaries (see the [module docs](self)), and links the extreme-scene report
+/// `extreme/index.html` if present.
+///
+/// # Errors
+/// I/O failures naming the path.
+pub fn write_convergence_index(dir: &Path) -> Result<()> {
+    let (listed, other) = journals(dir)?;
     let mut h = String::new();
     let _ = writeln!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>langevin-fem convergence</title><style>{CSS}td.warn{{background:#fff8c5;color:#7d4e00;font-weight:bold;text-align:center}}p.fail,span.fail{{color:#a40e26;font-weight:bold}}p.warn{{color:#7d4e00}}</style></head><body>\n<h1>langevin-fem: convergence, work–precision, stability</h1>"
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>langevin-fem convergence</title><style>{CSS}td.warn{{background:#fff8c5;color:#7d4e00;font-weight:bold;text-align:center}}p.fail,span.fail{{color:#a40e26;font-weight:bold}}p.warn{{color:#7d4e00}}</style></head><body>\n<h1>langevin-fem: convergence, work–precision, stability</h1>\n<p class=\"meta\">Every study below is listed from its complete journal (<code>&lt;study&gt;.manifest.json</code>: its run id and every file it wrote).</p>"
     );
+    for (journal, run_id) in &other {
+        let _ = writeln!(
+            h,
+            "<p class=\"warn\">Not listed: the study of <a href=\"{}\">{}</a> (run <code class=\"incomplete-run-id\">{}</code>) did not finish writing (interrupted, or still running); its next run replaces or removes its files.</p>",
+            url_path(journal),
+            esc(journal),
+            esc(run_id)
+        );
+    }
     if dir.join("extreme").join("index.html").exists() {
         h.push_str("<h2>Extreme scenes</h2>\n<p>Very stiff, floppy (small-slope warning), 1000-element and huge-EA scenes: <a href=\"extreme/index.html\">extreme/index.html</a>.</p>\n");
     }
-    if let Some(v) = read::<StabilitySummary>(dir, "stability.json") {
-        stability_section(&mut h, &v);
-    }
-    if let Some(v) = read::<WorkPrecisionSummary>(dir, "work-precision.json") {
-        work_precision_section(&mut h, &v);
-    }
-    let studies: Vec<ConvergeSummary> = names
-        .iter()
-        .filter(|n| n.ends_with("-elements.json") || n.ends_with("-dt.json"))
-        .filter_map(|n| read(dir, n))
-        .collect();
-    if !studies.is_empty() {
-        h.push_str("<h2>Convergence over element count and time step</h2>\n");
-        for v in &studies {
-            convergence_section(&mut h, v);
+    let mut converge_heading = false;
+    for (journal, study) in &listed {
+        match study {
+            Study::Stability(v) => stability_section(&mut h, journal, v),
+            Study::WorkPrecision(v) => work_precision_section(&mut h, journal, v),
+            Study::Converge(v) => {
+                if !converge_heading {
+                    h.push_str("<h2>Convergence over element count and time step</h2>\n");
+                    converge_heading = true;
+                }
+                convergence_section(&mut h, journal, v);
+            }
         }
     }
     h.push_str("</body></html>\n");
-    write_atomic(&dir.join("index.html"), h.as_bytes())
+    write_atomic(&dir.join(INDEX), h.as_bytes())
 }
 
 #[cfg(test)]
@@ -317,7 +409,7 @@ mod tests {
     #[test]
     fn null_numbers_read_back_and_render() {
         let text = json!({
-            "scene": "s", "elements": 10, "observable": "w2(L/2)", "continuum": null,
+            "run_id": "r", "scene": "s", "elements": 10, "observable": "w2(L/2)", "continuum": null,
             "tolerance": 0.01, "trajectories": 2, "duration_tau1": 50.0,
             "em_duration_tau1": 4.0, "threads": 1, "sampling_floor": null, "points": [],
             "methods": [{
@@ -331,7 +423,7 @@ mod tests {
         assert!(v.continuum.is_nan() && v.methods[0].min_rel_bias.is_nan());
         assert_eq!(serde_json::to_value(&v).unwrap(), text);
         let mut h = String::new();
-        work_precision_section(&mut h, &v);
+        work_precision_section(&mut h, "work-precision.manifest.json", &v);
         assert!(h.contains("sampling floor (median relative s.e.) –."));
         assert!(h.contains("<td class=\"num\">–</td><td class=\"detail\">n</td>"));
         let f: OrderFit = serde_json::from_value(

@@ -37,18 +37,19 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 
+use super::output::StudyReport;
 use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::output::{Figure, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
 use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 pub mod compression;
@@ -788,6 +789,10 @@ impl FailedValue {
 /// The JSON summary of a study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergeSummary {
+    /// The run that wrote this summary: the run id of the study's journal
+    /// ([`super::output`]); empty in a summary written before journals existed.
+    #[serde(default)]
+    pub run_id: String,
     /// Scene name.
     pub scene: String,
     /// Run name (with `-as-<integrator>` if the integrator was overridden).
@@ -825,7 +830,8 @@ pub struct ConvergeSummary {
     pub warnings: Vec<String>,
     /// All rows.
     pub rows: Vec<Row>,
-    /// Files written (relative to the output directory).
+    /// The study's files (relative to the output directory, sorted): its table, figure
+    /// and this summary; its journal and the shared index apart.
     pub files: Vec<String>,
     /// Wall time (s).
     #[serde(deserialize_with = "nan_if_null")]
@@ -905,7 +911,8 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 }
 
 /// Runs a convergence study and writes `<scene>-<run>-<over>.{csv,svg,json}` in `out`
-/// (`<run>-as-<integrator>` with an integrator override).
+/// (`<run>-as-<integrator>` with an integrator override) with its journal
+/// `<scene>-<run>-<over>.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
 /// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
@@ -1110,8 +1117,8 @@ fn linear_texts(scene: &Scene, spec: &RunSpec, over: Over) -> (String, String) {
     }
 }
 
-/// Summarizes `study`, writes its CSV, SVG and JSON and rebuilds nothing else (the CLI
-/// rebuilds the index page).
+/// Summarizes `study` and writes its output set `<stem>.{csv,svg,json}` with its journal
+/// `<stem>.manifest.json` ([`super::output`]); the CLI then rebuilds the index page.
 fn finish(
     opts: &ConvergeOptions,
     scene: &Scene,
@@ -1124,13 +1131,14 @@ fn finish(
     let over = opts.over;
     let observables = summarize(&study.names, &study.rows, &study.expected);
     let stem = format!("{}-{label}-{}", scene.name, over.name());
-    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
-    let csv = opts.out.join(format!("{stem}.csv"));
-    write_rows_csv(&csv, &study.rows)?;
-    let svg = opts.out.join(format!("{stem}.svg"));
-    figure(scene, label, spec, over, &study.names, &study.rows).write_svg(&svg)?;
-    let json = opts.out.join(format!("{stem}.json"));
+    let report = StudyReport::begin(&opts.out, "converge", &stem)?;
+    report.write(&format!("{stem}.csv"), rows_csv(&study.rows).as_bytes())?;
+    report.write_svg(
+        &format!("{stem}.svg"),
+        &figure(scene, label, spec, over, &study.names, &study.rows),
+    )?;
     let summary = ConvergeSummary {
+        run_id: report.run_id(),
         scene: scene.name.clone(),
         run: label.to_string(),
         integrator: spec.integrator.name().to_string(),
@@ -1149,18 +1157,10 @@ fn finish(
         notes: study.notes,
         warnings: study.warnings,
         rows: study.rows,
-        files: [&csv, &svg, &json]
-            .iter()
-            .map(|p| {
-                p.file_name()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .into_owned()
-            })
-            .collect(),
+        files: report.files(),
         wall_seconds: start.elapsed().as_secs_f64(),
     };
-    write_json(&json, &summary)?;
+    report.complete(&summary)?;
     Ok(summary)
 }
 
@@ -1306,7 +1306,8 @@ fn opt_cell(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| x.to_string())
 }
 
-fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
+/// The study's table `<stem>.csv`: one line per value and observable.
+fn rows_csv(rows: &[Row]) -> String {
     let mut text = String::from(
         "value,h,observable,estimate,std_error,discrete,limit,total_error,total_error_se,exact_error,status\n",
     );
@@ -1330,7 +1331,7 @@ fn write_rows_csv(path: &Path, rows: &[Row]) -> Result<()> {
             }
         ));
     }
-    write_atomic(path, text.as_bytes())
+    text
 }
 
 fn figure(

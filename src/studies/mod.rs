@@ -10,7 +10,11 @@
 //!   integrators' exact discrete-time stationary-variance formulas.
 //! - [`work_precision`]: error in ⟨w²(L/2)⟩ against wall time, and the projected cost to a
 //!   tolerance.
+//! - [`output`]: the shared study folder: one output set and journal per study
+//!   ([`output::StudyReport`]), so that studies keep each other's files and a rerun
+//!   replaces its own.
 
 pub mod converge;
+pub mod output;
 pub mod stability;
 pub mod work_precision;

@@ -33,6 +33,7 @@
 //! Each cell has its own seed (derived from the scene seed and the cell's label) and its
 //! trajectories their own streams, so results do not depend on the thread count.
 
+use super::output::StudyReport;
 use crate::dynamics::{
     Components, Driver, Family, Integrator, IntegratorKind, Observer, ThetaScheme, build_integrator,
 };
@@ -41,7 +42,7 @@ use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::modal::generalized_modes;
 use crate::fem::noise::NoiseModel;
-use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::output::{Figure, Series, SeriesStyle};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
 use crate::stats;
@@ -184,9 +185,18 @@ pub struct Cell {
     pub modes: Vec<ModeBias>,
 }
 
+/// The stem of the study's output set: `stability.json`, `stability.manifest.json`
+/// ([`super::output`]).
+pub const STEM: &str = "stability";
+
 /// The JSON summary of a stability study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StabilitySummary {
+    /// The run that wrote this summary: the run id of the journal
+    /// `stability.manifest.json` ([`super::output`]); empty in a summary written before
+    /// journals existed.
+    #[serde(default)]
+    pub run_id: String,
     /// Scene name.
     pub scene: String,
     /// Noise model (consistent).
@@ -209,7 +219,8 @@ pub struct StabilitySummary {
     /// Whether the predicted stability agreed with every run (refused cells diverge
     /// when forced, accepted cells do not).
     pub stability_as_predicted: bool,
-    /// Files written (relative to the output directory).
+    /// The study's files (relative to the output directory, sorted): its tables, figures
+    /// and this summary; its journal and the shared index apart.
     pub files: Vec<String>,
     /// Wall time (s).
     #[serde(deserialize_with = "nan_if_null")]
@@ -623,7 +634,8 @@ fn classify(cell: &mut Cell, biased: bool) {
 
 /// Runs the stability study and writes `stability-cells.csv`, `stationary-bias.csv`,
 /// `stability.json`, `stability-map-<integrator>.svg` and `stationary-bias.svg` in
-/// `opts.out`.
+/// `opts.out`, with their journal `stability.manifest.json`, after every simulation
+/// ([`super::output`]); a rerun removes the maps of integrators it left out.
 ///
 /// # Errors
 /// Bad options (exit 2, naming the flag); numerical or I/O failures.
@@ -637,8 +649,10 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
         Status::Unstable => c.refused.is_some() && c.diverged_at.is_some(),
         _ => c.refused.is_none(),
     });
-    let files = write_outputs(opts, &cells)?;
+    let report = StudyReport::begin(&opts.out, "stability", STEM)?;
+    write_outputs(&report, opts, &cells)?;
     let summary = StabilitySummary {
+        run_id: report.run_id(),
         scene: opts.scene.name.clone(),
         noise: NoiseModel::Consistent.name().to_string(),
         alpha: opts.alpha,
@@ -649,10 +663,10 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
         formula_rejections,
         stability_as_predicted,
         cells,
-        files,
+        files: report.files(),
         wall_seconds: start.elapsed().as_secs_f64(),
     };
-    write_json(&opts.out.join("stability.json"), &summary)?;
+    report.complete(&summary)?;
     Ok(summary)
 }
 
@@ -721,31 +735,18 @@ fn judge_formulas(cells: &mut [Cell], alpha: f64) -> (usize, usize) {
     (p.len(), decisions.iter().filter(|d| d.1).count())
 }
 
-/// Writes the CSV tables and the figures in `opts.out`; returns the files written, with
-/// `stability.json` (written last, by the caller).
-fn write_outputs(opts: &StabilityOptions, cells: &[Cell]) -> Result<Vec<String>> {
-    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
-    let mut files = Vec::new();
-    write_atomic(
-        &opts.out.join("stability-cells.csv"),
-        cells_csv(cells).as_bytes(),
-    )?;
-    files.push("stability-cells.csv".to_string());
-    write_atomic(
-        &opts.out.join("stationary-bias.csv"),
-        modes_csv(cells).as_bytes(),
-    )?;
-    files.push("stationary-bias.csv".to_string());
+/// Writes the CSV tables and the figures of the output set through `report`.
+fn write_outputs(report: &StudyReport, opts: &StabilityOptions, cells: &[Cell]) -> Result<()> {
+    report.write("stability-cells.csv", cells_csv(cells).as_bytes())?;
+    report.write("stationary-bias.csv", modes_csv(cells).as_bytes())?;
     for &k in &opts.integrators {
         let name = format!("stability-map-{}.svg", k.name());
-        map_figure(&opts.scene.name, k, cells).write_svg(&opts.out.join(&name))?;
-        files.push(name);
+        report.write_svg(&name, &map_figure(&opts.scene.name, k, cells))?;
     }
-    bias_figure(&opts.scene.name, &opts.integrators, cells)
-        .write_svg(&opts.out.join("stationary-bias.svg"))?;
-    files.push("stationary-bias.svg".to_string());
-    files.push("stability.json".to_string());
-    Ok(files)
+    report.write_svg(
+        "stationary-bias.svg",
+        &bias_figure(&opts.scene.name, &opts.integrators, cells),
+    )
 }
 
 /// `stability-cells.csv`: one line per cell.

@@ -23,16 +23,17 @@
 //! Wall times are measured on this machine with the rayon pool over trajectories (the
 //! thread count is recorded); they are not reproducible bit for bit, the estimates are.
 
+use super::output::StudyReport;
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
-use crate::output::{Figure, Series, SeriesStyle, write_atomic, write_json};
+use crate::output::{Figure, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::LinearRun;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Default methods: the paper's explicit scheme with both noise models, backward Euler,
@@ -145,9 +146,18 @@ pub struct MethodSummary {
     pub note: String,
 }
 
+/// The stem of the study's output set: `work-precision.json`,
+/// `work-precision.manifest.json` ([`super::output`]).
+pub const STEM: &str = "work-precision";
+
 /// The JSON summary of a work–precision study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorkPrecisionSummary {
+    /// The run that wrote this summary: the run id of the journal
+    /// `work-precision.manifest.json` ([`super::output`]); empty in a summary written
+    /// before journals existed.
+    #[serde(default)]
+    pub run_id: String,
     /// Scene name.
     pub scene: String,
     /// Elements of the mesh.
@@ -180,7 +190,8 @@ pub struct WorkPrecisionSummary {
     pub methods: Vec<MethodSummary>,
     /// Points whose estimate disagrees with the exact discrete value (|z| > 3).
     pub inconsistent_points: usize,
-    /// Files written (relative to the output directory).
+    /// The study's files (relative to the output directory, sorted): its table, figures
+    /// and this summary; its journal and the shared index apart.
     pub files: Vec<String>,
     /// Wall time (s).
     #[serde(deserialize_with = "nan_if_null")]
@@ -298,7 +309,8 @@ fn point_scene(
 type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 
 /// Runs the study and writes `work-precision.{csv,json,svg}` and
-/// `work-precision-projected.svg` in `opts.out`.
+/// `work-precision-projected.svg` in `opts.out`, with their journal
+/// `work-precision.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
 /// Bad options (exit 2, naming the flag); run failures.
@@ -316,12 +328,18 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     ses.sort_by(f64::total_cmp);
     let sampling_floor = ses.get(ses.len() / 2).copied().unwrap_or(f64::NAN);
 
-    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
-    write_points_csv(&opts.out.join("work-precision.csv"), &points)?;
-    measured_figure(opts, &points, sampling_floor)
-        .write_svg(&opts.out.join("work-precision.svg"))?;
-    projected_figure(opts, &points).write_svg(&opts.out.join("work-precision-projected.svg"))?;
+    let report = StudyReport::begin(&opts.out, "work-precision", STEM)?;
+    report.write("work-precision.csv", points_csv(&points).as_bytes())?;
+    report.write_svg(
+        "work-precision.svg",
+        &measured_figure(opts, &points, sampling_floor),
+    )?;
+    report.write_svg(
+        "work-precision-projected.svg",
+        &projected_figure(opts, &points),
+    )?;
     let summary = WorkPrecisionSummary {
+        run_id: report.run_id(),
         scene: opts.scene.name.clone(),
         elements: opts.scene.mesh.elements,
         observable: "w2(L/2)".to_string(),
@@ -335,18 +353,10 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
         inconsistent_points: points.iter().filter(|p| p.z_discrete.abs() > 3.0).count(),
         points,
         methods,
-        files: [
-            "work-precision.csv",
-            "work-precision.svg",
-            "work-precision-projected.svg",
-            "work-precision.json",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect(),
+        files: report.files(),
         wall_seconds: start.elapsed().as_secs_f64(),
     };
-    write_json(&opts.out.join("work-precision.json"), &summary)?;
+    report.complete(&summary)?;
     Ok(summary)
 }
 
@@ -420,8 +430,8 @@ fn run_point(opts: &WorkPrecisionOptions, (method, dt, s, lr): &PreparedPoint) -
     Ok(p)
 }
 
-/// Writes the points as CSV (one line per point).
-fn write_points_csv(path: &Path, points: &[WpPoint]) -> Result<()> {
+/// The points as CSV (one line per point).
+fn points_csv(points: &[WpPoint]) -> String {
     let mut csv = String::from(
         "integrator,noise,dt_tau1,trajectories,duration_tau1,steps_per_trajectory,wall_seconds,estimate,std_error,discrete,continuum,rel_error,rel_std_error,rel_bias,z_discrete,seconds_to_tolerance\n",
     );
@@ -448,7 +458,7 @@ fn write_points_csv(path: &Path, points: &[WpPoint]) -> Result<()> {
                 .unwrap_or_default()
         ));
     }
-    write_atomic(path, csv.as_bytes())
+    csv
 }
 
 fn method_points(points: &[WpPoint], (k, n): (IntegratorKind, NoiseModel)) -> Vec<&WpPoint> {
