@@ -39,9 +39,10 @@ pub struct LaneOf<'a, B: ?Sized> {
 
 /// The θ-scheme of [`ThetaScheme`](super::ThetaScheme) for [`LANES`] trajectories at
 /// once: the noise of each lane drawn and formed as the one-trajectory step forms it
-/// (`g_i = sqrt(2kTΔt)·ζ_i`; for consistent noise the product `L z` of all lanes at once,
-/// [`BandedCholesky::mul_lower_lanes`]), then one forward and one backward banded sweep over all
-/// lanes ([`BandedCholesky::theta_sweeps_lanes`]). Allocation-free per step.
+/// (`g_i = sqrt(2kTΔt)·ζ_i`), then one forward and one backward banded sweep over all
+/// lanes ([`BandedCholesky::theta_sweeps_lanes`]; for consistent noise the product `L z`
+/// of all lanes formed inside the forward sweep,
+/// [`BandedCholesky::theta_sweeps_lanes_noise`]). Allocation-free per step.
 pub struct ThetaBatch {
     lhs: BandedCholesky,
     rhs: SymBanded,
