@@ -247,7 +247,13 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             if !(eta.is_finite() && eta >= 0.0) {
                 return Err(Error::invalid("--eta", eta, "finite and >= 0"));
             }
-            require_in_range("--t", t, 0.0, eta)?;
+            if !(t.is_finite() && (0.0..=eta).contains(&t)) {
+                return Err(Error::invalid(
+                    "--t",
+                    t,
+                    format!("in [0, --eta] = [0, {eta}] (the earlier time of the pair)"),
+                ));
+            }
             if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
                 return Err(Error::invalid("--tolerance", tolerance, "in (0, 1)"));
             }
