@@ -430,7 +430,7 @@ fn theory_rejects_out_of_range_values_with_exit_2() {
                 "--eta",
                 "1",
             ],
-            &["--t must be in [0, 1], got 2"],
+            &["--t must be in [0, --eta] = [0, 1]", "got 2"],
         ),
         (
             &[
