@@ -237,21 +237,25 @@ impl WorkLimits {
     }
 }
 
-/// A count for messages: whole below 1e6, else three significant digits in exponent
-/// form (`3.21e13`, `1e13`).
+/// A number for messages: whole numbers below 1e6 as they are, others to three
+/// significant digits, in exponent form from 1e6 and below 1e-2 (`3.21e13`, `1e13`,
+/// `4.4`, `2.9e-4`).
 pub fn count(x: f64) -> String {
-    if !x.is_finite() {
+    if !x.is_finite() || x == 0.0 {
         return format!("{x}");
     }
-    if x.abs() < 1e6 {
+    if (1e-2..1e6).contains(&x.abs()) {
         let r = x.round();
         return if (x - r).abs() < 1e-9 * x.abs().max(1.0) {
             format!("{r}")
         } else {
-            format!("{:.3}", x)
-                .trim_end_matches('0')
-                .trim_end_matches('.')
-                .to_string()
+            let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+            let s = format!("{x:.decimals$}");
+            if s.contains('.') {
+                s.trim_end_matches('0').trim_end_matches('.').to_string()
+            } else {
+                s
+            }
         };
     }
     let s = format!("{x:.2e}");
@@ -283,6 +287,9 @@ fn round_up(x: f64) -> String {
 pub fn duration(seconds: f64) -> String {
     if !seconds.is_finite() {
         return "forever".to_string();
+    }
+    if seconds < 1.0 {
+        return "under 1 s".to_string();
     }
     let (v, unit) = if seconds < 120.0 {
         (seconds, "s")
@@ -356,6 +363,11 @@ mod tests {
         assert_eq!(count(3.2149e13), "3.21e13");
         assert_eq!(count(20.0), "20");
         assert_eq!(count(0.5), "0.5");
+        assert_eq!(count(4.39), "4.39");
+        assert_eq!(count(146.48), "146");
+        assert_eq!(count(2.9e-4), "2.9e-4");
+        assert_eq!(round_up(2.861e-4), "2.9e-4");
+        assert_eq!(duration(0.01), "under 1 s");
         assert_eq!(round_up(3.2149e13), "3.3e13");
         assert_eq!(round_up(4.0), "4");
         assert_eq!(round_up(4.01), "4.1");

@@ -614,7 +614,7 @@ pub fn projected_work(
             };
             let name = s.runs.get(run).map_or("?", |r| r.name.as_str());
             Part {
-                label: format!("{} {name} at {}={v}", s.name, opts.over.name()),
+                label: format!("{} {name} at {}={}", s.name, opts.over.name(), Num(v)),
                 drivers: format!(
                     "{} ({} elements, dt_tau1 = {})",
                     drivers.join(", "),
