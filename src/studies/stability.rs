@@ -102,7 +102,8 @@ pub struct StabilityOptions {
 /// and holds the series of at most [`MAX_CHECKED_MODES`] modes at every sampled step;
 /// the cells run in parallel, as many at once as there are threads.
 pub fn projected_work(opts: &StabilityOptions) -> WorkProjection {
-    let per_trajectory = (opts.burn_in_steps + opts.sampled_steps) as f64;
+    // In f64: the projection may be asked of options that were not validated.
+    let per_trajectory = opts.burn_in_steps as f64 + opts.sampled_steps as f64;
     let traj = opts.trajectories as f64;
     let mut work = RunWork::default();
     let mut per_cell_samples: f64 = 0.0;
