@@ -8,7 +8,8 @@
 //! Layers, from the bottom up (each imports only from the layers below it):
 //!
 //! 1. Foundation: [`params`], [`rng`], [`error`] (physical parameters, deterministic
-//!    randomness, errors) and [`output`] (domain-free SVG figures and atomic file writers).
+//!    randomness, errors), [`output`] (domain-free SVG figures and atomic file writers)
+//!    and [`work`] (the caps on a command's projected total work and memory).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
 //!    (2)–(4)).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
@@ -63,6 +64,7 @@ pub mod stats;
 pub mod studies;
 pub mod theory;
 pub mod verify;
+pub mod work;
 
 pub use error::{Error, Result};
 pub use params::FilamentParams;

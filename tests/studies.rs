@@ -9,6 +9,7 @@ use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::fem::noise::NoiseModel;
 use langevin_fem::studies::stability::{StabilityOptions, Status, run_stability};
 use langevin_fem::studies::work_precision::{WorkPrecisionOptions, run_work_precision};
+use langevin_fem::work::WorkLimits;
 
 /// A small map: each integrator's measured per-mode stationary variance agrees with its
 /// exact discrete-time formula (no Holm rejection), and the classification rejects the
@@ -33,6 +34,7 @@ fn stability_map_classifies_and_matches_the_exact_formulas() {
         alpha: 0.01,
         out: dir.path().to_path_buf(),
         progress: false,
+        limits: WorkLimits::default(),
     })
     .expect("study runs");
     assert_eq!(s.formula_rejections, 0, "{:#?}", s.cells);
@@ -91,6 +93,7 @@ fn work_precision_separates_bias_from_sampling() {
         tolerance: 0.005,
         out: dir.path().to_path_buf(),
         progress: false,
+        limits: WorkLimits::default(),
     })
     .expect("study runs");
     assert_eq!(s.points.len(), 4);

@@ -55,6 +55,8 @@ pub struct ConvergeArgs {
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,
+    #[command(flatten)]
+    limits: super::LimitArgs,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -126,6 +128,7 @@ fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
         duration_tau1: args.duration_tau1,
         out: args.out,
         progress: true,
+        limits: args.limits.limits(),
     })
 }
 

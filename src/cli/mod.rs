@@ -6,10 +6,11 @@ mod theory;
 mod verify;
 mod work_precision;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
 use langevin_fem::scene::{Scene, resolve_scenes};
+use langevin_fem::work::WorkLimits;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -107,6 +108,51 @@ fn check_out_dir(out: &Path) -> Result<()> {
             existing.display()
         ))
     })
+}
+
+/// The caps on a command's projected work and memory (`--max-work`,
+/// `--max-memory-gib`), flattened into every command that simulates. The projection is
+/// made from the input alone, before anything runs; above a cap the command exits 2 with
+/// the projected figures and the flags or keys that drive them.
+#[derive(Debug, Args)]
+pub struct LimitArgs {
+    /// Cap on the projected total work, in DOF-steps (time steps of every trajectory
+    /// times the unknowns each updates; about 5e7 per second on 2 cores): the command is
+    /// refused (exit 2) above it, before anything runs. Raise it deliberately to run a
+    /// larger job.
+    #[arg(long, value_name = "DOF_STEPS", default_value = "5e13", allow_negative_numbers = true, value_parser = parse_max_work)]
+    max_work: f64,
+    /// Cap on the samples held in memory at once, in GiB (8 bytes a sample): the command
+    /// is refused (exit 2) above it, before anything is allocated. Raise it deliberately
+    /// on a larger machine.
+    #[arg(long, value_name = "GIB", default_value = "4", allow_negative_numbers = true, value_parser = parse_max_memory_gib)]
+    max_memory_gib: f64,
+}
+
+impl LimitArgs {
+    /// The caps.
+    pub fn limits(&self) -> WorkLimits {
+        WorkLimits {
+            max_work: self.max_work,
+            max_memory_gib: self.max_memory_gib,
+        }
+    }
+}
+
+/// `--max-work`: a number in [1, 1e30] (clap adds the flag to the message).
+fn parse_max_work(text: &str) -> std::result::Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if (1.0..=1e30).contains(&v) => Ok(v),
+        _ => Err("must be a number of DOF-steps in [1, 1e30], such as 1e14".to_string()),
+    }
+}
+
+/// `--max-memory-gib`: a number in (0, 1e6] (clap adds the flag to the message).
+fn parse_max_memory_gib(text: &str) -> std::result::Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 1e6 => Ok(v),
+        _ => Err("must be a number of GiB in (0, 1e6], such as 16".to_string()),
+    }
 }
 
 /// A whole-number flag in `[LO, HI]`, as clap's value parser: any integer text is read

@@ -47,6 +47,8 @@ pub struct StabilityArgs {
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,
+    #[command(flatten)]
+    limits: super::LimitArgs,
 }
 
 /// Runs the study and prints the map on stderr; exit code 0 if every formula comparison
@@ -97,6 +99,7 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         alpha: args.alpha,
         out: args.out.clone(),
         progress: true,
+        limits: args.limits.limits(),
     })?;
     eprintln!(
         "stability map of {} (consistent noise; {} trajectories x {} steps after {} burn-in)",

@@ -26,6 +26,8 @@ pub struct VerifyArgs {
     /// Family-wise significance level per scene (Holm correction).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
+    #[command(flatten)]
+    limits: super::LimitArgs,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -59,6 +61,7 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
         out: args.out.clone(),
         alpha: args.alpha,
         progress: std::io::stderr().is_terminal(),
+        limits: args.limits.limits(),
     })?;
     write_report(report, &summary)?;
     for scene in &summary.scenes {

@@ -50,6 +50,8 @@ pub struct WorkPrecisionArgs {
     /// Directory holding the scene files.
     #[arg(long, default_value = "verification")]
     scene_dir: PathBuf,
+    #[command(flatten)]
+    limits: super::LimitArgs,
 }
 
 fn parse_method(text: &str) -> Result<(IntegratorKind, NoiseModel)> {
@@ -103,6 +105,7 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         tolerance: args.tolerance,
         out: args.out.clone(),
         progress: true,
+        limits: args.limits.limits(),
     })?;
     eprintln!(
         "{} ({} elements): <w2(L/2)> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",

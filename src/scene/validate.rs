@@ -19,11 +19,21 @@
 //! full precision, [`Num`]) and the allowed range (exit code 2). Every count is bounded
 //! here, before anything is allocated or run: trajectories, list lengths
 //! ([`MAX_POINTS`]), durations and steps per trajectory (at most 1e10).
+//!
+//! Their product, the total work of the scene's runs at a budget, is projected here too
+//! ([`Scene::projected_work`], [`Scene::run_work`]) and capped by the command that runs
+//! them ([`crate::work::WorkLimits`]): the cap is a setting of the command
+//! (`--max-work`), not of the scene.
 
-use super::spec::{Budget, CheckKind, CompressionSpec, ModelKind, RunSpec, Sampling, Scene};
+use super::compression::PROBE_STEPS;
+use super::linear::MAX_SAMPLES;
+use super::spec::{
+    Budget, CheckKind, CompressionSpec, Ensemble, ModelKind, RunSpec, Sampling, Scene,
+};
 use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
+use crate::work::{Origin, Part, RunWork};
 use std::fmt::Display;
 
 /// Most trajectories (full or two-time) of a run at one budget.
@@ -689,6 +699,222 @@ impl Scene {
             }
             None => Ok(()),
         }
+    }
+}
+
+/// Steps of a duration at a step (both in τ1), rounded as the runs round them; in `f64`,
+/// so that no projection overflows.
+fn steps_of(duration_tau1: f64, dt_tau1: f64) -> f64 {
+    (duration_tau1 / dt_tau1).round()
+}
+
+impl Scene {
+    /// The unknowns one step of `run` updates, over all components: `components × n`
+    /// (n = 2·elements for the finite elements, the number of modes for the spectral
+    /// model), `components × n²` for the dense exact modal update of the finite elements.
+    pub fn step_cost(&self, run: &RunSpec) -> f64 {
+        let components = self.dims.saturating_sub(1) as f64;
+        let n = match self.model {
+            ModelKind::Spectral => self.mesh.elements as f64,
+            ModelKind::Fem | ModelKind::Compression => 2.0 * self.mesh.elements as f64,
+        };
+        let dense = self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal;
+        components * if dense { n * n } else { n }
+    }
+
+    /// The projected work of run `i` with ensemble `e` (an upper bound, from the scene
+    /// alone: see [`crate::work`]):
+    ///
+    /// - a linear run: `trajectories` × (burn-in, at least to the largest two-time η, +
+    ///   `duration_tau1/dt_tau1`) plus `two_time_trajectories` × the largest η; samples
+    ///   `trajectories × components × (modes + profile points)` series of at most
+    ///   `min(sampled steps, MAX_SAMPLES)` samples, and the two-time products;
+    /// - a compression run, at every strain: `trajectories` × (burn-in + sampled steps)
+    ///   for a fixed budget; for a budget by target precision (`duration_tau1` left out)
+    ///   the probes of the step search (every candidate), the pilot and the main stage at
+    ///   its longest, `max_duration_tau1`; samples those of the main stage at every
+    ///   strain. `sampling_dt_tau1` replaces the run's step while sampling: the second run
+    ///   of the Δt-halving pair inherits half the steps the first chose (at least half the
+    ///   first run's `dt_tau1`).
+    ///
+    /// # Panics
+    /// Never: a run index out of range projects no work.
+    pub fn run_work(&self, i: usize, e: &Ensemble, sampling_dt_tau1: Option<f64>) -> RunWork {
+        let Some(run) = self.runs.get(i) else {
+            return RunWork::default();
+        };
+        let components = self.dims.saturating_sub(1) as f64;
+        let dt = run.dt_tau1;
+        let traj = e.trajectories as f64;
+        let (trajectory_steps, samples) = match &self.compression {
+            None => {
+                let s = &self.sampling;
+                let burn = steps_of(s.burn_in_tau1, dt);
+                let last_eta = s
+                    .two_time
+                    .iter()
+                    .map(|p| steps_of(p[3], dt))
+                    .fold(0.0, f64::max);
+                let sampled = steps_of(e.duration_tau1, dt).max(1.0);
+                let two_time = e.two_time_trajectories as f64;
+                let series = (s.modes + s.profile_points.len()) as f64;
+                let products = s.two_time.len() as f64;
+                (
+                    traj * (burn.max(last_eta) + sampled) + two_time * last_eta,
+                    components
+                        * (traj * (series * sampled.min(MAX_SAMPLES as f64) + products)
+                            + two_time * products),
+                )
+            }
+            Some(c) => {
+                let points = c.strain_ratios.len() as f64;
+                let burn = steps_of(c.burn_in_tau1, dt);
+                // (sampled steps, samples) of a duration at step `h`, as `StepPlan` rounds.
+                let sampled = |d: f64, h: f64| {
+                    let every = steps_of(c.sample_every_tau1, h).max(1.0);
+                    let n = (steps_of(d, h) / every).floor().max(1.0);
+                    (n * every, n)
+                };
+                let h = sampling_dt_tau1.unwrap_or(dt);
+                let per_trajectory = match e.precision_target() {
+                    Some(t) if !e.duration_given() => {
+                        let probes = t.step_search.map_or(0.0, |search| {
+                            let doublings = (search.max_dt_tau1 / dt).log2().floor().max(0.0);
+                            (0..=doublings.min(64.0) as i32)
+                                .map(|k| {
+                                    let hk = dt * 2f64.powi(k);
+                                    let every = steps_of(c.sample_every_tau1, hk).max(1.0);
+                                    burn + (PROBE_STEPS as f64 / every).ceil() * every
+                                })
+                                .sum()
+                        });
+                        let (pilot, _) = sampled(t.pilot_tau1, h);
+                        let (main, n) = sampled(t.max_duration_tau1, h);
+                        (probes + 2.0 * burn + pilot + main, n)
+                    }
+                    _ => {
+                        let (steps, n) = sampled(e.duration_tau1, h);
+                        (burn + steps, n)
+                    }
+                };
+                (
+                    points * traj * per_trajectory.0,
+                    points * traj * per_trajectory.1,
+                )
+            }
+        };
+        RunWork {
+            trajectory_steps,
+            dof_steps: trajectory_steps * self.step_cost(run),
+            samples,
+        }
+    }
+
+    /// The sampling step of run `i` at `budget` if it is the second run of the
+    /// Δt-halving pair and the first searches its steps: half the first run's `dt_tau1`
+    /// at the least (see [`Self::run_work`]).
+    fn inherited_dt(&self, i: usize, budget: Budget) -> Option<f64> {
+        let [first, second] = self.compression.as_ref()?.halving.as_ref()?;
+        if &self.runs.get(i)?.name != second {
+            return None;
+        }
+        let first = self.runs.iter().find(|r| &r.name == first)?;
+        first
+            .ensemble(budget)
+            .max_dt_tau1
+            .map(|_| 0.5 * first.dt_tau1)
+    }
+
+    /// The projected work of every run of the scene at `budget`, one [`Part`] per run
+    /// (the runs run one after the other), each naming the keys that drive it.
+    pub fn projected_work(&self, budget: Budget) -> Vec<Part> {
+        let b = budget.name();
+        self.runs
+            .iter()
+            .enumerate()
+            .map(|(i, run)| {
+                let e = run.ensemble(budget);
+                let inherited = self.inherited_dt(i, budget);
+                let k = |key: &str| format!("runs[{i}].{b}.{key}");
+                let mut keys = Vec::new();
+                if let Some(c) = &self.compression {
+                    keys.push(format!(
+                        "compression.strain_ratios ({} strains)",
+                        c.strain_ratios.len()
+                    ));
+                }
+                keys.push(format!("{} = {}", k("trajectories"), e.trajectories));
+                match e.precision_target() {
+                    Some(t) if !e.duration_given() => {
+                        keys.push(format!("{} = {}", k("pilot_tau1"), Num(t.pilot_tau1)));
+                        keys.push(format!(
+                            "{} = {}",
+                            k("max_duration_tau1"),
+                            Num(t.max_duration_tau1)
+                        ));
+                        if let Some(s) = t.step_search {
+                            keys.push(format!("{} = {}", k("max_dt_tau1"), Num(s.max_dt_tau1)));
+                        }
+                    }
+                    _ => keys.push(format!("{} = {}", k("duration_tau1"), Num(e.duration_tau1))),
+                }
+                if e.two_time_trajectories > 0 && !self.sampling.two_time.is_empty() {
+                    keys.push(format!(
+                        "{} = {}",
+                        k("two_time_trajectories"),
+                        e.two_time_trajectories
+                    ));
+                }
+                keys.push(format!("runs[{i}].dt_tau1 = {}", Num(run.dt_tau1)));
+                if let Some(h) = inherited {
+                    keys.push(format!(
+                        "sampling at dt_tau1 >= {} (half the steps of the first run of compression.halving)",
+                        Num(h)
+                    ));
+                }
+                match &self.compression {
+                    Some(c) => {
+                        keys.push(format!(
+                            "compression.burn_in_tau1 = {}",
+                            Num(c.burn_in_tau1)
+                        ));
+                        keys.push(format!(
+                            "compression.sample_every_tau1 = {}",
+                            Num(c.sample_every_tau1)
+                        ));
+                    }
+                    None => {
+                        let s = &self.sampling;
+                        keys.push(format!("sampling.burn_in_tau1 = {}", Num(s.burn_in_tau1)));
+                        keys.push(format!(
+                            "sampling.modes = {} and {} profile points",
+                            s.modes,
+                            s.profile_points.len()
+                        ));
+                    }
+                }
+                keys.push(format!(
+                    "mesh.elements = {}, dims = {}{}",
+                    self.mesh.elements,
+                    self.dims,
+                    if self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal
+                    {
+                        " (exact-modal: n^2 per step)"
+                    } else {
+                        ""
+                    }
+                ));
+                Part {
+                    label: format!("{} runs[{i}] ({}) at budget {b}", self.name, run.name),
+                    drivers: keys.join(", "),
+                    origin: Origin::Scene {
+                        file: self.path.clone(),
+                        key: format!("runs[{i}].{b}"),
+                    },
+                    work: self.run_work(i, &e, inherited),
+                }
+            })
+            .collect()
     }
 }
 

@@ -45,8 +45,10 @@ use crate::fem::noise::{NoiseGenerator, NoiseModel};
 use crate::output::{Figure, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
+use crate::scene::validate::Num;
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
 use crate::stats;
+use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::path::PathBuf;
@@ -559,6 +561,80 @@ pub struct ConvergeOptions {
     pub out: PathBuf,
     /// Progress lines on stderr.
     pub progress: bool,
+    /// The caps on the study's projected work and memory ([`projected_work`]), checked
+    /// before any simulation.
+    pub limits: WorkLimits,
+}
+
+/// The projected work of a study of run `run` of `scene` with `ensemble` at `values`
+/// (and, for a compression scene, at `strains`): one part per value, each the work of
+/// the scene rebuilt for it ([`Scene::run_work`]); the values run one after the other.
+pub fn projected_work(
+    scene: &Scene,
+    run: usize,
+    opts: &ConvergeOptions,
+    ensemble: Ensemble,
+    values: &[f64],
+    strains: Option<&[f64]>,
+) -> WorkProjection {
+    let b = opts.budget.name();
+    // A flag as given, or the scene's key it defaults to.
+    let source = |flag: &str, given: bool, key: &str, v: String| {
+        if given {
+            format!("{flag} {v}")
+        } else {
+            format!("{flag} not given: runs[{run}].{b}.{key} = {v}")
+        }
+    };
+    let mut drivers = vec![
+        format!("--values ({} values)", values.len()),
+        source(
+            "--trajectories",
+            opts.trajectories.is_some(),
+            "trajectories",
+            ensemble.trajectories.to_string(),
+        ),
+        source(
+            "--duration-tau1",
+            opts.duration_tau1.is_some(),
+            "duration_tau1",
+            Num(ensemble.duration_tau1).to_string(),
+        ),
+    ];
+    let mut flags = "--values, --trajectories, --duration-tau1".to_string();
+    if let Some(st) = strains {
+        drivers.push(format!("--strain-ratios ({} strains)", st.len()));
+        flags.push_str(", --strain-ratios");
+    }
+    let parts = values
+        .iter()
+        .map(|&v| {
+            let s = match strains {
+                Some(st) => compression::rebuild(scene, run, opts.over, v, st),
+                None => rebuild(scene, run, opts.over, v),
+            };
+            let name = s.runs.get(run).map_or("?", |r| r.name.as_str());
+            Part {
+                label: format!("{} {name} at {}={}", s.name, opts.over.name(), Num(v)),
+                drivers: format!(
+                    "{} ({} elements, dt_tau1 = {})",
+                    drivers.join(", "),
+                    s.mesh.elements,
+                    Num(s.runs.get(run).map_or(f64::NAN, |r| r.dt_tau1))
+                ),
+                origin: Origin::Flags(flags.clone()),
+                work: s.run_work(run, &ensemble, None),
+            }
+        })
+        .collect();
+    WorkProjection {
+        command: format!(
+            "converge --scene {} --over {}",
+            scene.name,
+            opts.over.name()
+        ),
+        parts,
+    }
 }
 
 /// Allowed `--trajectories` of a study.
@@ -957,6 +1033,8 @@ fn linear_study(
     let spec = &scene.runs[run];
     let over = opts.over;
     let values = linear_values(scene, run, opts)?;
+    opts.limits
+        .check(&projected_work(scene, run, opts, ensemble, &values, None))?;
     let names = observable_names();
     let limit_dt = match over {
         Over::Dt => Some(semi_discrete_limit(scene, spec)?),

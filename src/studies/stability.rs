@@ -47,6 +47,7 @@ use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
 use crate::stats;
 use crate::studies::converge::nan_if_null;
+use crate::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -91,6 +92,62 @@ pub struct StabilityOptions {
     pub out: PathBuf,
     /// Print one line per cell on stderr.
     pub progress: bool,
+    /// The caps on the map's projected work and memory ([`projected_work`]), checked
+    /// before any simulation.
+    pub limits: WorkLimits,
+}
+
+/// The projected work of the map (an upper bound, see [`crate::work`]): every cell runs
+/// `trajectories × (burn_in_steps + sampled_steps)` steps of `2·elements` unknowns
+/// (`(2·elements)²` for exact-modal; a refused cell runs one forced trajectory instead)
+/// and holds the series of at most [`MAX_CHECKED_MODES`] modes at every sampled step;
+/// the cells run in parallel, as many at once as there are threads.
+pub fn projected_work(opts: &StabilityOptions) -> WorkProjection {
+    // In f64: the projection may be asked of options that were not validated.
+    let per_trajectory = opts.burn_in_steps as f64 + opts.sampled_steps as f64;
+    let traj = opts.trajectories as f64;
+    let mut work = RunWork::default();
+    let mut per_cell_samples: f64 = 0.0;
+    for &k in &opts.integrators {
+        for &e in &opts.elements {
+            let n = 2.0 * e as f64;
+            let cost = if k == IntegratorKind::ExactModal {
+                n * n
+            } else {
+                n
+            };
+            let cells = opts.dt_lambda_max.len() as f64;
+            work.trajectory_steps += cells * traj * per_trajectory;
+            work.dof_steps += cells * traj * per_trajectory * cost;
+            let rows = (MAX_CHECKED_MODES as f64).min(n);
+            per_cell_samples = per_cell_samples.max(traj * rows * opts.sampled_steps as f64);
+        }
+    }
+    let cells = opts.integrators.len() * opts.elements.len() * opts.dt_lambda_max.len();
+    let at_once = rayon::current_num_threads().clamp(1, cells.max(1)) as f64;
+    work.samples = per_cell_samples * at_once;
+    let largest = opts.elements.iter().max().copied().unwrap_or(0);
+    WorkProjection {
+        command: format!("stability --scene {}", opts.scene.name),
+        parts: vec![Part {
+            label: format!(
+                "the map of {cells} cells ({} integrators x {} element counts x {} steps dt*lambda_max, up to {largest} elements; {} cells at once)",
+                opts.integrators.len(),
+                opts.elements.len(),
+                opts.dt_lambda_max.len(),
+                at_once
+            ),
+            drivers: format!(
+                "--integrators, --elements, --dt-lambda-max ({cells} cells) x --trajectories {} x (--burn-in {} + --steps {})",
+                opts.trajectories, opts.burn_in_steps, opts.sampled_steps
+            ),
+            origin: Origin::Flags(
+                "--integrators, --elements, --dt-lambda-max, --trajectories, --burn-in, --steps"
+                    .to_string(),
+            ),
+            work,
+        }],
+    }
 }
 
 /// The classification of a cell.
@@ -638,10 +695,12 @@ fn classify(cell: &mut Cell, biased: bool) {
 /// ([`super::output`]); a rerun removes the maps of integrators it left out.
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag); numerical or I/O failures.
+/// Bad options (exit 2, naming the flag), a projected work or memory above
+/// `opts.limits`; numerical or I/O failures.
 pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let start = Instant::now();
     validate(opts)?;
+    opts.limits.check(&projected_work(opts))?;
     let mut cells = run_cells(opts)?;
     classify_cells(&mut cells, opts.alpha);
     let (formula_tests, formula_rejections) = judge_formulas(&mut cells, opts.alpha);

@@ -30,8 +30,10 @@ use crate::fem::noise::NoiseModel;
 use crate::output::{Figure, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::LinearRun;
+use crate::scene::validate::Num;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
+use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -76,6 +78,50 @@ pub struct WorkPrecisionOptions {
     pub out: PathBuf,
     /// Print one line per point on stderr.
     pub progress: bool,
+    /// The caps on the study's projected work and memory ([`projected_work`]), checked
+    /// before any simulation.
+    pub limits: WorkLimits,
+}
+
+/// The projected work of the study: one part per method and time step (the points run
+/// one after the other), each the work of its one-run scene ([`Scene::run_work`]).
+///
+/// # Errors
+/// As the stability limit of euler-maruyama ([`BeamModel::explicit_euler_dt_limit`]).
+///
+/// [`BeamModel::explicit_euler_dt_limit`]: crate::fem::beam::BeamModel::explicit_euler_dt_limit
+pub fn projected_work(opts: &WorkPrecisionOptions) -> Result<WorkProjection> {
+    let mut parts = Vec::new();
+    for &method in &opts.methods {
+        let em = method.0 == IntegratorKind::EulerMaruyama;
+        let flags = if em {
+            "--methods, --em-fractions, --trajectories, --em-duration"
+        } else {
+            "--methods, --dt-tau1, --trajectories, --duration"
+        };
+        for dt in method_dts(opts, method)? {
+            let s = point_scene(opts, method, dt);
+            let e = s.runs[0].quick;
+            parts.push(Part {
+                label: format!("{} at dt/tau1 = {}", label(method), Num(dt)),
+                drivers: format!(
+                    "{} (--trajectories {} x {} = {} tau1 at dt/tau1 = {}, {} elements)",
+                    flags,
+                    opts.trajectories,
+                    if em { "--em-duration" } else { "--duration" },
+                    Num(e.duration_tau1),
+                    Num(dt),
+                    s.mesh.elements
+                ),
+                origin: Origin::Flags(flags.to_string()),
+                work: s.run_work(0, &e, None),
+            });
+        }
+    }
+    Ok(WorkProjection {
+        command: format!("work-precision --scene {}", opts.scene.name),
+        parts,
+    })
 }
 
 /// One method at one time step.
@@ -313,10 +359,12 @@ type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 /// `work-precision.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag); run failures.
+/// Bad options (exit 2, naming the flag), a projected work or memory above
+/// `opts.limits`; run failures.
 pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
     let start = Instant::now();
     validate(opts)?;
+    opts.limits.check(&projected_work(opts)?)?;
     // Prepare every point first, so that bad input fails before any simulation.
     let prepared = prepare_points(opts)?;
     let points = prepared
@@ -365,22 +413,29 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
 fn prepare_points(opts: &WorkPrecisionOptions) -> Result<Vec<PreparedPoint>> {
     let mut prepared = Vec::new();
     for &method in &opts.methods {
-        let dts: Vec<f64> = if method.0 == IntegratorKind::EulerMaruyama {
-            let s = point_scene(opts, method, 1.0);
-            let beam =
-                crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
-            let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
-            opts.em_fractions.iter().map(|f| f * limit).collect()
-        } else {
-            opts.dt_tau1.clone()
-        };
-        for dt in dts {
+        for dt in method_dts(opts, method)? {
             let s = point_scene(opts, method, dt);
             let lr = LinearRun::prepare(&s, &s.runs[0])?;
             prepared.push((method, dt, s, lr));
         }
     }
     Ok(prepared)
+}
+
+/// The time steps Δt/τ1 of `method`: the options' `dt_tau1`, or for euler-maruyama the
+/// fractions of its stability limit.
+fn method_dts(
+    opts: &WorkPrecisionOptions,
+    method: (IntegratorKind, NoiseModel),
+) -> Result<Vec<f64>> {
+    Ok(if method.0 == IntegratorKind::EulerMaruyama {
+        let s = point_scene(opts, method, 1.0);
+        let beam = crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
+        let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
+        opts.em_fractions.iter().map(|f| f * limit).collect()
+    } else {
+        opts.dt_tau1.clone()
+    })
 }
 
 /// Simulates one point's ensemble, timing it, and measures its errors and projected

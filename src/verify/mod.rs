@@ -15,5 +15,5 @@ pub mod compression;
 pub mod runner;
 pub mod summary;
 
-pub use runner::{VerifyOptions, run_verification};
+pub use runner::{VerifyOptions, projected_work, run_verification};
 pub use summary::{CheckResult, SceneSummary, Summary};

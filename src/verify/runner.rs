@@ -45,6 +45,7 @@ use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
 use crate::verify::summary::{CheckResult, SceneSummary, Summary};
+use crate::work::{WorkLimits, WorkProjection};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -62,6 +63,21 @@ pub struct VerifyOptions {
     pub alpha: f64,
     /// Show a progress bar (only drawn on a terminal).
     pub progress: bool,
+    /// The caps on the projected work and memory of all the scenes
+    /// ([`projected_work`]), checked before anything runs.
+    pub limits: WorkLimits,
+}
+
+/// The projected work of verifying `scenes` at `budget`: every run of every scene, one
+/// after the other ([`Scene::projected_work`]).
+pub fn projected_work(scenes: &[Scene], budget: Budget) -> WorkProjection {
+    WorkProjection {
+        command: format!("verify --budget {}", budget.name()),
+        parts: scenes
+            .iter()
+            .flat_map(|s| s.projected_work(budget))
+            .collect(),
+    }
 }
 
 /// Element counts of the element-uniform noise study (theory only).
@@ -80,16 +96,19 @@ pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
 /// invalidated only once the input has passed every check.
 ///
 /// # Errors
-/// Input (exit 2): bad scene files, a time step above a stability limit, a budget that
-/// gives a check fewer samples than its estimator needs ([`Error::Scene`]). Run failures
-/// (exit 3): diverging runs ([`Error::Diverged`]), estimator or set-up failures
-/// ([`Error::RunFailed`]), I/O failures.
+/// Input (exit 2): bad scene files, a projected work or memory above `opts.limits`, a
+/// time step above a stability limit, a budget that gives a check fewer samples than its
+/// estimator needs ([`Error::Scene`]). Run failures (exit 3): diverging runs
+/// ([`Error::Diverged`]), estimator or set-up failures ([`Error::RunFailed`]), I/O
+/// failures.
 pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes: Vec<Scene> = opts
         .scenes
         .iter()
         .map(|p| Scene::load(p))
         .collect::<Result<_>>()?;
+    // The total work and memory, from the scene files alone, before anything is prepared.
+    opts.limits.check(&projected_work(&scenes, opts.budget))?;
     // Prepare every run first so that bad input is reported before any long work.
     let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
     for (scene, work) in scenes.iter().zip(&prepared) {

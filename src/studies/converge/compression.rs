@@ -361,6 +361,8 @@ pub(super) fn study(
     let over = opts.over;
     let spec = &scene.runs[run];
     let (strains, values) = strains_and_values(scene, run, opts)?;
+    let work = super::projected_work(scene, run, opts, ensemble, &values, Some(&strains));
+    opts.limits.check(&work)?;
     // Everything that can be refused is checked before any simulation.
     let prepared = values
         .iter()
