@@ -17,13 +17,14 @@
 
 mod common;
 
-use common::{TempDir, all_files, command, describe, fixture, run, stderr_of, write_scene};
+use common::{
+    TempDir, all_files, command, describe, fixture, json, run, stderr_of, strings, write_scene,
+};
 use langevin_fem::Error;
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::scene::Scene;
 use langevin_fem::scene::linear::LinearRun;
 use langevin_fem::verify::checks::linear_checks;
-use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -41,18 +42,6 @@ fn tiny_with_duration(duration: &str) -> String {
         quick,
         &format!("quick = {{ trajectories = 4, duration_tau1 = {duration}"),
     )
-}
-
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).expect("readable")).expect("JSON")
-}
-
-fn strings(v: &Value) -> Vec<String> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|s| s.as_str().expect("string").to_string())
-        .collect()
 }
 
 /// The run id shown in `index.html`.

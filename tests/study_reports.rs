@@ -22,7 +22,7 @@
 
 mod common;
 
-use common::{TempDir, command, describe, run};
+use common::{TempDir, all_files, command, describe, json, run, strings};
 use serde_json::Value;
 use std::path::Path;
 use std::process::Stdio;
@@ -108,38 +108,6 @@ fn run_ok(args: &[String]) -> Duration {
     let o = run(&args);
     assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
     start.elapsed()
-}
-
-/// Every regular file under `dir`, relative with `/` separators, sorted.
-fn all_files(dir: &Path) -> Vec<String> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
-        for entry in std::fs::read_dir(dir).expect("read dir") {
-            let p = entry.expect("entry").path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).expect("under root");
-                out.push(rel.to_string_lossy().replace('\\', "/"));
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(dir, dir, &mut out);
-    out.sort();
-    out
-}
-
-fn json(path: &Path) -> Value {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-fn strings(v: &Value) -> Vec<String> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|s| s.as_str().expect("string").to_string())
-        .collect()
 }
 
 /// A study journal of the folder.
