@@ -10,7 +10,7 @@
 //! bit-identical to the same trajectory stepped alone, whatever lane it occupies and
 //! whatever the other lanes hold (tests below).
 
-use super::integrator::{THETA_SUGGESTION, check_dt, check_stability};
+use super::integrator::{THETA_SUGGESTION, ThetaOperators, check_dt, check_stability};
 use super::{Family, IntegratorKind};
 use crate::error::Result;
 use crate::fem::banded::{BandedCholesky, LANES, Lanes, SymBanded};
@@ -67,9 +67,12 @@ impl ThetaBatch {
     /// # Errors
     /// As [`ThetaScheme::new`](super::ThetaScheme::new).
     pub fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Option<Self>> {
-        let (k, c) = (beam.stiffness(), beam.damping());
-        let lhs = SymBanded::linear_combination(1.0, c, theta * dt, k)?.cholesky()?;
-        let rhs = SymBanded::linear_combination(1.0, c, -(1.0 - theta) * dt, k)?;
+        let ThetaOperators {
+            lhs,
+            rhs,
+            scale,
+            noise,
+        } = ThetaOperators::new(beam, noise, theta, dt)?;
         if !lhs.lanes_supported(&rhs) {
             return Ok(None);
         }
@@ -77,8 +80,8 @@ impl ThetaBatch {
         Ok(Some(ThetaBatch {
             lhs,
             rhs,
-            scale: (2.0 * beam.params().kt * dt).sqrt(),
-            noise: NoiseGenerator::new(noise, beam)?,
+            scale,
+            noise,
             g: vec![[0.0; LANES]; n],
             y: vec![[0.0; LANES]; n],
             z: vec![[0.0; LANES]; n],

@@ -92,6 +92,12 @@ impl Driver {
         self.burn_in + self.sampled
     }
 
+    /// `Some(steps since the burn-in)` if step `step` (1-based) is a sampling step.
+    fn sample_at(&self, step: u64) -> Option<u64> {
+        (step > self.burn_in && (step - self.burn_in).is_multiple_of(self.every))
+            .then(|| step - self.burn_in)
+    }
+
     /// Runs trajectory `trajectory` of `system` with random stream `rng` through the
     /// schedule, calling `observer` ([`Observer`]).
     ///
@@ -117,8 +123,8 @@ impl Driver {
                 return Err(Error::diverged(step, self.dt, detail(system)));
             }
             observer.on_step(trajectory, step, system);
-            if step > self.burn_in && (step - self.burn_in).is_multiple_of(self.every) {
-                observer.on_sample(trajectory, step - self.burn_in, system);
+            if let Some(since) = self.sample_at(step) {
+                observer.on_sample(trajectory, since, system);
             }
         }
         observer.on_finish(trajectory, system);
@@ -169,8 +175,7 @@ impl Driver {
                 break;
             }
             batch.step(rngs);
-            let sample = (step > self.burn_in && (step - self.burn_in).is_multiple_of(self.every))
-                .then(|| step - self.burn_in);
+            let sample = self.sample_at(step);
             for (lane, o) in observers.iter_mut().enumerate() {
                 if !alive[lane] {
                     continue;

@@ -91,17 +91,46 @@ impl ThetaScheme {
     /// # Errors
     /// A factorization failure (non-positive-definite left-hand side).
     pub fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Self> {
-        let (k, c) = (beam.stiffness(), beam.damping());
-        let lhs = SymBanded::linear_combination(1.0, c, theta * dt, k)?.cholesky()?;
-        let rhs = SymBanded::linear_combination(1.0, c, -(1.0 - theta) * dt, k)?;
+        let ThetaOperators {
+            lhs,
+            rhs,
+            scale,
+            noise,
+        } = ThetaOperators::new(beam, noise, theta, dt)?;
         let n = beam.n_dofs();
         Ok(ThetaScheme {
             lhs,
             rhs,
-            scale: (2.0 * beam.params().kt * dt).sqrt(),
-            noise: NoiseGenerator::new(noise, beam)?,
+            scale,
+            noise,
             buf: vec![0.0; n],
             scratch: vec![0.0; n],
+        })
+    }
+}
+
+/// What a θ-step is made of, for one trajectory ([`ThetaScheme`]) or a batch
+/// ([`ThetaBatch`](super::ThetaBatch)): the factor of `C + θΔtK`, the matrix
+/// `C − (1−θ)ΔtK`, the noise scale `sqrt(2kTΔt)` and the noise generator.
+pub(super) struct ThetaOperators {
+    pub(super) lhs: BandedCholesky,
+    pub(super) rhs: SymBanded,
+    pub(super) scale: f64,
+    pub(super) noise: NoiseGenerator,
+}
+
+impl ThetaOperators {
+    /// The operators for `beam`, noise `noise`, parameter `theta` and step `dt`.
+    ///
+    /// # Errors
+    /// A factorization failure (non-positive-definite left-hand side).
+    pub(super) fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Self> {
+        let (k, c) = (beam.stiffness(), beam.damping());
+        Ok(ThetaOperators {
+            lhs: SymBanded::linear_combination(1.0, c, theta * dt, k)?.cholesky()?,
+            rhs: SymBanded::linear_combination(1.0, c, -(1.0 - theta) * dt, k)?,
+            scale: (2.0 * beam.params().kt * dt).sqrt(),
+            noise: NoiseGenerator::new(noise, beam)?,
         })
     }
 }
