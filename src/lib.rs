@@ -51,6 +51,7 @@
 //! discrete covariances) are documented where they are computed:
 //! [`dynamics::IntegratorKind::modal_form`], [`fem::modal`].
 
+pub mod data;
 pub mod dynamics;
 pub mod error;
 pub mod fem;

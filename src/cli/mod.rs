@@ -1,6 +1,8 @@
 //! Argument parsing (clap) and dispatch.
 
+mod check;
 mod converge;
+mod run;
 mod stability;
 mod theory;
 mod verify;
@@ -38,6 +40,12 @@ enum Command {
     /// Work-precision study: error in <w2(L/2)> against wall time for every integrator
     /// and noise model, and the projected cost of reaching a tolerance.
     WorkPrecision(work_precision::WorkPrecisionArgs),
+    /// Simulate a scene's ensemble and write every trajectory's time series (NumPy .npy
+    /// or CSV, with a data.json sidecar) for your own analysis or `check`.
+    Run(run::RunArgs),
+    /// Apply a scene's statistical checks to trajectories written by any simulator in
+    /// the trajectory data format (the format `run` writes).
+    Check(check::CheckArgs),
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
@@ -60,6 +68,14 @@ pub fn run() -> Result<i32> {
         Command::WorkPrecision(args) => {
             check_out_dir(&args.out)?;
             work_precision::run(args)
+        }
+        Command::Run(args) => {
+            check_out_dir(&args.out)?;
+            run::run(args)
+        }
+        Command::Check(args) => {
+            check_out_dir(&args.out)?;
+            check::run(args)
         }
     }
 }

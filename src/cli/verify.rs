@@ -30,11 +30,23 @@ pub struct VerifyArgs {
     limits: super::LimitArgs,
 }
 
+/// A statistics budget on the command line.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
-enum BudgetArg {
+pub(super) enum BudgetArg {
     Quick,
     Standard,
     Full,
+}
+
+impl BudgetArg {
+    /// The budget.
+    pub(super) fn budget(self) -> Budget {
+        match self {
+            BudgetArg::Quick => Budget::Quick,
+            BudgetArg::Standard => Budget::Standard,
+            BudgetArg::Full => Budget::Full,
+        }
+    }
 }
 
 /// Runs the verification; exit code 0 if every check passes, 1 otherwise.
@@ -42,11 +54,7 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
-    let budget = match args.budget {
-        BudgetArg::Quick => Budget::Quick,
-        BudgetArg::Standard => Budget::Standard,
-        BudgetArg::Full => Budget::Full,
-    };
+    let budget = args.budget.budget();
     let scenes = resolve_scenes(&args.scenes, &args.scene_dir)?;
     if scenes.is_empty() {
         return Err(Error::invalid(

@@ -52,6 +52,100 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// A file written by streaming and made visible atomically: the bytes go to a temporary
+/// file in the destination directory (named as [`write_atomic`] names its own, so
+/// [`remove_stale_temporaries`] removes it after an interruption), and
+/// [`AtomicFile::commit`] syncs it and renames it over the destination. Dropped without
+/// a commit, the temporary file is removed.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    temp: PathBuf,
+    file: Option<io::BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file of `path` (and missing parent directories).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming `path` if the directory or the file cannot be created.
+    pub fn create(path: &Path) -> Result<AtomicFile> {
+        let file_name = path.file_name().ok_or_else(|| {
+            Error::io(
+                path,
+                io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
+            )
+        })?;
+        let dir = match path.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let mut temp_name = std::ffi::OsString::from(".");
+        temp_name.push(file_name);
+        temp_name.push(format!(".tmp.{}.{n}", std::process::id()));
+        let temp = dir.join(temp_name);
+        let file = OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&temp)
+            .map_err(|e| Error::io(path, e))?;
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            temp,
+            file: Some(io::BufWriter::with_capacity(1 << 16, file)),
+        })
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes, syncs and renames the file over its destination.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the destination.
+    pub fn commit(mut self) -> Result<()> {
+        let file = self.file.take().expect("an AtomicFile commits once");
+        let result = file
+            .into_inner()
+            .map_err(io::IntoInnerError::into_error)
+            .and_then(|f| f.sync_all())
+            .and_then(|()| fs::rename(&self.temp, &self.path));
+        if let Err(e) = result {
+            let _ = fs::remove_file(&self.temp);
+            return Err(Error::io(&self.path, e));
+        }
+        if let Some(dir) = self.path.parent() {
+            sync_dir(if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            });
+        }
+        Ok(())
+    }
+}
+
+impl io::Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.file.as_mut().map_or(Ok(0), |f| f.write(buf))
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.as_mut().map_or(Ok(()), io::Write::flush)
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.file.take().is_some() {
+            let _ = fs::remove_file(&self.temp);
+        }
+    }
+}
+
 /// Removes the temporary files that interrupted runs left in `dir` and its
 /// subdirectories (two levels down): files named like those of [`write_atomic`],
 /// `.<name>.tmp.<pid>.<n>`, whose process is gone (on Linux: no `/proc/<pid>`; elsewhere:
@@ -185,7 +279,7 @@ pub(crate) fn csv_text(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Resul
     Ok(out)
 }
 
-fn push_csv_field(out: &mut String, field: &str) {
+pub(crate) fn push_csv_field(out: &mut String, field: &str) {
     if field.contains([',', '"', '\n', '\r']) {
         out.push('"');
         out.push_str(&field.replace('"', "\"\""));
@@ -196,7 +290,7 @@ fn push_csv_field(out: &mut String, field: &str) {
 }
 
 /// Appends `v` with round-trip precision (see [`write_csv`]).
-fn push_csv_number(out: &mut String, v: f64) {
+pub(crate) fn push_csv_number(out: &mut String, v: f64) {
     if v.is_nan() {
         out.push_str("nan");
     } else if v.is_infinite() {

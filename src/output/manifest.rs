@@ -113,7 +113,7 @@ pub fn read_manifest(path: &Path) -> Option<Manifest> {
 
 /// `rel` if it is a plain relative path below the directory (no root, no `..`, no `.`,
 /// not empty); `None` otherwise. Journal entries that fail this are never touched.
-fn safe_relative(rel: &str) -> Option<&Path> {
+pub fn safe_relative(rel: &str) -> Option<&Path> {
     let p = Path::new(rel);
     let plain = !rel.is_empty() && p.components().all(|c| matches!(c, Component::Normal(_)));
     plain.then_some(p)
@@ -306,8 +306,13 @@ impl ReportRun {
     }
 
     /// Lists `path` (below the directory) in the journal, on disk first if the journal
-    /// does not yet name it.
-    fn record(&self, path: &Path) -> Result<()> {
+    /// does not yet name it: called before a file the caller streams itself (e.g. with
+    /// [`crate::output::AtomicFile`]) is created.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming `path` if it is not below the directory, or the journal if
+    /// that cannot be updated.
+    pub fn record(&self, path: &Path) -> Result<()> {
         let rel = path
             .strip_prefix(&self.dir)
             .ok()

@@ -20,5 +20,5 @@ pub mod io;
 pub mod manifest;
 
 pub use figure::{Figure, Series, SeriesStyle};
-pub use io::{remove_stale_temporaries, write_atomic, write_csv, write_json};
+pub use io::{AtomicFile, remove_stale_temporaries, write_atomic, write_csv, write_json};
 pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};

@@ -29,6 +29,10 @@ use crate::stats;
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
+mod stream;
+
+pub use stream::RowPlan;
+
 /// Exact references for one mode of one run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeReference {
@@ -439,6 +443,12 @@ pub struct LinearRun {
     pub profile_every: u64,
     /// Burn-in steps.
     pub burn_in_steps: u64,
+    /// Per checked mode, the factor that turns the model's modal amplitude into the
+    /// sine-basis amplitude aₙ of w(x) = Σ aₙ sin(nπx/L) (the trajectory data format,
+    /// [`crate::data`]): ±√(2/(ξL)) for the finite-element modes (normalized by the
+    /// damping matrix, signed so that the mode is positive at x = L/(2n)), 1 for the
+    /// spectral model.
+    pub amplitude_scale: Vec<f64>,
     model: Model,
 }
 
@@ -454,11 +464,14 @@ enum Model {
         beam: HingedBeam,
         n_modes: usize,
     },
+    /// No model: the references of another program's data ([`LinearRun::for_data`]).
+    Data,
 }
 
 /// What the preparation of a model yields besides the sampling plan.
 struct Prepared {
     model: Model,
+    amplitude_scale: Vec<f64>,
     modes: Vec<ModeReference>,
     profile_discrete: Vec<f64>,
     two_time: Vec<TwoTimeReference>,
@@ -526,6 +539,7 @@ impl Setup<'_> {
             });
         }
         Ok(Prepared {
+            amplitude_scale: vec![1.0; self.scene.sampling.modes],
             model: Model::Spectral {
                 beam: *continuum,
                 n_modes,
@@ -595,7 +609,15 @@ impl Setup<'_> {
         let two_time = self.fem_two_time(&m, &g, &sigma_q, &probe)?;
         let projector = gm.projector(&beam, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
+        let scale = (2.0 / (p.drag * p.length)).sqrt();
+        let amplitude_scale = (1..=self.scene.sampling.modes)
+            .map(|n| {
+                let at = probe(p.length / (2.0 * n as f64))[n - 1];
+                if at < 0.0 { -scale } else { scale }
+            })
+            .collect();
         Ok(Prepared {
+            amplitude_scale,
             model: Model::Fem {
                 beam: Box::new(beam),
                 modes: keep_modes.then_some(gm),
@@ -727,6 +749,7 @@ impl LinearRun {
             mode_every,
             profile_every,
             burn_in_steps,
+            amplitude_scale: prepared.amplitude_scale,
             model: prepared.model,
         })
     }
@@ -767,7 +790,7 @@ impl LinearRun {
     fn n_nodes(&self) -> usize {
         match &self.model {
             Model::Fem { beam, .. } => beam.mesh().n_nodes(),
-            Model::Spectral { .. } => 0,
+            Model::Spectral { .. } | Model::Data => 0,
         }
     }
 
@@ -820,6 +843,13 @@ impl LinearRun {
                     sims,
                     n_modes: self.reference.modes.len(),
                 })
+            }
+            Model::Data => {
+                return Err(Error::invalid(
+                    format!("run {}", self.spec.name),
+                    "data",
+                    "a run with a model to simulate (this one checks another program's data)",
+                ));
             }
         })
     }
@@ -882,38 +912,69 @@ impl LinearRun {
         sampled_steps: u64,
         done: impl Fn(u64) + Sync,
     ) -> Result<Vec<TrajectoryRecord>> {
+        let recorders = self.observe_ensemble(
+            seed,
+            first,
+            count,
+            sampled_steps,
+            |_| Recorder::new(self, sampled_steps),
+            done,
+        )?;
+        Ok(recorders.into_iter().map(|r| r.rec).collect())
+    }
+
+    /// The trajectories `first..first + count` of the ensemble seeded `seed`, each
+    /// observed by its own observer `make(j)` over the schedule of [`Self::simulate`], in
+    /// parallel (the finite-element θ-schemes [`LANES`] at a time in lockstep); returns
+    /// the observers in index order.
+    ///
+    /// # Errors
+    /// The error of the smallest failing trajectory index.
+    fn observe_ensemble<O>(
+        &self,
+        seed: u64,
+        first: u64,
+        count: u64,
+        sampled_steps: u64,
+        make: impl Fn(u64) -> O + Sync,
+        done: impl Fn(u64) + Sync,
+    ) -> Result<Vec<O>>
+    where
+        O: Send
+            + for<'a, 'b> Observer<LaneOf<'a, FemBatch<'b>>>
+            + for<'s> Observer<dyn Sampler + 's>,
+    {
         let batches = count.div_ceil(LANES as u64);
         let per_batch = par_indexed(batches, |b| {
             let start = first + b * LANES as u64;
             let end = (start + LANES as u64).min(first + count);
             let mut rngs: Vec<TrajectoryRng> =
                 (start..end).map(|j| trajectory_rng(seed, j)).collect();
-            let records: Vec<Result<TrajectoryRecord>> = match self.batch()? {
-                Some(mut batch) => {
-                    let mut recorders: Vec<Recorder> = rngs
-                        .iter()
-                        .map(|_| Recorder::new(self, sampled_steps))
-                        .collect();
-                    self.schedule(sampled_steps)
-                        .run_batch(
-                            start as usize,
-                            &mut batch,
-                            &mut rngs,
-                            &mut recorders,
-                            |_| self.divergence_detail(),
-                        )
-                        .into_iter()
-                        .zip(recorders)
-                        .map(|(r, rec)| r.map(|()| rec.rec))
-                        .collect()
-                }
+            let mut observers: Vec<O> = (start..end).map(&make).collect();
+            let results: Vec<Result<()>> = match self.batch()? {
+                Some(mut batch) => self.schedule(sampled_steps).run_batch(
+                    start as usize,
+                    &mut batch,
+                    &mut rngs,
+                    &mut observers,
+                    |_| self.divergence_detail(),
+                ),
                 None => rngs
                     .iter_mut()
-                    .map(|rng| self.simulate(rng, sampled_steps))
+                    .zip(&mut observers)
+                    .map(|(rng, obs)| {
+                        let mut sampler = self.sampler()?;
+                        self.schedule(sampled_steps)
+                            .run(0, &mut *sampler, rng, obs, |_| self.divergence_detail())
+                    })
                     .collect(),
             };
             done(end - start);
-            Ok(records)
+            Ok(results
+                .into_iter()
+                .zip(observers)
+                .map(|(r, o)| r.map(|()| o))
+                .collect::<Vec<_>>())
         })?;
         per_batch.into_iter().flatten().collect()
     }
@@ -969,5 +1030,31 @@ impl LinearRun {
             r.dt,
             r.max_rate * r.dt
         )
+    }
+}
+
+impl LinearRun {
+    /// A run without a model, checking another program's data against `reference`
+    /// ([`crate::verify::data`]): the sampling plan is in rows of the data (`reference.dt`
+    /// is the time between rows), and `amplitude_scale` turns the data's aₙ into the
+    /// reference's modal units (its inverse is applied on reading).
+    pub fn for_data(
+        spec: RunSpec,
+        components: usize,
+        reference: LinearReference,
+        mode_every: Vec<u64>,
+        profile_every: u64,
+        amplitude_scale: Vec<f64>,
+    ) -> LinearRun {
+        LinearRun {
+            spec,
+            components,
+            reference,
+            mode_every,
+            profile_every,
+            burn_in_steps: 0,
+            amplitude_scale,
+            model: Model::Data,
+        }
     }
 }

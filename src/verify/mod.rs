@@ -12,8 +12,9 @@
 
 pub mod checks;
 pub mod compression;
+pub mod data;
 pub mod runner;
 pub mod summary;
 
-pub use runner::{VerifyOptions, projected_work, run_verification};
+pub use runner::{VerifyOptions, check_data, projected_work, run_verification};
 pub use summary::{CheckResult, SceneSummary, Summary};

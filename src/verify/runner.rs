@@ -461,7 +461,7 @@ fn run_compression_scene(
     }
     outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
     outputs.figures.push(write_fig2(report, &opts.out, curves)?);
-    let mut summary = finish_scene(scene, outputs, start, opts)?;
+    let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((what, slope)) = largest_slope {
         summary
             .warnings
@@ -825,7 +825,8 @@ fn finish_scene(
     scene: &Scene,
     outputs: SceneOutputs<'_>,
     start: Instant,
-    opts: &VerifyOptions,
+    alpha: f64,
+    out: &Path,
 ) -> Result<SceneSummary> {
     let SceneOutputs {
         report: _,
@@ -835,14 +836,14 @@ fn finish_scene(
         notes,
     } = outputs;
     let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
-    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, opts.alpha)) {
+    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, alpha)) {
         c.p_adjusted = Some(adj);
         c.passed = !reject;
     }
     let rel = |v: Vec<PathBuf>| -> Vec<String> {
         v.iter()
             .map(|p| {
-                p.strip_prefix(&opts.out)
+                p.strip_prefix(out)
                     .unwrap_or(p)
                     .to_string_lossy()
                     .into_owned()
@@ -886,9 +887,8 @@ fn run_scene(
         let e = run.spec.ensemble(opts.budget);
         let (records, two_time) = simulate_linear(scene, k, run, &e, bar)?;
         let budget_key = format!("{}.duration_tau1", opts.budget.name());
-        let (run_checks, est) = linear_checks(run, run.spec.checks(scene), &records, &two_time)
+        let est = apply_linear_checks(scene, run, &records, &two_time, &mut outputs)
             .map_err(|e| estimation_error(scene, k, "checks", &budget_key, e))?;
-        outputs.checks.extend(run_checks);
         if let Some(slope) = run.measured_rms_slope(&records)
             && largest_slope.as_ref().is_none_or(|(_, s)| slope.0 > s.0)
         {
@@ -906,7 +906,7 @@ fn run_scene(
             outputs.notes.push(note);
         }
     }
-    let mut summary = finish_scene(scene, outputs, start, opts)?;
+    let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((run, slope)) = largest_slope {
         summary.warnings.extend(small_slope_warning(
             &format!("run {run} (largest of the runs)"),
@@ -915,6 +915,95 @@ fn run_scene(
         ));
     }
     Ok(summary)
+}
+
+/// The checks of linear run `run` on its records, added to `outputs`; returns the
+/// estimates for its tables and figures.
+///
+/// # Errors
+/// An estimator's failure ([`linear_checks`]).
+fn apply_linear_checks(
+    scene: &Scene,
+    run: &LinearRun,
+    records: &[TrajectoryRecord],
+    two_time: &[Vec<f64>],
+    outputs: &mut SceneOutputs<'_>,
+) -> Result<LinearEstimates> {
+    let (run_checks, est) = linear_checks(run, run.spec.checks(scene), records, two_time)?;
+    outputs.checks.extend(run_checks);
+    Ok(est)
+}
+
+/// Applies `scene`'s checks to the trajectory data in `data_dir` (any program's, in the
+/// format of [`crate::data`]; see [`crate::verify::data`]) and writes the report to
+/// `out` as `verify` does (summary, index, per-run tables and figures, journal); returns
+/// the summary (budget `data`) and the report run, to be finished by
+/// [`crate::report::write_report`].
+///
+/// # Errors
+/// Input (exit 2): a bad sidecar or trajectory file, data that cannot serve the scene;
+/// run failures (exit 3): an estimator that finds no answer in the data.
+pub fn check_data(
+    scene: &Scene,
+    data_dir: &Path,
+    out: &Path,
+    alpha: f64,
+) -> Result<(Summary, ReportRun)> {
+    let sidecar = crate::data::DataSidecar::load(data_dir)?;
+    let prepared = (0..sidecar.runs.len())
+        .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k))
+        .collect::<Result<Vec<_>>>()?;
+    let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
+    let start = Instant::now();
+    let dir = out.join(&scene.name);
+    let mut outputs = SceneOutputs::new(scene, &report);
+    outputs.notes.push(format!(
+        "checked data: {} (producer: {}), {} run(s)",
+        data_dir.display(),
+        if sidecar.producer.is_empty() {
+            "not given"
+        } else {
+            &sidecar.producer
+        },
+        sidecar.runs.len()
+    ));
+    for (data, dc) in sidecar.runs.iter().zip(&prepared) {
+        let est = apply_linear_checks(scene, &dc.run, &dc.records, &dc.two_time, &mut outputs)
+            .map_err(|e| {
+                Error::run_failed(format!("data run {}", data.name), "checks", e).with_advice(
+                    "the data did not support the estimate; longer or more trajectories may help",
+                )
+            })?;
+        outputs.notes.extend(
+            est.skipped
+                .iter()
+                .map(|s| format!("not evaluated with these data: {s}")),
+        );
+        outputs.notes.extend(dc.notes.iter().cloned());
+        outputs.notes.push(format!(
+            "run {}: {} trajectories {}, rows every {:e} (time units of the filament), burn-in {:e}",
+            data.name,
+            dc.records.len(),
+            if data.start == crate::data::Start::Rest {
+                "from rest"
+            } else {
+                "stationary"
+            },
+            data.dt_sample,
+            data.burn_in
+        ));
+        write_run_outputs(&dir, &dc.run, &est, &mut outputs)?;
+    }
+    let scene_summary = finish_scene(scene, outputs, start, alpha, out)?;
+    let summary = Summary {
+        run_id: report.run_id(),
+        budget: "data".to_string(),
+        alpha,
+        passed: scene_summary.passed,
+        scenes: vec![scene_summary],
+        files: report.files(),
+    };
+    Ok((summary, report))
 }
 
 /// Simulates run `k` of a linear scene with ensemble `e`: the full trajectories, and the

@@ -1,0 +1,74 @@
+//! `langevin-fem check`: a scene's statistical checks applied to trajectories written by
+//! any program in the trajectory data format ([`langevin_fem::data`]).
+
+use super::resolve_scene;
+use clap::Args;
+use langevin_fem::error::{Error, Result};
+use langevin_fem::report::write_report;
+use langevin_fem::verify::check_data;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Scene whose checks are applied: a name from the scene directory or a path to a
+    /// .toml file. Its check kinds, modes, profile and two-time points say what is
+    /// checked; the data's sidecar says what was simulated.
+    #[arg(long, value_name = "NAME|PATH")]
+    scene: String,
+    /// Data directory: data.json (the sidecar) and the trajectory files it lists, as
+    /// `langevin-fem run` writes them (see the README, "Check your own simulator").
+    #[arg(long, value_name = "DIR")]
+    data: PathBuf,
+    /// Output directory for summary.json, index.html and per-run tables and figures.
+    #[arg(long, default_value = "check-report")]
+    pub(super) out: PathBuf,
+    /// Directory holding the scene files.
+    #[arg(long, default_value = "verification")]
+    scene_dir: PathBuf,
+    /// Family-wise significance level (Holm correction over every check).
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    alpha: f64,
+}
+
+/// Runs the checks; exit code 0 if every check passes, 1 otherwise.
+pub fn run(args: CheckArgs) -> Result<i32> {
+    if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
+        return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
+    }
+    if !args.data.is_dir() {
+        return Err(Error::invalid(
+            "--data",
+            args.data.display(),
+            "a directory holding data.json and the trajectory files it lists",
+        ));
+    }
+    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha)?;
+    write_report(report, &summary)?;
+    for s in &summary.scenes {
+        let failed: Vec<&str> = s
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.name.as_str())
+            .collect();
+        println!(
+            "{:<24} {}  {} checks, {} failed",
+            s.name,
+            if s.passed { "PASS" } else { "FAIL" },
+            s.checks.len(),
+            failed.len()
+        );
+        for f in failed {
+            println!("    failed: {f}");
+        }
+    }
+    println!(
+        "{} (data {}, family-wise alpha {}, Holm); report: {}",
+        if summary.passed { "PASSED" } else { "FAILED" },
+        args.data.display(),
+        summary.alpha,
+        args.out.join("index.html").display()
+    );
+    Ok(if summary.passed { 0 } else { 1 })
+}

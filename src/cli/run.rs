@@ -1,0 +1,278 @@
+//! `langevin-fem run`: simulate a scene's ensemble and write every trajectory's time
+//! series in the trajectory data format ([`langevin_fem::data`]), ready for NumPy, pandas
+//! or `langevin-fem check`.
+
+use super::{resolve_scene, usize_in};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use langevin_fem::data::{
+    DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR, Start, VERSION,
+};
+use langevin_fem::error::{Error, Result};
+use langevin_fem::fem::banded::LANES;
+use langevin_fem::output::ReportRun;
+use langevin_fem::rng::derive_seed;
+use langevin_fem::scene::linear::LinearRun;
+use langevin_fem::scene::{Budget, ModelKind, Scene};
+use langevin_fem::work::{RunWork, WorkProjection};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scene: a name from the scene directory or a path to a .toml file (linear scenes:
+    /// hinged-linear-2d, hinged-linear-3d, spectral-reference).
+    #[arg(long, value_name = "NAME|PATH")]
+    scene: String,
+    /// Run of the scene to simulate (repeatable; default: every run).
+    #[arg(long = "run", value_name = "NAME")]
+    runs: Vec<String>,
+    /// The ensemble: trajectories and duration of the scene's budget.
+    #[arg(long, value_enum, default_value = "quick")]
+    budget: super::verify::BudgetArg,
+    /// Trajectories per run (default: the budget's).
+    #[arg(long, value_name = "N", value_parser = usize_in::<1, 100_000>)]
+    trajectories: Option<usize>,
+    /// Sampled duration per trajectory after the burn-in, in tau1 (default: the budget's).
+    #[arg(long, value_name = "TAU1", allow_negative_numbers = true)]
+    duration_tau1: Option<f64>,
+    /// Steps between rows (default: the cadence of the fastest checked mode, made a
+    /// divisor of the two-time points' steps).
+    #[arg(long, value_name = "STEPS", value_parser = super::count_in::<1, 1_000_000_000>)]
+    every: Option<u64>,
+    /// File format of the trajectories.
+    #[arg(long, value_enum, default_value = "npy")]
+    format: FormatArg,
+    /// Master seed (default: the scene's).
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Output directory: data.json (the sidecar), manifest.json and <run>/trajectory-NNNN.<format>.
+    #[arg(long, default_value = "trajectories")]
+    pub(super) out: PathBuf,
+    /// Directory holding the scene files.
+    #[arg(long, default_value = "verification")]
+    scene_dir: PathBuf,
+    #[command(flatten)]
+    limits: super::LimitArgs,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum FormatArg {
+    Npy,
+    Csv,
+}
+
+/// Runs the command; exit code 0.
+pub fn run(args: RunArgs) -> Result<i32> {
+    let mut scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    if let Some(seed) = args.seed {
+        scene.seed = seed;
+    }
+    if scene.compression.is_some() || scene.model == ModelKind::Compression {
+        return Err(Error::invalid(
+            "--scene",
+            &args.scene,
+            "a linear scene (model fem or spectral): the trajectory format has no compression runs yet",
+        ));
+    }
+    if let Some(d) = args.duration_tau1
+        && !(d.is_finite() && (1.0..=1e6).contains(&d))
+    {
+        return Err(Error::invalid(
+            "--duration-tau1",
+            d,
+            "a duration in [1, 1e6] tau1",
+        ));
+    }
+    for r in &args.runs {
+        if !scene.runs.iter().any(|s| &s.name == r) {
+            let names: Vec<&str> = scene.runs.iter().map(|s| s.name.as_str()).collect();
+            return Err(Error::invalid(
+                "--run",
+                r,
+                format!("a run of {}: {}", scene.name, names.join(", ")),
+            ));
+        }
+    }
+    let budget = args.budget.budget();
+    let tau1 = scene.filament.tau1();
+    let chosen: Vec<usize> = (0..scene.runs.len())
+        .filter(|&k| args.runs.is_empty() || args.runs.contains(&scene.runs[k].name))
+        .collect();
+    let ensemble = |k: usize| {
+        let e = scene.runs[k].ensemble(budget);
+        (
+            args.trajectories.unwrap_or(e.trajectories),
+            args.duration_tau1.unwrap_or(e.duration_tau1),
+        )
+    };
+    let runs = chosen
+        .iter()
+        .map(|&k| {
+            LinearRun::prepare(&scene, &scene.runs[k])
+                .map_err(|e| scene.run_error(k, "integrator", e))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let ext = match args.format {
+        FormatArg::Npy => "npy",
+        FormatArg::Csv => "csv",
+    };
+    let plans = chosen
+        .iter()
+        .zip(&runs)
+        .map(|(&k, run)| {
+            let steps = run.sampled_steps(ensemble(k).1 * tau1);
+            run.row_plan(&scene, steps, args.every)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    args.limits
+        .limits()
+        .check(&projection(&scene, budget, &chosen, &plans, &ensemble))?;
+    let report = ReportRun::begin(&args.out, "run", "manifest.json", &[SIDECAR])?;
+    let total: u64 = chosen.iter().map(|&k| ensemble(k).0 as u64).sum();
+    let bar = progress(total);
+    let mut data_runs = Vec::new();
+    for ((&k, run), plan) in chosen.iter().zip(&runs).zip(&plans) {
+        let spec = &scene.runs[k];
+        bar.set_message(format!("{} / {}", scene.name, spec.name));
+        let count = ensemble(k).0 as u64;
+        let files: Vec<String> = (0..count)
+            .map(|j| format!("{}/trajectory-{j:04}.{ext}", spec.name))
+            .collect();
+        for f in &files {
+            report.record(&args.out.join(f))?;
+        }
+        let seed = derive_seed(scene.seed, &spec.name);
+        run.write_ensemble(
+            seed,
+            count,
+            plan,
+            |j| args.out.join(&files[j as usize]),
+            |n| bar.inc(n),
+        )
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        if !std::io::stderr().is_terminal() {
+            eprintln!(
+                "{} / {}: {count} trajectories x {} rows",
+                scene.name, spec.name, plan.rows
+            );
+        }
+        data_runs.push(DataRun {
+            name: spec.name.clone(),
+            dt_sample: plan.every as f64 * run.reference.dt,
+            start: Start::Rest,
+            burn_in: run.burn_in_steps as f64 * run.reference.dt,
+            positions: plan.positions.clone(),
+            modes: run.reference.modes.len(),
+            discretization: Some(Discretization {
+                model: match scene.model {
+                    ModelKind::Spectral => "spectral",
+                    _ => "fem",
+                }
+                .to_string(),
+                elements: Some(scene.mesh.elements),
+                integrator: Some(spec.integrator.to_string()),
+                noise: Some(spec.noise.name().to_string()),
+                dt: Some(run.reference.dt),
+            }),
+            files,
+        });
+    }
+    bar.finish_and_clear();
+    let f = scene.filament;
+    let sidecar = DataSidecar {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
+        dims: scene.dims,
+        filament: DataFilament {
+            length: f.length,
+            bending_rigidity: f.bending_rigidity,
+            drag: f.drag,
+            kt: f.kt,
+        },
+        runs: data_runs,
+        provenance: Some(serde_json::json!({
+            "tool": "langevin-fem",
+            "version": env!("CARGO_PKG_VERSION"),
+            "command_line": std::env::args().collect::<Vec<_>>(),
+            "scene": scene.name,
+            "scene_source": scene.path.display().to_string(),
+            "seed": scene.seed,
+            "budget": budget.name(),
+            "tau1": tau1,
+            "run_id": report.run_id(),
+        })),
+    };
+    let text = serde_json::to_string_pretty(&sidecar)
+        .map_err(|e| Error::io(args.out.join(SIDECAR), e.into()))?
+        + "\n";
+    report.finish(&[(SIDECAR, text.as_bytes())])?;
+    println!(
+        "wrote {} trajectories of {} ({} run(s)) to {}; check them with: langevin-fem check --scene {} --data {}",
+        total,
+        scene.name,
+        chosen.len(),
+        args.out.display(),
+        args.scene,
+        args.out.display()
+    );
+    Ok(0)
+}
+
+/// The projected work: per chosen run, every trajectory's steps (burn-in included)
+/// times the unknowns each updates, at the cost per step of the scene's own projection.
+fn projection(
+    scene: &Scene,
+    budget: Budget,
+    chosen: &[usize],
+    plans: &[langevin_fem::scene::linear::RowPlan],
+    ensemble: &dyn Fn(usize) -> (usize, f64),
+) -> WorkProjection {
+    let parts = scene.projected_work(budget);
+    WorkProjection {
+        command: "run".to_string(),
+        parts: chosen
+            .iter()
+            .zip(plans)
+            .map(|(&k, plan)| {
+                let mut part = parts[k].clone();
+                let w = part.work;
+                let per_step = if w.trajectory_steps > 0.0 {
+                    w.dof_steps / w.trajectory_steps
+                } else {
+                    0.0
+                };
+                let n = ensemble(k).0 as f64;
+                let steps = n * (plan.rows * plan.every) as f64;
+                part.work = RunWork {
+                    trajectory_steps: steps,
+                    dof_steps: steps * per_step,
+                    samples: (plan.columns.len() * LANES) as f64,
+                };
+                part.drivers = format!(
+                    "{}; {} trajectories x {} rows of {} columns written",
+                    part.drivers,
+                    n,
+                    plan.rows,
+                    plan.columns.len()
+                );
+                part
+            })
+            .collect(),
+    }
+}
+
+/// A progress bar over trajectories on stderr when it is a terminal, else hidden.
+fn progress(total: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories (eta {eta})  {msg}",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}

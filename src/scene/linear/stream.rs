@@ -1,0 +1,171 @@
+//! Writing an ensemble's time series to trajectory files ([`crate::data`]): the sampled
+//! rows of every trajectory from rest, streamed to disk as they are simulated.
+
+use super::{LinearRun, Model, Observables};
+use crate::data::TrajectoryFile;
+use crate::dynamics::Observer;
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use std::path::PathBuf;
+
+/// What [`LinearRun::write_ensemble`] writes per trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowPlan {
+    /// Positions x of the deflection columns (physical length units).
+    pub positions: Vec<f64>,
+    /// Steps between rows (rows at steps 0, every, 2·every, …).
+    pub every: u64,
+    /// Steps after the burn-in (the sampled duration).
+    pub sampled_steps: u64,
+    /// Rows per trajectory (the first at rest, t = 0).
+    pub rows: u64,
+    /// Column names ([`crate::data::columns`]).
+    pub columns: Vec<String>,
+}
+
+impl LinearRun {
+    /// The rows of this run's trajectory files for a sampled duration of
+    /// `sampled_steps` steps: deflections at the mesh nodes (for the spectral model, the
+    /// nodes of a uniform mesh of its element count), the profile points and the two-time
+    /// points; a row every `every` steps, by default the largest step count no larger
+    /// than the cadence of the fastest checked mode that divides every two-time step (so
+    /// the two-time correlation from rest can be checked on the rows).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `--every` if `every` is 0.
+    pub fn row_plan(
+        &self,
+        scene: &Scene,
+        sampled_steps: u64,
+        every: Option<u64>,
+    ) -> Result<RowPlan> {
+        let length = scene.filament.length;
+        let mut positions: Vec<f64> = match &self.model {
+            Model::Fem { beam, .. } => beam.mesh().nodes().to_vec(),
+            Model::Spectral { .. } | Model::Data => {
+                let n = scene.mesh.elements;
+                (0..=n).map(|k| length * k as f64 / n as f64).collect()
+            }
+        };
+        let r = &self.reference;
+        positions.extend(&r.profile_x);
+        positions.extend(r.two_time.iter().flat_map(|q| [q.x, q.y]));
+        positions.sort_by(f64::total_cmp);
+        positions.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * length);
+        let every = match every {
+            Some(0) => return Err(Error::invalid("--every", 0, "a step count >= 1")),
+            Some(e) => e,
+            None => {
+                let fastest = self.mode_every.iter().copied().min().unwrap_or(1).max(1);
+                let steps: Vec<u64> = r
+                    .two_time
+                    .iter()
+                    .flat_map(|q| [q.t_step, q.eta_step])
+                    .collect();
+                (1..=fastest)
+                    .rev()
+                    .find(|d| steps.iter().all(|s| s % d == 0))
+                    .unwrap_or(1)
+            }
+        };
+        let total = self.schedule(sampled_steps).total();
+        Ok(RowPlan {
+            columns: crate::data::columns(self.components + 1, positions.len(), r.modes.len()),
+            positions,
+            every,
+            sampled_steps,
+            rows: total / every + 1,
+        })
+    }
+
+    /// Simulates the trajectories `0..count` of the ensemble seeded `seed` (the same
+    /// trajectories as [`Self::simulate_ensemble`]) and writes each, as `plan` says, to
+    /// `path(j)` (`.csv` or `.npy`), streaming; a file appears only once complete.
+    /// `done(k)` is called as `k` more trajectories finish.
+    ///
+    /// # Errors
+    /// A divergence naming the step; [`Error::Io`] naming the file.
+    pub fn write_ensemble(
+        &self,
+        seed: u64,
+        count: u64,
+        plan: &RowPlan,
+        path: impl Fn(u64) -> PathBuf + Sync,
+        done: impl Fn(u64) + Sync,
+    ) -> Result<()> {
+        let writers = self.observe_ensemble(
+            seed,
+            0,
+            count,
+            plan.sampled_steps,
+            |j| RowWriter::new(self, plan, &path(j)),
+            done,
+        )?;
+        for w in writers {
+            w.commit()?;
+        }
+        Ok(())
+    }
+}
+
+/// The observer of [`LinearRun::write_ensemble`]: one row every `plan.every` steps from
+/// rest (step 0 included) to the end.
+struct RowWriter<'r> {
+    run: &'r LinearRun,
+    plan: &'r RowPlan,
+    file: Result<TrajectoryFile>,
+    row: Vec<f64>,
+    deflections: Vec<f64>,
+    modes: Vec<f64>,
+}
+
+impl<'r> RowWriter<'r> {
+    fn new(run: &'r LinearRun, plan: &'r RowPlan, path: &std::path::Path) -> Self {
+        let c = run.components;
+        RowWriter {
+            run,
+            plan,
+            file: TrajectoryFile::create(path, &plan.columns, plan.rows),
+            row: Vec::with_capacity(plan.columns.len()),
+            deflections: vec![0.0; c * plan.positions.len()],
+            modes: vec![0.0; c * run.reference.modes.len()],
+        }
+    }
+
+    fn write<S: Observables + ?Sized>(&mut self, step: u64, sampler: &S) {
+        let Ok(file) = &mut self.file else {
+            return;
+        };
+        let nm = self.run.reference.modes.len();
+        sampler.deflections(&self.plan.positions, &mut self.deflections);
+        sampler.modes(&mut self.modes);
+        self.row.clear();
+        self.row.push(step as f64 * self.run.reference.dt);
+        self.row.extend(&self.deflections);
+        self.row.extend(
+            self.modes
+                .iter()
+                .enumerate()
+                .map(|(k, q)| q * self.run.amplitude_scale[k % nm]),
+        );
+        if let Err(e) = file.push_row(&self.row) {
+            self.file = Err(e);
+        }
+    }
+
+    /// Completes the file (the first write error, if any).
+    fn commit(self) -> Result<()> {
+        self.file?.commit()
+    }
+}
+
+impl<S: Observables + ?Sized> Observer<S> for RowWriter<'_> {
+    fn on_start(&mut self, _: usize, sampler: &S) {
+        self.write(0, sampler);
+    }
+    fn on_step(&mut self, _: usize, step: u64, sampler: &S) {
+        if step.is_multiple_of(self.plan.every) {
+            self.write(step, sampler);
+        }
+    }
+}

@@ -1,0 +1,479 @@
+//! `check`: a scene's statistical checks applied to trajectories written by any program
+//! in the trajectory data format ([`crate::data`]).
+//!
+//! The scene says what is checked (its check kinds, modes, profile points and two-time
+//! points); the data's sidecar says what was simulated (the filament, the sampling, the
+//! positions and, if known, the discretization). The references are:
+//!
+//! - the exact discrete reference of the producer's discretization, when it is one this
+//!   tool models (`fem` with its elements, integrator, noise and time step, or
+//!   `spectral`): as in `verify`, a failure then says the data disagree with what that
+//!   discretization must give; each check states the continuum value beside it and the
+//!   run's note the expected discretization deficit (discrete / continuum − 1) per mode;
+//! - otherwise the continuum solution of eq. (2)–(4): the producer's discretization and
+//!   time-step errors are then part of what is checked, and a producer whose bias
+//!   exceeds the statistical error fails, naming the checks.
+//!
+//! The data are read into the same per-trajectory records `verify` builds while it
+//! simulates, and judged by the same checks ([`crate::verify::checks::linear_checks`]),
+//! family-wise correction and report.
+
+use crate::data::{DataRun, DataSidecar, Discretization, Start, columns, read_table};
+use crate::dynamics::IntegratorKind;
+use crate::error::{Error, Result};
+use crate::fem::noise::NoiseModel;
+use crate::params::FilamentParams;
+use crate::scene::linear::{
+    LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
+};
+use crate::scene::{ModelKind, RunSpec, Scene};
+use crate::spectral::HingedBeam;
+use crate::stats::moments::MIN_SERIES_LEN;
+use std::path::Path;
+
+/// A data run ready for the checks: the references in rows of the data, the records
+/// read from its files, and what a reader should know.
+pub struct DataCheck {
+    /// The run (no model; references and sampling plan in rows).
+    pub run: LinearRun,
+    /// The per-trajectory records, as `verify` builds them.
+    pub records: Vec<TrajectoryRecord>,
+    /// The two-time products per trajectory.
+    pub two_time: Vec<Vec<f64>>,
+    /// Notes: the references used, the expected discretization deficit, what the data
+    /// did not allow to check and why.
+    pub notes: Vec<String>,
+}
+
+/// Relative tolerance on a time or position of the data matching a scene's.
+const MATCH: f64 = 1e-6;
+
+/// Prepares the checks of data run `k` of `sidecar` (read from `dir`) against `scene`.
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar (or scene) key when the data cannot serve the
+/// scene's checks (another model kind, too few rows for the slowest checked series);
+/// [`Error::InvalidParameter`] naming a trajectory file that does not hold what the
+/// sidecar says; [`Error::Io`] if unreadable.
+pub fn prepare_data_check(
+    scene: &Scene,
+    sidecar: &DataSidecar,
+    dir: &Path,
+    k: usize,
+) -> Result<DataCheck> {
+    let sidecar_path = dir.join(crate::data::SIDECAR);
+    let data = &sidecar.runs[k];
+    let key_err = |key: &str, message: String| Error::Scene {
+        file: sidecar_path.clone(),
+        key: format!("runs[{k}].{key}"),
+        message,
+    };
+    if scene.compression.is_some() || scene.model == ModelKind::Compression {
+        return Err(Error::Scene {
+            file: scene.path.clone(),
+            key: "model".into(),
+            message: "check reads linear scenes (model = \"fem\" or \"spectral\"); the data format has no compression runs yet".into(),
+        });
+    }
+    if sidecar.dims != scene.dims {
+        return Err(Error::Scene {
+            file: sidecar_path.clone(),
+            key: "dims".into(),
+            message: format!(
+                "must equal the scene's dims = {} ({}), got {}",
+                scene.dims,
+                scene.path.display(),
+                sidecar.dims
+            ),
+        });
+    }
+    let filament = sidecar.filament.params();
+    let continuum = HingedBeam::new(filament)?;
+    let tau1 = filament.tau1();
+    let mut notes = Vec::new();
+    let discrete = discrete_run(scene, filament, data, &mut notes)?;
+    let spec = data_spec(scene, data);
+    let n_modes = scene.sampling.modes.min(data.modes);
+    if data.modes < scene.sampling.modes {
+        notes.push(format!(
+            "run {}: the data carry {} modal amplitudes per component; modes {}..{} of the scene are not checked",
+            data.name,
+            data.modes,
+            data.modes + 1,
+            scene.sampling.modes
+        ));
+    }
+    let dts = data.dt_sample;
+    // Steps of the discretization per row, if whole.
+    let per_row = discrete.as_ref().and_then(|d| {
+        let r = dts / d.reference.dt;
+        ((r - r.round()).abs() <= MATCH * r.max(1.0)).then(|| r.round())
+    });
+    let mut modes = Vec::new();
+    let mut scale = Vec::new();
+    for i in 0..n_modes {
+        let n = i + 1;
+        let rate_c = continuum.mode_rate(n);
+        match (&discrete, per_row) {
+            (Some(d), Some(r)) => {
+                let mut m = d.reference.modes[i].clone();
+                m.multiplier = m.multiplier.powf(r);
+                modes.push(m);
+                scale.push(d.amplitude_scale[i]);
+            }
+            _ => {
+                let var = continuum.mode_variance(n);
+                modes.push(ModeReference {
+                    n,
+                    variance_discrete: var,
+                    variance_equipartition: var,
+                    variance_continuum: var,
+                    multiplier: (-rate_c * dts).exp(),
+                    rate_discrete: Some(rate_c),
+                    rate_continuum: rate_c,
+                });
+                scale.push(1.0);
+            }
+        }
+    }
+    if discrete.is_some() && per_row.is_none() {
+        notes.push(format!(
+            "run {}: dt_sample = {dts} is not a whole number of the discretization's steps: continuum references",
+            data.name
+        ));
+    }
+    let discrete = discrete.filter(|_| per_row.is_some());
+    if let Some(d) = &discrete {
+        let deficits: Vec<String> = d.reference.modes[..n_modes]
+            .iter()
+            .map(|m| format!("{:+.2e}", m.variance_discrete / m.variance_continuum - 1.0))
+            .collect();
+        notes.push(format!(
+            "run {}: references of the producer's discretization (exact, discrete); expected deficit of its mode variances (mesh, noise, integrator and step) against the continuum, discrete/continuum - 1, modes 1..{n_modes}: {}",
+            data.name,
+            deficits.join(", ")
+        ));
+    } else {
+        notes.push(format!(
+            "run {}: continuum references (eq. 2-4): the producer's discretization and time-step errors are part of what is checked",
+            data.name
+        ));
+    }
+    let length = filament.length;
+    let column_of = |x: f64| {
+        data.positions
+            .iter()
+            .position(|&p| (p - x).abs() <= MATCH * length)
+    };
+    // Profile points present in the data.
+    let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (j, f) in scene.sampling.profile_points.iter().enumerate() {
+        let x = f * length;
+        match column_of(x) {
+            Some(col) => {
+                profile.0.push(x);
+                profile.1.push(match &discrete {
+                    Some(d) => d.reference.profile_discrete[j],
+                    None => continuum.profile_variance(x),
+                });
+                profile.2.push(continuum.profile_variance(x));
+                profile.3.push(col);
+            }
+            None => notes.push(format!(
+                "run {}: profile point x/L = {f} is not among the data's positions: not checked",
+                data.name
+            )),
+        }
+    }
+    // Two-time points on the rows, from rest only.
+    let mut two_time = Vec::new();
+    let mut tt_cols = Vec::new();
+    if data.start == Start::Rest {
+        for (j, q) in scene.sampling.two_time.iter().enumerate() {
+            let (x, y) = (q[0] * length, q[1] * length);
+            let (t, eta) = match &discrete {
+                Some(d) => (d.reference.two_time[j].t, d.reference.two_time[j].eta),
+                None => (q[2] * tau1, q[3] * tau1),
+            };
+            let row = |time: f64| {
+                let r = time / dts;
+                ((r - r.round()).abs() <= MATCH * r.max(1.0)).then(|| r.round() as u64)
+            };
+            match (column_of(x), column_of(y), row(t), row(eta)) {
+                (Some(cx), Some(cy), Some(rt), Some(re)) => {
+                    two_time.push(TwoTimeReference {
+                        x,
+                        y,
+                        t,
+                        eta,
+                        t_step: rt,
+                        eta_step: re,
+                        discrete: match &discrete {
+                            Some(d) => d.reference.two_time[j].discrete,
+                            None => continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                        },
+                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                    });
+                    tt_cols.push((cx, cy));
+                }
+                _ => notes.push(format!(
+                    "run {}: two-time point (x/L, y/L, t/tau1, eta/tau1) = ({}, {}, {}, {}) needs the positions among the data's and t, eta on the rows (dt_sample = {dts}): not checked",
+                    data.name, q[0], q[1], q[2], q[3]
+                )),
+            }
+        }
+    } else if !scene.sampling.two_time.is_empty() {
+        notes.push(format!(
+            "run {}: the trajectories do not start from rest: the two-time correlation from rest, eq. (4), is not checked",
+            data.name
+        ));
+    }
+    let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
+    let mode_every: Vec<u64> = modes
+        .iter()
+        .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))
+        .collect();
+    let rate1 = continuum.mode_rate(1);
+    let profile_every = every(4.0 * rate1);
+    let max_rate = modes.last().map_or(rate1, |m| m.rate_continuum);
+    let components = scene.dims - 1;
+    let reference = LinearReference {
+        modes,
+        profile_x: profile.0,
+        profile_discrete: profile.1,
+        profile_continuum: profile.2,
+        two_time,
+        dt: dts,
+        max_rate,
+    };
+    let run = LinearRun::for_data(
+        spec,
+        components,
+        reference,
+        mode_every,
+        profile_every,
+        scale,
+    );
+    let cols = columns(sidecar.dims, data.positions.len(), data.modes);
+    let layout = Layout {
+        n_positions: data.positions.len(),
+        n_modes_data: data.modes,
+        profile_cols: profile.3,
+        tt_cols,
+    };
+    let mut records = Vec::new();
+    let mut products = Vec::new();
+    for path in data.paths(dir) {
+        let (rec, tt) = read_record(&run, data, &path, &cols, &layout)?;
+        records.push(rec);
+        products.push(tt);
+    }
+    // The sparsest checked series sets the rows needed.
+    if let Some(shortest) = records
+        .iter()
+        .flat_map(|r| r.modes.iter().chain(&r.profile))
+        .map(Vec::len)
+        .min()
+        && shortest < MIN_SERIES_LEN
+    {
+        let sparsest = run.mode_every.iter().copied().max().unwrap_or(1);
+        return Err(key_err(
+            "files",
+            format!(
+                "each trajectory needs at least {} stationary rows after burn_in = {} (mode 1 is taken every {sparsest} rows of dt_sample = {dts}, {MIN_SERIES_LEN} samples at least), got {}; write longer trajectories",
+                sparsest * MIN_SERIES_LEN as u64,
+                data.burn_in,
+                shortest as u64 * sparsest
+            ),
+        ));
+    }
+    Ok(DataCheck {
+        run,
+        records,
+        two_time: products,
+        notes,
+    })
+}
+
+/// The columns the checks read from a file.
+struct Layout {
+    n_positions: usize,
+    n_modes_data: usize,
+    profile_cols: Vec<usize>,
+    tt_cols: Vec<(usize, usize)>,
+}
+
+/// Reads one trajectory file into the record `verify` would have built: the mode and
+/// profile series at their cadences after the burn-in (modal amplitudes in the
+/// reference's units), and the two-time products.
+fn read_record(
+    run: &LinearRun,
+    data: &DataRun,
+    path: &Path,
+    cols: &[String],
+    layout: &Layout,
+) -> Result<(TrajectoryRecord, Vec<f64>)> {
+    let table = read_table(path, cols)?;
+    let bad = |what: String| Error::invalid("trajectory file", path.display(), what);
+    if table.rows == 0 {
+        return Err(bad("at least one row".into()));
+    }
+    let dts = data.dt_sample;
+    let t0 = table.get(0, 0);
+    if data.start == Start::Rest && t0.abs() > MATCH * dts {
+        return Err(bad(format!(
+            "a first row at t = 0 (the sidecar says start = \"rest\"), got t = {t0}"
+        )));
+    }
+    for r in 0..table.rows {
+        let t = table.get(r, 0);
+        let expected = t0 + r as f64 * dts;
+        let off = (t - expected).abs();
+        if off.is_nan() || off > MATCH * dts + 1e-12 * expected.abs() {
+            return Err(bad(format!(
+                "rows every dt_sample = {dts} (row {} should be at t = {expected}, got {t})",
+                r + 1
+            )));
+        }
+    }
+    let first = ((data.burn_in - t0) / dts - MATCH).ceil().max(0.0) as usize;
+    let c = run.components;
+    let nm = run.reference.modes.len();
+    let np = layout.n_positions;
+    let rows_from = |every: u64| (first..table.rows).step_by(every as usize);
+    // Column indices: t, w_j, (v_j), aw_n, (av_n).
+    let deflection_col = |k: usize, j: usize| 1 + k * np + j;
+    let mode_col = |k: usize, i: usize| 1 + c * np + k * layout.n_modes_data + i;
+    let mut modes = Vec::with_capacity(c * nm);
+    for k in 0..c {
+        for i in 0..nm {
+            let scale = run.amplitude_scale[i];
+            modes.push(
+                rows_from(run.mode_every[i])
+                    .map(|r| table.get(r, mode_col(k, i)) / scale)
+                    .collect(),
+            );
+        }
+    }
+    let mut profile = Vec::with_capacity(c * layout.profile_cols.len());
+    for k in 0..c {
+        for &j in &layout.profile_cols {
+            profile.push(
+                rows_from(run.profile_every)
+                    .map(|r| table.get(r, deflection_col(k, j)))
+                    .collect(),
+            );
+        }
+    }
+    let tt = &run.reference.two_time;
+    let mut two_time = vec![0.0; c * tt.len()];
+    for (j, (q, &(cx, cy))) in tt.iter().zip(&layout.tt_cols).enumerate() {
+        let (rt, re) = (q.t_step as usize, q.eta_step as usize);
+        if re >= table.rows {
+            return Err(bad(format!(
+                "rows up to t = {} for the two-time point at eta = {} (from rest), got {} rows",
+                q.eta, q.eta, table.rows
+            )));
+        }
+        for k in 0..c {
+            two_time[k * tt.len() + j] =
+                table.get(rt, deflection_col(k, cx)) * table.get(re, deflection_col(k, cy));
+        }
+    }
+    let record = TrajectoryRecord {
+        modes,
+        profile,
+        two_time: two_time.clone(),
+        slope_squares: Vec::new(),
+        slope_samples: 0,
+    };
+    Ok((record, two_time))
+}
+
+/// The run specification the checks of data run `data` take from `scene`: the scene's
+/// run of the same name if there is one (its own check list), else the first run with
+/// the scene's checks; named after the data run.
+fn data_spec(scene: &Scene, data: &DataRun) -> RunSpec {
+    let mut spec = scene
+        .runs
+        .iter()
+        .find(|r| r.name == data.name)
+        .cloned()
+        .unwrap_or_else(|| RunSpec {
+            checks: None,
+            ..scene.runs[0].clone()
+        });
+    spec.name = data.name.clone();
+    spec
+}
+
+/// The producer's discretization as a run of this tool, when it is one it models
+/// (`fem` with elements, integrator, noise and dt; `spectral` with modes and dt): the
+/// run prepared on the data's filament, whose exact discrete references serve as the
+/// data's. `None` (with a note) otherwise.
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar key of a known model given with an unknown
+/// integrator or noise name; the preparation's errors.
+fn discrete_run(
+    scene: &Scene,
+    filament: FilamentParams,
+    data: &DataRun,
+    notes: &mut Vec<String>,
+) -> Result<Option<LinearRun>> {
+    let Some(d) = &data.discretization else {
+        return Ok(None);
+    };
+    let model = match d.model.as_str() {
+        "fem" => ModelKind::Fem,
+        "spectral" => ModelKind::Spectral,
+        other => {
+            notes.push(format!(
+                "run {}: the producer's discretization ({other}) is not one this tool models",
+                data.name
+            ));
+            return Ok(None);
+        }
+    };
+    let (Some(elements), Some(dt)) = (d.elements, d.dt) else {
+        notes.push(format!(
+            "run {}: the discretization gives no elements or dt: continuum references",
+            data.name
+        ));
+        return Ok(None);
+    };
+    let name_of = |v: &Option<String>, default: &str| v.clone().unwrap_or(default.into());
+    let integrator: IntegratorKind = parse_name(&name_of(&d.integrator, "exact-modal"))
+        .ok_or_else(|| discretization_error(data, "integrator", d))?;
+    let noise: NoiseModel = parse_name(&name_of(&d.noise, "consistent"))
+        .ok_or_else(|| discretization_error(data, "noise", d))?;
+    let mut scene = scene.clone();
+    scene.filament = FilamentParams {
+        stretch_rigidity: scene.filament.stretch_rigidity,
+        ..filament
+    };
+    scene.model = model;
+    scene.mesh.elements = elements;
+    scene.mesh.grading = 1.0;
+    let spec = RunSpec {
+        integrator,
+        noise,
+        dt_tau1: dt / filament.tau1(),
+        ..data_spec(&scene, data)
+    };
+    LinearRun::prepare(&scene, &spec).map(Some)
+}
+
+/// A name as the scene files spell it (`crank-nicolson`), parsed by serde.
+fn parse_name<T: serde::de::DeserializeOwned>(name: &str) -> Option<T> {
+    serde_json::from_value(serde_json::Value::String(name.to_string())).ok()
+}
+
+/// An unknown integrator or noise name in a discretization.
+fn discretization_error(data: &DataRun, key: &str, d: &Discretization) -> Error {
+    Error::invalid(
+        format!("discretization.{key} of data run {}", data.name),
+        format!("{d:?}"),
+        "an integrator (euler-maruyama, backward-euler, crank-nicolson, exact-modal) and noise (consistent, element-uniform) as in scene files",
+    )
+}
