@@ -2,7 +2,8 @@
 #
 #   make verify            quick verification suite (CI), reports in reports/
 #   make verify BUDGET=full   publication-grade error bars
-#   make test              all tests (unit, integration, statistical validation, golden)
+#   make test              all tests (unit, integration, statistical validation, golden),
+#                          then `check` against the NumPy example simulator
 #   make check             fmt --check, clippy -D warnings, tests
 #   make bench             benchmarks (benches/), see README performance table
 #   make golden            re-run golden snapshots, accept changes, show the diff
@@ -15,7 +16,7 @@ BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge bench-peers
+.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check
 
 all: build
 
@@ -36,6 +37,16 @@ verify: build
 # compiled dependency (one build, not two: the time to first result on a fresh clone).
 test:
 	$(CARGO) test --release --locked
+	$(MAKE) --no-print-directory example-check
+
+# `check` against an independent simulator (examples/numpy-simulator, NumPy in a venv):
+# passes at a small time step, fails naming the biased modes at a large one; NumPy reads
+# what `run` writes. Part of `make test` (CI).
+EXAMPLE_OUT ?= target/example-check
+example-check: build
+	test -x $(PEERS_VENV)/bin/python || python3 -m venv $(PEERS_VENV)
+	$(PEERS_VENV)/bin/python -c "import numpy" 2>/dev/null || $(PEERS_VENV)/bin/python -m pip install -q numpy==$(PEERS_NUMPY)
+	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
 
 check:
 	$(CARGO) fmt --check

@@ -87,6 +87,17 @@ pub fn prepare_data_check(
             ),
         });
     }
+    for (j, path) in data.paths(dir).iter().enumerate() {
+        if !path.is_file() {
+            return Err(key_err(
+                &format!("files[{j}]"),
+                format!(
+                    "must name a trajectory file in the data directory; {} is not a file",
+                    path.display()
+                ),
+            ));
+        }
+    }
     let filament = sidecar.filament.params();
     let continuum = HingedBeam::new(filament)?;
     let tau1 = filament.tau1();

@@ -1,0 +1,209 @@
+//! `run` and `check`: the round trip of the project's own output, a bias injected into
+//! the data that `check` must find, and data directories that are the user's mistake
+//! (exit 2 naming the sidecar key or the file). The independent NumPy simulator is
+//! checked by `make example-check` (part of `make test`).
+
+mod common;
+
+use common::{TempDir, describe, json, run, stderr_of};
+use std::path::Path;
+
+/// `run` of the Crank–Nicolson run of hinged-linear-2d (8 trajectories × 40 τ1, a row
+/// every 10 steps: 4501 rows of 19 columns), into `out`, in `format`.
+fn simulate(out: &str, format: &str) {
+    let args = [
+        "run",
+        "--scene",
+        "hinged-linear-2d",
+        "--run",
+        "crank-nicolson",
+        "--trajectories",
+        "8",
+        "--duration-tau1",
+        "40",
+        "--every",
+        "10",
+        "--format",
+        format,
+        "--out",
+        out,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+}
+
+fn check(data: &str, out: &str) -> (std::process::Output, Vec<&'static str>) {
+    let args: Vec<&'static str> = [
+        "check",
+        "--scene",
+        "hinged-linear-2d",
+        "--data",
+        data,
+        "--out",
+        out,
+    ]
+    .iter()
+    .map(|s| &*Box::leak(s.to_string().into_boxed_str()))
+    .collect();
+    (run(&args), args)
+}
+
+/// The checks of a report: (name, passed).
+fn checks(report: &Path) -> Vec<(String, bool)> {
+    let s = json(&report.join("summary.json"));
+    s["scenes"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            (
+                c["name"].as_str().unwrap().to_string(),
+                c["passed"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// The project's own output passes its own checks in both formats, with the references
+/// of its own discretization, and every check kind of the scene is evaluated.
+#[test]
+fn own_output_round_trips_in_both_formats() {
+    let dir = TempDir::new("run-check");
+    for format in ["npy", "csv"] {
+        let data = dir.join_str(&format!("data-{format}"));
+        simulate(&data, format);
+        let side = json(&Path::new(&data).join("data.json"));
+        assert_eq!(side["format"], "langevin-fem-trajectories");
+        assert_eq!(side["runs"][0]["discretization"]["model"], "fem");
+        assert!(side["provenance"]["seed"].is_u64());
+        let report = dir.join(&format!("report-{format}"));
+        let (o, args) = check(&data, report.to_str().unwrap());
+        assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+        let names: Vec<String> = checks(&report).into_iter().map(|c| c.0).collect();
+        for kind in [
+            "profile",
+            "mode-variance",
+            "mode-ks",
+            "decay-rate",
+            "spectrum-low",
+            "two-time",
+        ] {
+            assert!(
+                names.iter().any(|n| n.contains(&format!("/{kind}/"))),
+                "{kind} missing: {names:?}"
+            );
+        }
+        let summary = json(&report.join("summary.json"));
+        assert_eq!(summary["budget"], "data");
+    }
+}
+
+/// Modal amplitudes scaled by 1.1 (variances +21 %): `check` exits 1 naming the mode
+/// variance checks of the well-resolved modes; the deflections untouched, the profile
+/// checks still pass.
+#[test]
+fn an_injected_bias_fails_naming_the_checks() {
+    let dir = TempDir::new("run-check-bias");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let side = json(&Path::new(&data).join("data.json"));
+    for f in side["runs"][0]["files"].as_array().unwrap() {
+        let path = Path::new(&data).join(f.as_str().unwrap());
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let mut out = header.join(",") + "\n";
+        for line in lines {
+            let row: Vec<String> = line
+                .split(',')
+                .zip(&header)
+                .map(|(v, h)| {
+                    if h.starts_with("aw_") {
+                        (v.parse::<f64>().unwrap() * 1.1).to_string()
+                    } else {
+                        v.to_string()
+                    }
+                })
+                .collect();
+            out += &(row.join(",") + "\n");
+        }
+        std::fs::write(&path, out).unwrap();
+    }
+    let report = dir.join("report");
+    let (o, args) = check(&data, report.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
+    let results = checks(&report);
+    let failed: Vec<&String> = results.iter().filter(|c| !c.1).map(|c| &c.0).collect();
+    for n in 2..=6 {
+        let name = format!("crank-nicolson/mode-variance/n={n}");
+        assert!(
+            failed.iter().any(|f| **f == name),
+            "{name} not in {failed:?}"
+        );
+    }
+    assert!(
+        results
+            .iter()
+            .filter(|c| c.0.contains("/profile/"))
+            .all(|c| c.1)
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("failed: crank-nicolson/mode-variance/n=2"),
+        "{stdout}"
+    );
+}
+
+/// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
+#[test]
+fn bad_data_directories_exit_2_naming_what_to_fix() {
+    let dir = TempDir::new("run-check-bad");
+    let data = dir.join_str("data");
+    simulate(&data, "npy");
+    let side_path = Path::new(&data).join("data.json");
+    let original = std::fs::read_to_string(&side_path).unwrap();
+    let cases: [(&str, &str, &[&str]); 5] = [
+        (
+            "\"version\": 1",
+            "\"version\": 7",
+            &["data.json", "version", "7"],
+        ),
+        ("\"dims\": 2", "\"dims\": 3", &["data.json", "dims", "3"]),
+        (
+            "\"dt_sample\": ",
+            "\"dt_sample\": -",
+            &["runs[0].dt_sample"],
+        ),
+        (
+            "trajectory-0003.npy",
+            "trajectory-9999.npy",
+            &["runs[0].files[3]", "trajectory-9999.npy"],
+        ),
+        (
+            "\"modes\": 6",
+            "\"modes\": 7",
+            &["trajectory-0000.npy", "columns"],
+        ),
+    ];
+    for (from, to, named) in cases {
+        assert!(original.contains(from), "{from}");
+        std::fs::write(&side_path, original.replacen(from, to, 1)).unwrap();
+        let report = dir.join("report");
+        let (o, args) = check(&data, report.to_str().unwrap());
+        let err = stderr_of(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{from} -> {to}: {}",
+            describe(&args, &o)
+        );
+        for n in named {
+            assert!(err.contains(n), "{from} -> {to}: {n:?} not in {err}");
+        }
+        assert!(!report.join("summary.json").exists());
+    }
+    std::fs::write(&side_path, &original).unwrap();
+    let (o, args) = check(&dir.join_str("nowhere"), dir.join_str("report").as_str());
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    assert!(stderr_of(&o).contains("--data"));
+}
