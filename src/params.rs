@@ -1,4 +1,10 @@
 //! Physical parameters of a filament, their units and dimensionless groups.
+//!
+//! [`FilamentParams`] holds them in any consistent unit system; [`physical`] converts a
+//! filament given in physical units (µm, pN, Pa·s, K, …) to the consistent units µm, s,
+//! pN.
+
+pub mod physical;
 
 use crate::error::{Result, require_positive};
 use serde::{Deserialize, Serialize};

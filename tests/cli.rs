@@ -154,13 +154,14 @@ fn verify_scene(scene: &Path, out: &Path, threads: Option<usize>) -> Value {
     summary
 }
 
-/// `v` with every `wall_seconds` and `run_id` field removed (the only non-deterministic
-/// fields).
+/// `v` with every `wall_seconds`, `run_id` and `provenance` field removed (the only
+/// non-deterministic fields: the provenance records how the run was made — start time,
+/// command line, thread count — and is checked by `tests/provenance.rs`).
 fn without_wall_seconds(v: &Value) -> Value {
     match v {
         Value::Object(m) => Value::Object(
             m.iter()
-                .filter(|(k, _)| !matches!(k.as_str(), "wall_seconds" | "run_id"))
+                .filter(|(k, _)| !matches!(k.as_str(), "wall_seconds" | "run_id" | "provenance"))
                 .map(|(k, v)| (k.clone(), without_wall_seconds(v)))
                 .collect(),
         ),

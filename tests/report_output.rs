@@ -331,6 +331,7 @@ fn sample_summary() -> Summary {
             "manifest.json".to_string(),
             "summary.json".to_string(),
         ],
+        provenance: None,
     }
 }
 

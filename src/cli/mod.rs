@@ -19,7 +19,7 @@ use std::str::FromStr;
 /// Finite-element Langevin dynamics of thermally fluctuating filaments, with exact
 /// references and statistical verification.
 #[derive(Debug, Parser)]
-#[command(name = "langevin-fem", version, about, long_about = None)]
+#[command(name = "langevin-fem", version = langevin_fem::output::provenance::VERSION_LINE, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

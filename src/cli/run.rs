@@ -5,12 +5,13 @@
 use super::{resolve_scene, usize_in};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use langevin_fem::data::trajectory_columns;
 use langevin_fem::data::{
     DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR, Start, VERSION,
 };
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::banded::LANES;
-use langevin_fem::output::ReportRun;
+use langevin_fem::output::{Provenance, ReportRun};
 use langevin_fem::rng::derive_seed;
 use langevin_fem::scene::linear::LinearRun;
 use langevin_fem::scene::{Budget, ModelKind, Scene};
@@ -128,7 +129,9 @@ pub fn run(args: RunArgs) -> Result<i32> {
     args.limits
         .limits()
         .check(&projection(&scene, budget, &chosen, &plans, &ensemble))?;
+    let mut provenance = Provenance::begin(&[&scene]);
     let report = ReportRun::begin(&args.out, "run", "manifest.json", &[SIDECAR])?;
+    report.set_provenance(provenance.clone())?;
     let total: u64 = chosen.iter().map(|&k| ensemble(k).0 as u64).sum();
     let bar = progress(total);
     let mut data_runs = Vec::new();
@@ -179,6 +182,8 @@ pub fn run(args: RunArgs) -> Result<i32> {
         });
     }
     bar.finish_and_clear();
+    provenance.finish();
+    report.set_provenance(provenance.clone())?;
     let f = scene.filament;
     let sidecar = DataSidecar {
         format: FORMAT.to_string(),
@@ -193,16 +198,14 @@ pub fn run(args: RunArgs) -> Result<i32> {
         },
         runs: data_runs,
         provenance: Some(serde_json::json!({
-            "tool": "langevin-fem",
-            "version": env!("CARGO_PKG_VERSION"),
-            "command_line": std::env::args().collect::<Vec<_>>(),
-            "scene": scene.name,
-            "scene_source": scene.path.display().to_string(),
-            "seed": scene.seed,
-            "budget": budget.name(),
-            "tau1": tau1,
             "run_id": report.run_id(),
+            "budget": budget.name(),
+            "seed": scene.seed,
+            "tau1": tau1,
+            "journal": "manifest.json",
+            "record": provenance,
         })),
+        columns: Some(trajectory_columns()),
     };
     let text = serde_json::to_string_pretty(&sidecar)
         .map_err(|e| Error::io(args.out.join(SIDECAR), e.into()))?

@@ -78,6 +78,25 @@ pub struct DataSidecar {
     /// free-form, not read by `check`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<serde_json::Value>,
+    /// The columns of the trajectory files with their units and meanings, for a reader
+    /// ([`trajectory_columns`]): written by this tool, not read by `check`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub columns: Option<serde_json::Value>,
+}
+
+/// The units and meanings of the trajectory files' columns (`#` stands for the index
+/// `j` of `positions` or the mode number `n`), in the base dimensions of the filament's
+/// unit system ([`crate::output::columns`]: `[L]` its length unit, `[T]` its time unit).
+pub fn trajectory_columns() -> serde_json::Value {
+    serde_json::json!([
+        { "name": "t", "unit": "[T]", "meaning": "time since the start (physical time, not a multiple of tau1)" },
+        { "name": "w_#", "unit": "[L]", "meaning": "transverse deflection w at positions[#]" },
+        { "name": "v_#", "unit": "[L]", "meaning": "3D: second transverse deflection v at positions[#]" },
+        { "name": "aw_#", "unit": "[L]", "meaning": "modal amplitude a_n of w, w(x) = sum_n a_n sin(n pi x / L), n = #" },
+        { "name": "av_#", "unit": "[L]", "meaning": "3D: modal amplitude a_n of v, n = #" },
+        { "name": "positions (sidecar)", "unit": "[L]", "meaning": "positions of the deflection columns" },
+        { "name": "dt_sample, burn_in, discretization.dt (sidecar)", "unit": "[T]", "meaning": "time between rows, burn-in, integration step" }
+    ])
 }
 
 /// The filament of a data directory.

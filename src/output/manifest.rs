@@ -30,11 +30,18 @@
 //! (the shared index apart): a rerun removes the files its own earlier journal named, and
 //! never reads another journal.
 //!
+//! A journal also records what produced the run, its [`Provenance`] (tool version and
+//! commit, command line, start and wall time, threads, the scenes as run: see
+//! [`super::provenance`]), set by [`ReportRun::set_provenance`] and completed with the
+//! wall time when the run finishes, and the schema of every CSV file the run wrote: its
+//! columns with their units and meanings ([`Manifest::columns`], from the column
+//! dictionary [`super::columns`]).
+//!
 //! The temporary files of killed writers are removed by the next run
 //! ([`super::remove_stale_temporaries`]). Files the journal never named (e.g. the
 //! `convergence/` folder of other commands) are left alone.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::hash::{BuildHasher, Hasher};
 use std::path::{Component, Path, PathBuf};
@@ -43,8 +50,10 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use serde::{Deserialize, Serialize};
 
+use super::columns::{TableSchema, table_schema};
 use super::figure::Figure;
 use super::io::{csv_text, json_text, write_atomic};
+use super::provenance::{Provenance, ProvenanceRef};
 use crate::error::{Error, Result};
 
 /// The journal of a report run (see the [module docs](self)).
@@ -64,6 +73,14 @@ pub struct Manifest {
     /// the run is complete.
     #[serde(default)]
     pub superseded: Vec<String>,
+    /// What produced the run (absent in journals of runs that did not record it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+    /// Per CSV file of the run (relative path as in `files`): its columns with their
+    /// units and meanings, from the header line and the column dictionary
+    /// ([`super::columns`]).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub columns: BTreeMap<String, TableSchema>,
 }
 
 /// A unique id for a run: UTC start time, process id and 32 random bits, e.g.
@@ -162,6 +179,8 @@ impl ReportRun {
                     .into_iter()
                     .filter(|f| f != journal && safe_relative(f).is_some())
                     .collect(),
+                provenance: None,
+                columns: BTreeMap::new(),
             }),
         };
         // Entry points first: an entry point on disk always names the run of the journal
@@ -180,6 +199,31 @@ impl ReportRun {
     /// The run id.
     pub fn run_id(&self) -> String {
         self.lock().run_id.clone()
+    }
+
+    /// Records what produced the run in its journal (written at once; the wall time is
+    /// added when the run finishes).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the journal if it cannot be written.
+    pub fn set_provenance(&self, provenance: Provenance) -> Result<()> {
+        let mut state = self.lock();
+        state.provenance = Some(provenance);
+        self.persist(&state)
+    }
+
+    /// The reference to the run's provenance for an entry point (the journal's file name
+    /// and the essentials), if [`Self::set_provenance`] was called.
+    pub fn provenance_ref(&self) -> Option<ProvenanceRef> {
+        self.lock()
+            .provenance
+            .as_ref()
+            .map(|p| p.reference(&self.journal))
+    }
+
+    /// The journal's file name in the directory.
+    pub fn journal(&self) -> &str {
+        &self.journal
     }
 
     /// The report directory.
@@ -203,8 +247,19 @@ impl ReportRun {
     /// # Errors
     /// [`Error::Io`] naming `path` if it is not below the directory or cannot be written,
     /// or naming the journal if that cannot be updated.
+    /// A CSV file's columns are recorded in the journal with their units
+    /// ([`Manifest::columns`]).
     pub fn write(&self, path: &Path, bytes: &[u8]) -> Result<()> {
-        self.record(path)?;
+        let rel = self.record(path)?;
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+        {
+            let text = String::from_utf8_lossy(bytes);
+            let header = text.lines().next().unwrap_or("");
+            let schema = table_schema(&rel, header);
+            self.lock().columns.insert(rel, schema);
+        }
         write_atomic(path, bytes)
     }
 
@@ -295,8 +350,12 @@ impl ReportRun {
         {
             let mut state = self.lock();
             state.complete = true;
+            state.columns.retain(|f, _| files.binary_search(f).is_ok());
             state.files = files;
             state.superseded.clear();
+            if let Some(p) = &mut state.provenance {
+                p.finish();
+            }
             self.persist(&state)?;
         }
         for (name, bytes) in after {
@@ -306,13 +365,14 @@ impl ReportRun {
     }
 
     /// Lists `path` (below the directory) in the journal, on disk first if the journal
-    /// does not yet name it: called before a file the caller streams itself (e.g. with
-    /// [`crate::output::AtomicFile`]) is created.
+    /// does not yet name it, and returns its path relative to the directory: called
+    /// before a file the caller streams itself (e.g. with [`crate::output::AtomicFile`])
+    /// is created.
     ///
     /// # Errors
     /// [`Error::Io`] naming `path` if it is not below the directory, or the journal if
     /// that cannot be updated.
-    pub fn record(&self, path: &Path) -> Result<()> {
+    pub fn record(&self, path: &Path) -> Result<String> {
         let rel = path
             .strip_prefix(&self.dir)
             .ok()
@@ -334,12 +394,12 @@ impl ReportRun {
         let mut state = self.lock();
         if let Err(i) = state.files.binary_search(&rel) {
             let on_disk = state.superseded.binary_search(&rel).is_ok();
-            state.files.insert(i, rel);
+            state.files.insert(i, rel.clone());
             if !on_disk {
                 self.persist(&state)?;
             }
         }
-        Ok(())
+        Ok(rel)
     }
 
     /// Removes the superseded file `rel` (a regular file, if present) and then its parent

@@ -1,5 +1,7 @@
-//! Domain-free output: SVG figures and atomic file writers. Nothing here knows about
-//! filaments, scenes or checks; every layer above writes its files through this one.
+//! Domain-free output: SVG figures, atomic file writers, journals with provenance and the
+//! column dictionary. Nothing here depends on filaments, scenes or checks (a scene
+//! describes itself to the provenance through [`DescribeScene`]); every layer above
+//! writes its files through this one.
 //!
 //! - [`io`]: atomic writers. [`write_atomic`] writes through a temporary file in the
 //!   destination directory and a rename, so an interrupted run never leaves a truncated
@@ -10,15 +12,24 @@
 //!   rerun writes fewer files (old entry points removed first, dropped files removed,
 //!   entry points written last); several journals may share one directory, one per
 //!   output set (the studies' convergence folder).
+//! - [`provenance`]: [`Provenance`], what produced an output (version and commit baked
+//!   in at build time, command line, start and wall time, threads, every scene as run
+//!   with its hash, seed and parameters with units), carried by every journal and
+//!   referenced from every entry point ([`ProvenanceRef`]).
+//! - [`columns`]: the column dictionary, the unit and meaning of every column of every
+//!   CSV table the commands write; the journal records each CSV file's schema from it.
 //! - [`figure`]: [`Figure`] and [`Series`], rendered to SVG with `plotters` (SVG backend
 //!   only, no font files: text is emitted as SVG `<text>` and laid out by the viewer).
 //!   Rendering is deterministic, tolerates non-finite data and empty figures, and draws
 //!   error bars and horizontal reference lines.
 
+pub mod columns;
 pub mod figure;
 pub mod io;
 pub mod manifest;
+pub mod provenance;
 
 pub use figure::{Figure, Series, SeriesStyle};
 pub use io::{AtomicFile, remove_stale_temporaries, write_atomic, write_csv, write_json};
 pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};
+pub use provenance::{DescribeScene, Provenance, ProvenanceRef, SceneProvenance};

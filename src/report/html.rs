@@ -3,8 +3,9 @@
 //! A single static, self-contained page: inline CSS, no scripts, no external resources.
 //! Figures are referenced by their relative paths (they live next to `index.html`), so
 //! the output directory can be moved or archived as a whole. All text from the summary
-//! is HTML-escaped. The run id (also in `summary.json`) and the wall times are the only
-//! content that differs between two runs with the same seeds.
+//! is HTML-escaped. The run id (also in `summary.json`), the wall times and the
+//! provenance box's start time, command line and thread count are the only content that
+//! differs between two runs with the same seeds.
 //!
 //! [`write_report`] finishes a verification's [`ReportRun`]: `summary.json` and
 //! `index.html` are written last, after every other file of the run (see
@@ -14,6 +15,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::Result;
+use crate::output::ProvenanceRef;
 use crate::output::io::json_text;
 use crate::output::{ReportRun, write_atomic};
 use crate::verify::runner::ENTRY_POINTS;
@@ -42,12 +44,18 @@ figure{margin:0;border:1px solid #d0d7de;padding:.4em;background:#fff}
 figure img{display:block;width:100%;max-width:800px;height:auto}
 figcaption{font-size:.85em;color:#57606a;text-align:center;font-family:monospace}
 code{font-size:.95em}
+.provenance{border:1px solid #d0d7de;border-radius:.4em;padding:.2em 1em;margin:1em 0;\
+background:#f6f8fa}
+.provenance table{background:#fff}
+.provenance code{word-break:break-all}
 ";
 
 /// Renders the HTML index page for `summary`.
 ///
 /// Content: the overall verdict, the run id (every file of the report belongs to this
-/// run; `summary.json` lists them), the budget and the family-wise significance level α
+/// run; `summary.json` lists them), the provenance box (version, commit, start time,
+/// command line, threads, per scene its seed, source and SHA-256; the full record is in
+/// the journal it names), the budget and the family-wise significance level α
 /// (Holm-corrected within each scene), a table of scenes, and per scene its notes, its
 /// figures embedded as `<img>` with the file name as caption, links to its CSV tables and
 /// the table of its checks (estimate, reference, standard error, raw and Holm-adjusted
@@ -98,6 +106,9 @@ pub fn render_index(summary: &Summary) -> String {
             esc(&summary.run_id),
             summary.files.len()
         );
+    }
+    if let Some(p) = &summary.provenance {
+        provenance_box(&mut h, p);
     }
     let _ = writeln!(
         h,
@@ -162,6 +173,75 @@ fn index_html(out_dir: &Path, summary: &Summary) -> String {
         );
     }
     html
+}
+
+/// The provenance box: what produced the report.
+fn provenance_box(h: &mut String, p: &ProvenanceRef) {
+    let dirty = match p.dirty {
+        Some(true) => " <b>(dirty: built with uncommitted changes to tracked files)</b>",
+        Some(false) => "",
+        None => " (unknown whether the work tree had changes)",
+    };
+    let _ = writeln!(
+        h,
+        "<div class=\"provenance\" id=\"provenance\">\n<h2>Provenance</h2>\n<table>\n\
+         <tr><th>Version</th><td>langevin-fem {}</td></tr>\n\
+         <tr><th>Commit</th><td><code id=\"commit\">{}</code>{dirty}</td></tr>\n\
+         <tr><th>Started</th><td>{} (UTC)</td></tr>\n\
+         <tr><th>Command line</th><td><code>{}</code></td></tr>\n\
+         <tr><th>Threads</th><td class=\"num\">{}</td></tr>\n</table>",
+        esc(&p.version),
+        esc(&p.commit),
+        esc(&p.started),
+        esc(&shell_words(&p.command_line)),
+        p.threads
+    );
+    h.push_str(
+        "<table>\n<thead><tr><th>Scene</th><th>Seed</th><th>Source</th><th>SHA-256 of the scene text</th>\
+         <th>Overrides</th></tr></thead>\n<tbody>\n",
+    );
+    for s in &p.scenes {
+        let overrides = if s.overrides.is_empty() {
+            "none (ran as written)".to_string()
+        } else {
+            s.overrides.join("; ")
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"num\">{}</td><td><code>{}</code></td>\
+             <td><code>{}</code></td><td>{}</td></tr>",
+            esc(&s.name),
+            s.seed,
+            esc(&s.source),
+            esc(&s.sha256),
+            esc(&overrides)
+        );
+    }
+    let _ = writeln!(
+        h,
+        "</tbody>\n</table>\n<p class=\"meta\">The full record — every scene's text as run, \
+         its physical parameters with units and dimensionless groups, the wall time, and the \
+         unit of every column of every CSV table — is in <a href=\"{0}\">{0}</a>.</p>\n</div>",
+        esc(&url_path(&p.manifest))
+    );
+}
+
+/// A command line as one string: arguments with characters other than
+/// `[A-Za-z0-9_./=:,+-]` in single quotes.
+fn shell_words(args: &[String]) -> String {
+    args.iter()
+        .map(|a| {
+            let plain = !a.is_empty()
+                && a.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "_./=:,+-".contains(c));
+            if plain {
+                a.clone()
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn scenes_table(h: &mut String, summary: &Summary) {
@@ -394,6 +474,15 @@ mod tests {
         assert_eq!(fmt4(Some(1.23456e-7)), "1.235e-7");
         assert_eq!(fmt4(Some(-0.00123456)), "-0.001235");
         assert_eq!(fmt4(Some(123_456.0)), "1.235e5");
+    }
+
+    #[test]
+    fn command_lines_are_quoted_where_needed() {
+        let args = ["langevin-fem", "verify", "--out", "a b", "it's"].map(String::from);
+        assert_eq!(
+            shell_words(&args),
+            "langevin-fem verify --out 'a b' 'it'\\''s'"
+        );
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //!
 //! Figures and files are written through the domain-free [`crate::output`] layer.
 //! Everything a report contains is a deterministic function of the run's results, except
-//! the run id and the wall-clock times.
+//! the run id, the wall-clock times and the provenance (start time, command line, thread
+//! count).
 
 pub mod convergence;
 pub mod html;

@@ -10,6 +10,10 @@
 //!
 //! [filament]                     # any FilamentParams field; defaults 1 (EA 1e6)
 //! bending_rigidity = 1.0
+//! # or, in physical units (never both; see crate::params::physical):
+//! # contour_length_um = 10.0, persistence_length_um = 17.0 (or bending_rigidity_pn_um2),
+//! # viscosity_pa_s = 1e-3 with diameter_nm = 7.0 (or drag_pn_s_per_um2),
+//! # temperature_k = 300.0, optional stretch_rigidity_pn
 //!
 //! [mesh]
 //! elements = 10                  # fem: element count; spectral: number of modes
@@ -88,8 +92,10 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
 use crate::fem::noise::NoiseModel;
+use crate::output::provenance::{DescribeScene, SceneProvenance};
 use crate::params::FilamentParams;
-use serde::{Deserialize, Serialize};
+use crate::params::physical::{self, FilamentInput, PhysicalFilament};
+use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
 
 /// The largest scene file read (1 MiB; the shipped scenes are a few KiB).
@@ -401,9 +407,18 @@ pub struct Scene {
     pub model: ModelKind,
     /// Which checks to run.
     pub checks: Vec<CheckKind>,
-    /// Physical parameters.
-    #[serde(default)]
+    /// Physical parameters, in the scene's consistent units: as written, or converted
+    /// from physical units ([`crate::params::physical`]).
+    #[serde(default, deserialize_with = "deserialize_filament")]
     pub filament: FilamentParams,
+    /// The filament as given in physical units, if the scene gave it so (not in the
+    /// file under this name: read from the `[filament]` keys).
+    #[serde(skip)]
+    pub physical: Option<PhysicalFilament>,
+    /// The scene text as parsed (not in the file), for the provenance: its hash is of
+    /// what was parsed. Empty for a scene built in code.
+    #[serde(skip)]
+    pub source_text: String,
     /// Discretization.
     pub mesh: MeshSpec,
     /// Sampling plan (linear models).
@@ -463,6 +478,8 @@ impl Scene {
     /// [`Error::Scene`] naming the file, key, value and allowed range.
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| parse_error(text, path, &e))?;
+        scene.physical = FilamentTable::physical(text);
+        scene.source_text = text.to_string();
         scene.path = path.to_path_buf();
         scene.name = path
             .file_stem()
@@ -553,6 +570,119 @@ impl Scene {
             .collect();
         files.sort();
         Ok(files)
+    }
+}
+
+/// `[filament]` as written, converted to [`FilamentParams`] ([`FilamentInput::resolve`]);
+/// a table that mixes or leaves out keys is an error at the table, naming the keys.
+fn deserialize_filament<'de, D: Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<FilamentParams, D::Error> {
+    let input = FilamentInput::deserialize(d)?;
+    input
+        .resolve()
+        .map(|(params, _)| params)
+        .map_err(serde::de::Error::custom)
+}
+
+/// The `[filament]` table alone (every other key of the file ignored), to recover the
+/// physical filament once the scene has parsed.
+#[derive(Deserialize)]
+struct FilamentTable {
+    #[serde(default)]
+    filament: FilamentInput,
+}
+
+impl FilamentTable {
+    /// The physical filament `text` gives, if any (`None` also for text that does not
+    /// parse: [`Scene::parse`] has refused it before).
+    fn physical(text: &str) -> Option<PhysicalFilament> {
+        let table: FilamentTable = toml::from_str(text).ok()?;
+        table.filament.resolve().ok()?.1
+    }
+}
+
+impl DescribeScene for Scene {
+    /// The scene as it will run: its source and text as parsed with their hash, the seed,
+    /// the discretization, the parameters with units, and the overrides — every
+    /// difference between this scene and its text parsed afresh (e.g. `seed = 7 (file:
+    /// 20261123)` after a `--seed`), found by comparing the two key by key.
+    fn describe(&self) -> SceneProvenance {
+        SceneProvenance {
+            name: self.name.clone(),
+            source: self.path.display().to_string(),
+            text: self.source_text.clone(),
+            sha256: SceneProvenance::hash(&self.source_text),
+            overrides: self.overrides(),
+            seed: self.seed,
+            model: match self.model {
+                ModelKind::Fem => "fem",
+                ModelKind::Spectral => "spectral",
+                ModelKind::Compression => "compression",
+            }
+            .to_string(),
+            dims: self.dims,
+            elements: self.mesh.elements,
+            units: physical::base_units(self.physical.is_some()),
+            parameters: physical::parameter_record(&self.filament, self.physical.as_ref()),
+        }
+    }
+}
+
+impl Scene {
+    /// The differences between this scene and its text parsed afresh, as `key = value
+    /// (file: value)`, in key order; empty for a scene without text or that runs as
+    /// written.
+    pub fn overrides(&self) -> Vec<String> {
+        if self.source_text.is_empty() {
+            return Vec::new();
+        }
+        let as_written = match toml::from_str::<Scene>(&self.source_text) {
+            Ok(s) => s,
+            Err(_) => return vec!["(the scene text no longer parses)".to_string()],
+        };
+        let (Ok(now), Ok(file)) = (
+            serde_json::to_value(self),
+            serde_json::to_value(&as_written),
+        ) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        json_diff("", &now, &file, &mut out);
+        out
+    }
+}
+
+/// The leaves where `now` differs from `file`, as `key = now (file: file)`.
+fn json_diff(key: &str, now: &serde_json::Value, file: &serde_json::Value, out: &mut Vec<String>) {
+    use serde_json::Value;
+    let join = |k: &str| {
+        if key.is_empty() {
+            k.to_string()
+        } else {
+            format!("{key}.{k}")
+        }
+    };
+    match (now, file) {
+        (Value::Object(a), Value::Object(b)) => {
+            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+            for k in keys {
+                let null = Value::Null;
+                json_diff(
+                    &join(k),
+                    a.get(k).unwrap_or(&null),
+                    b.get(k).unwrap_or(&null),
+                    out,
+                );
+            }
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => {
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                json_diff(&format!("{key}[{i}]"), x, y, out);
+            }
+        }
+        _ if now != file => out.push(format!("{key} = {now} (file: {file})")),
+        _ => {}
     }
 }
 

@@ -33,6 +33,7 @@ use super::spec::{
 use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
+use crate::params::physical;
 use crate::work::{Origin, Part, RunWork};
 use std::fmt::Display;
 
@@ -273,19 +274,7 @@ impl Scene {
 
     /// The checks of every scene: filament, `dims`, `checks` non-empty, mesh, burn-in.
     fn validate_common(&self) -> Result<()> {
-        let f = &self.filament;
-        // Bounds keep every derived quantity (tau1, lambda_max, variances) inside f64.
-        for (key, v) in [
-            ("filament.length", f.length),
-            ("filament.bending_rigidity", f.bending_rigidity),
-            ("filament.stretch_rigidity", f.stretch_rigidity),
-            ("filament.drag", f.drag),
-            ("filament.kt", f.kt),
-        ] {
-            if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
-                return Err(bad(self, key, &Num(v), "in [1e-30, 1e30]"));
-            }
-        }
+        self.validate_filament()?;
         if self.dims != 2 && self.dims != 3 {
             return Err(bad(self, "dims", &self.dims, "2 or 3"));
         }
@@ -307,6 +296,90 @@ impl Scene {
         let b = self.sampling.burn_in_tau1;
         if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
             return Err(bad(self, "sampling.burn_in_tau1", &Num(b), "in [0, 1e4]"));
+        }
+        Ok(())
+    }
+
+    /// The filament: every parameter in [1e-30, 1e30] (bounds that keep every derived
+    /// quantity, τ1, λ_max, variances, inside f64). For a filament given in physical units
+    /// the bounds apply after conversion (in µm, s, pN) and the message names the keys the
+    /// user wrote, with their values; the slender-body drag needs L/d ≥
+    /// [`physical::MIN_SLENDERNESS`].
+    fn validate_filament(&self) -> Result<()> {
+        let f = &self.filament;
+        if let Some(p) = &self.physical {
+            for (key, value, _) in p.given() {
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(bad(
+                        self,
+                        &format!("filament.{key}"),
+                        &Num(value),
+                        "a finite number > 0",
+                    ));
+                }
+            }
+            if let physical::Drag::Solvent { diameter_nm, .. } = p.drag {
+                let slenderness = p.contour_length_um / (diameter_nm * 1e-3);
+                if slenderness < physical::MIN_SLENDERNESS {
+                    return Err(bad(
+                        self,
+                        "filament.diameter_nm",
+                        &Num(diameter_nm),
+                        &format!(
+                            "at most contour_length_um/{} = {} nm for the slender-body drag (L/d >= {}; got L/d = {})",
+                            physical::MIN_SLENDERNESS,
+                            Num(p.contour_length_um * 1e3 / physical::MIN_SLENDERNESS),
+                            physical::MIN_SLENDERNESS,
+                            Num(slenderness)
+                        ),
+                    ));
+                }
+            }
+        }
+        for (key, v) in [
+            ("length", f.length),
+            ("bending_rigidity", f.bending_rigidity),
+            ("stretch_rigidity", f.stretch_rigidity),
+            ("drag", f.drag),
+            ("kt", f.kt),
+        ] {
+            if v.is_finite() && (1e-30..=1e30).contains(&v) {
+                continue;
+            }
+            return Err(match &self.physical {
+                None => bad(
+                    self,
+                    &format!("filament.{key}"),
+                    &Num(v),
+                    "in [1e-30, 1e30]",
+                ),
+                Some(p) => {
+                    let keys = p.keys_of(key);
+                    let given: Vec<String> = p
+                        .given()
+                        .iter()
+                        .filter(|(k, _, _)| keys.contains(k))
+                        .map(|(k, v, unit)| format!("{k} = {} {unit}", Num(*v)))
+                        .collect();
+                    let unit = physical::parameter_record(f, Some(p))
+                        .parameters
+                        .get(key)
+                        .map_or_else(String::new, |q| q.unit.clone());
+                    Error::Scene {
+                        file: self.path.clone(),
+                        key: format!("filament.{}", keys.first().copied().unwrap_or(key)),
+                        message: format!(
+                            "gives {key} = {} {unit} after conversion (from {}), which must be in [1e-30, 1e30] {unit}",
+                            Num(v),
+                            if given.is_empty() {
+                                "defaults".to_string()
+                            } else {
+                                given.join(", ")
+                            }
+                        ),
+                    }
+                }
+            });
         }
         Ok(())
     }

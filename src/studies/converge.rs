@@ -42,7 +42,7 @@ use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::output::{Figure, Series, SeriesStyle};
+use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::validate::Num;
@@ -1006,6 +1006,7 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
         label = format!("{label}-as-{}", k.name());
     }
     let spec = scene.runs[run].clone();
+    let provenance = Provenance::begin(&[&scene]);
     let ensemble = study_ensemble(opts, &spec)?;
     let study = match scene.model {
         ModelKind::Compression => compression::study(&scene, run, opts, ensemble)?,
@@ -1020,7 +1021,15 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
             linear_study(&scene, run, opts, ensemble)?
         }
     };
-    finish(opts, &scene, &spec, &label, study, ensemble, start)
+    finish(
+        opts,
+        &scene,
+        &spec,
+        &label,
+        study,
+        ensemble,
+        (start, provenance),
+    )
 }
 
 /// The linear study: ⟨w²(L/2)⟩ and the variances of modes 1–3 per value.
@@ -1204,12 +1213,12 @@ fn finish(
     label: &str,
     study: Study,
     ensemble: Ensemble,
-    start: Instant,
+    (start, provenance): (Instant, Provenance),
 ) -> Result<ConvergeSummary> {
     let over = opts.over;
     let observables = summarize(&study.names, &study.rows, &study.expected);
     let stem = format!("{}-{label}-{}", scene.name, over.name());
-    let report = StudyReport::begin(&opts.out, "converge", &stem)?;
+    let report = StudyReport::begin(&opts.out, "converge", &stem, provenance)?;
     report.write(&format!("{stem}.csv"), rows_csv(&study.rows).as_bytes())?;
     report.write_svg(
         &format!("{stem}.svg"),

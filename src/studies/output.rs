@@ -6,8 +6,11 @@
 //! `stability` and `work-precision`. It holds
 //!
 //! - the journal `<stem>.manifest.json` ([`crate::output::manifest`]: run id, complete,
-//!   files; [`journal_name`]),
-//! - the entry point `<stem>.json`, the study's summary with its run id
+//!   files, the [`Provenance`] of the study — version, commit, command line, start and
+//!   wall time, threads, the scene as run with its hash, seed and parameters with units
+//!   — and the columns of every CSV file with their units; [`journal_name`]),
+//! - the entry point `<stem>.json`, the study's summary with its run id and a
+//!   `provenance` reference to the journal with version, commit and seed in clear
 //!   ([`summary_name`]), written after every other file of the set and before the
 //!   journal is marked complete,
 //! - the study's tables and figures (`<stem>.csv`, `<stem>.svg`, `stability-map-*.svg`,
@@ -27,7 +30,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::output::io::json_text;
-use crate::output::{Figure, ReportRun};
+use crate::output::{Figure, Provenance, ProvenanceRef, ReportRun};
 
 /// The folder's index page, an entry point shared by every study there.
 pub const INDEX: &str = "index.html";
@@ -53,6 +56,16 @@ pub fn stem_of_journal(name: &str) -> Option<&str> {
     name.strip_suffix(JOURNAL_SUFFIX).filter(|s| !s.is_empty())
 }
 
+/// A study's summary with the reference to its provenance appended (its own keys first,
+/// in their order).
+#[derive(Serialize)]
+struct WithProvenance<'a, T> {
+    #[serde(flatten)]
+    summary: &'a T,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    provenance: Option<ProvenanceRef>,
+}
+
 /// A study writing its output set into the folder (see the [module docs](self)).
 #[derive(Debug)]
 pub struct StudyReport {
@@ -62,14 +75,16 @@ pub struct StudyReport {
 
 impl StudyReport {
     /// Starts writing the output set `stem` of `command` in `dir` (created if missing):
-    /// the journal names the new run as incomplete, then the set's summary and the
-    /// folder's index are removed.
+    /// the journal names the new run as incomplete and records `provenance` (begun when
+    /// the study started: [`Provenance::begin`]), then the set's summary and the folder's
+    /// index are removed.
     ///
     /// # Errors
     /// As [`ReportRun::begin`].
-    pub fn begin(dir: &Path, command: &str, stem: &str) -> Result<Self> {
+    pub fn begin(dir: &Path, command: &str, stem: &str, provenance: Provenance) -> Result<Self> {
         let summary = summary_name(stem);
         let run = ReportRun::begin(dir, command, &journal_name(stem), &[&summary, INDEX])?;
+        run.set_provenance(provenance)?;
         Ok(StudyReport {
             run,
             stem: stem.to_string(),
@@ -115,13 +130,20 @@ impl StudyReport {
 
     /// Writes `summary` as the set's entry point `<stem>.json`, after removing the files
     /// of the earlier run that this one did not write, and marks the journal complete
-    /// ([`ReportRun::complete`]). The caller then rebuilds the index.
+    /// ([`ReportRun::complete`]). The caller then rebuilds the index. The summary (a
+    /// struct or map) gains the key `provenance`, last: the journal's file name with
+    /// version, commit, command line and seeds in clear ([`ProvenanceRef`]).
     ///
     /// # Errors
     /// As [`ReportRun::complete`].
     pub fn complete<T: Serialize>(self, summary: &T) -> Result<()> {
         let name = summary_name(&self.stem);
-        let text = json_text(&self.path(&name), summary)?;
+        let path = self.path(&name);
+        let value = WithProvenance {
+            summary,
+            provenance: self.run.provenance_ref(),
+        };
+        let text = json_text(&path, &value)?;
         self.run.complete(&[(&name, text.as_bytes())])
     }
 }

@@ -42,7 +42,7 @@ use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::modal::generalized_modes;
 use crate::fem::noise::NoiseModel;
-use crate::output::{Figure, Series, SeriesStyle};
+use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
 use crate::stats;
@@ -699,6 +699,7 @@ fn classify(cell: &mut Cell, biased: bool) {
 /// `opts.limits`; numerical or I/O failures.
 pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let start = Instant::now();
+    let provenance = Provenance::begin(&[&opts.scene]);
     validate(opts)?;
     opts.limits.check(&projected_work(opts))?;
     let mut cells = run_cells(opts)?;
@@ -708,7 +709,7 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
         Status::Unstable => c.refused.is_some() && c.diverged_at.is_some(),
         _ => c.refused.is_none(),
     });
-    let report = StudyReport::begin(&opts.out, "stability", STEM)?;
+    let report = StudyReport::begin(&opts.out, "stability", STEM, provenance)?;
     write_outputs(&report, opts, &cells)?;
     let summary = StabilitySummary {
         run_id: report.run_id(),

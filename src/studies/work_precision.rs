@@ -27,7 +27,7 @@ use super::output::StudyReport;
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
-use crate::output::{Figure, Series, SeriesStyle};
+use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::LinearRun;
 use crate::scene::validate::Num;
@@ -363,6 +363,7 @@ type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 /// `opts.limits`; run failures.
 pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
     let start = Instant::now();
+    let provenance = Provenance::begin(&[&opts.scene]);
     validate(opts)?;
     opts.limits.check(&projected_work(opts)?)?;
     // Prepare every point first, so that bad input fails before any simulation.
@@ -376,7 +377,7 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     ses.sort_by(f64::total_cmp);
     let sampling_floor = ses.get(ses.len() / 2).copied().unwrap_or(f64::NAN);
 
-    let report = StudyReport::begin(&opts.out, "work-precision", STEM)?;
+    let report = StudyReport::begin(&opts.out, "work-precision", STEM, provenance)?;
     report.write("work-precision.csv", points_csv(&points).as_bytes())?;
     report.write_svg(
         "work-precision.svg",

@@ -13,7 +13,8 @@
 //!
 //! # Outputs
 //! Under `--out`: the entry points `summary.json` and `index.html`, the journal
-//! `manifest.json` ([`crate::output::manifest`]: run id and every file of the run), and
+//! `manifest.json` ([`crate::output::manifest`]: run id, every file of the run, the
+//! provenance and the columns of every CSV file with their units), and
 //! for scene `<scene>` in `<scene>/`:
 //!
 //! - a linear scene, per run `<run>`: `<run>-modes.csv` and `.svg` (modal variance against
@@ -33,7 +34,8 @@
 
 use crate::error::{Error, Result};
 use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
-use crate::output::{Figure, ReportRun, Series, SeriesStyle};
+use crate::output::{Figure, Provenance, ReportRun, Series, SeriesStyle};
+use crate::params::physical::units_note;
 use crate::rng::derive_seed;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
@@ -107,6 +109,7 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         .iter()
         .map(|p| Scene::load(p))
         .collect::<Result<_>>()?;
+    let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
     opts.limits.check(&projected_work(&scenes, opts.budget))?;
     // Prepare every run first so that bad input is reported before any long work.
@@ -119,6 +122,7 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         }
     }
     let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
+    report.set_provenance(provenance)?;
     let bar = progress_bar(trajectory_count(&scenes, opts.budget), opts.progress);
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
@@ -139,6 +143,7 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         passed: summaries.iter().all(|s| s.passed),
         scenes: summaries,
         files: report.files(),
+        provenance: report.provenance_ref(),
     };
     Ok((summary, report))
 }
@@ -351,7 +356,14 @@ impl<'r> SceneOutputs<'r> {
             checks: Vec::new(),
             figures: Vec::new(),
             tables: Vec::new(),
-            notes: vec![scene.description.clone()],
+            notes: std::iter::once(scene.description.clone())
+                .chain(
+                    scene
+                        .physical
+                        .as_ref()
+                        .map(|p| units_note(&scene.filament, p)),
+                )
+                .collect(),
         }
     }
 
@@ -953,7 +965,9 @@ pub fn check_data(
     let prepared = (0..sidecar.runs.len())
         .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k))
         .collect::<Result<Vec<_>>>()?;
+    let provenance = Provenance::begin(&[scene]);
     let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
+    report.set_provenance(provenance)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
@@ -1002,6 +1016,7 @@ pub fn check_data(
         passed: scene_summary.passed,
         scenes: vec![scene_summary],
         files: report.files(),
+        provenance: report.provenance_ref(),
     };
     Ok((summary, report))
 }

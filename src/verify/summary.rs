@@ -1,7 +1,9 @@
 //! The machine-readable result of a verification run (`summary.json`): the run id and
-//! every file of the report (see [`crate::output::manifest`]), the budget, the scenes and
-//! their checks.
+//! every file of the report (see [`crate::output::manifest`]), what produced it (a
+//! reference to the provenance in `manifest.json`, with version, commit and seeds in
+//! clear), the budget, the scenes and their checks.
 
+use crate::output::ProvenanceRef;
 use serde::{Deserialize, Serialize};
 
 /// One statistical or deterministic check.
@@ -108,4 +110,10 @@ pub struct Summary {
     /// command's).
     #[serde(default)]
     pub files: Vec<String>,
+    /// What produced the report: the journal holding the full provenance
+    /// (`manifest.json`: scene texts, parameters with units, wall time), with version,
+    /// commit, command line, start time, threads and per scene its source, hash and
+    /// seed in clear. `null` for a summary not written by a run.
+    #[serde(default)]
+    pub provenance: Option<ProvenanceRef>,
 }
