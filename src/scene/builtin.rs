@@ -149,6 +149,25 @@ fn is_path(text: &str) -> bool {
     p.extension().is_some_and(|x| x == "toml") || (p.exists() && !p.is_dir())
 }
 
+/// The scene names `--scene` takes, for messages: those of `scene_dir` if given, else
+/// the built-in ones, saying which.
+fn available(scene_dir: Option<&Path>) -> Result<String> {
+    Ok(match scene_dir {
+        Some(dir) => {
+            let names: Vec<String> = Scene::discover(dir)?
+                .iter()
+                .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                .collect();
+            format!(
+                "{} (the scenes of --scene-dir {})",
+                names.join(", "),
+                dir.display()
+            )
+        }
+        None => format!("{} (the built-in scenes)", names()),
+    })
+}
+
 /// Resolves one `--scene` value: a path ([`is_path`]), else a name in `scene_dir` when it
 /// is given, else a built-in name.
 ///
@@ -159,53 +178,37 @@ fn is_path(text: &str) -> bool {
 pub fn resolve(name_or_path: &str, scene_dir: Option<&Path>) -> Result<SceneSource> {
     if is_path(name_or_path) {
         let path = PathBuf::from(name_or_path);
-        if !path.exists() {
-            return Err(Error::invalid(
+        if path.exists() {
+            return Ok(SceneSource::File(path));
+        }
+        return Err(Error::invalid(
+            "--scene",
+            name_or_path,
+            format!(
+                "an existing scene file (there is no file {}) or a scene name, one of: {}",
+                path.display(),
+                available(scene_dir)?
+            ),
+        ));
+    }
+    let found = match scene_dir {
+        Some(dir) => Scene::discover(dir)?
+            .into_iter()
+            .find(|k| k.file_stem().is_some_and(|s| s == name_or_path))
+            .map(SceneSource::File),
+        None => find(name_or_path).map(SceneSource::Builtin),
+    };
+    found.ok_or_else(|| {
+        // The names first: "--scene must be one of: a, b, ...".
+        match available(scene_dir) {
+            Ok(names) => Error::invalid(
                 "--scene",
                 name_or_path,
-                format!(
-                    "an existing scene file or a scene name (no file {}; built-in scenes: {})",
-                    path.display(),
-                    names()
-                ),
-            ));
+                format!("one of: {names}, or a path to a .toml file"),
+            ),
+            Err(e) => e,
         }
-        return Ok(SceneSource::File(path));
-    }
-    match scene_dir {
-        Some(dir) => {
-            let known = Scene::discover(dir)?;
-            known
-                .iter()
-                .find(|k| k.file_stem().is_some_and(|s| s == name_or_path))
-                .map(|p| SceneSource::File(p.clone()))
-                .ok_or_else(|| {
-                    let names: Vec<String> = known
-                        .iter()
-                        .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
-                        .collect();
-                    Error::invalid(
-                        "--scene",
-                        name_or_path,
-                        format!(
-                            "one of: {} (the scenes of --scene-dir {}), or a path to a .toml file",
-                            names.join(", "),
-                            dir.display()
-                        ),
-                    )
-                })
-        }
-        None => find(name_or_path).map(SceneSource::Builtin).ok_or_else(|| {
-            Error::invalid(
-                "--scene",
-                name_or_path,
-                format!(
-                    "one of: {} (the built-in scenes), or a path to a .toml file",
-                    names()
-                ),
-            )
-        }),
-    }
+    })
 }
 
 /// Resolves the `--scene` values of a command that runs several scenes: each as
@@ -348,6 +351,7 @@ mod tests {
         let e = resolve("no/such/file.toml", None).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("no file no/such/file.toml"), "{e}");
+        assert!(e.to_string().contains("one of: compression-2d, "), "{e}");
         let bad = Scene::parse_named("seed = 1", &find("compression-2d").unwrap().label(), "x");
         let m = bad.unwrap_err().to_string();
         assert!(m.starts_with("compression-2d (built in): key "), "{m}");
