@@ -168,7 +168,7 @@ fn available(scene_dir: Option<&Path>) -> Result<String> {
     })
 }
 
-/// Resolves one `--scene` value: a path ([`is_path`]), else a name in `scene_dir` when it
+/// Resolves one `--scene` value: a path (it ends in `.toml` or names an existing file), else a name in `scene_dir` when it
 /// is given, else a built-in name.
 ///
 /// # Errors
