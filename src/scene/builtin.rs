@@ -168,8 +168,9 @@ fn available(scene_dir: Option<&Path>) -> Result<String> {
     })
 }
 
-/// Resolves one `--scene` value: a path (it ends in `.toml` or names an existing file), else a name in `scene_dir` when it
-/// is given, else a built-in name.
+/// Resolves one `--scene` value: a path (it ends in `.toml` or names an existing file
+/// that is not a directory), else a name in `scene_dir` when it is given, else a
+/// built-in name.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] (exit 2) for a `.toml` path that does not exist, or an
