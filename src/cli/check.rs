@@ -1,7 +1,6 @@
 //! `langevin-fem check`: a scene's statistical checks applied to trajectories written by
 //! any program in the trajectory data format ([`langevin_fem::data`]).
 
-use super::resolve_scene;
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
@@ -22,9 +21,10 @@ pub struct CheckArgs {
     /// Output directory for summary.json, index.html and per-run tables and figures.
     #[arg(long, default_value = "check-report")]
     pub(super) out: PathBuf,
-    /// Directory holding the scene files.
-    #[arg(long, default_value = "verification")]
-    scene_dir: PathBuf,
+    /// Directory of scene files in which --scene NAME is looked up (default: the
+    /// built-in scenes).
+    #[arg(long, value_name = "DIR")]
+    scene_dir: Option<PathBuf>,
     /// Family-wise significance level (Holm correction over every check).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
@@ -42,7 +42,7 @@ pub fn run(args: CheckArgs) -> Result<i32> {
             "a directory holding data.json and the trajectory files it lists",
         ));
     }
-    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha)?;
     write_report(report, &summary)?;
     for s in &summary.scenes {

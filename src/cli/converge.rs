@@ -2,12 +2,13 @@
 //! compression) over the element count or the time step, with fitted orders against the
 //! expected ones.
 
-use super::{parse_list, resolve_scene, usize_in};
+use super::{parse_list, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_convergence_index;
 use langevin_fem::scene::Budget;
+use langevin_fem::scene::load_scene;
 use langevin_fem::studies::converge::{
     ConvergeOptions, ConvergeSummary, ObservableSummary, OrderFit, Over, run_convergence,
 };
@@ -16,8 +17,9 @@ use std::path::{Path, PathBuf};
 /// Command-line arguments of `langevin-fem converge`.
 #[derive(Debug, Args)]
 pub struct ConvergeArgs {
-    /// Scene: a name from the scene directory or a path to a .toml file (finite-element
-    /// scenes: hinged-linear-2d, hinged-linear-3d, compression-2d, compression-3d, ...).
+    /// Scene: a built-in scene's name (finite-element scenes: hinged-linear-2d,
+    /// hinged-linear-3d, compression-2d, compression-3d, ...; see `langevin-fem list`), a
+    /// name in --scene-dir, or a path to a .toml file.
     #[arg(long, value_name = "NAME|PATH")]
     scene: String,
     /// What is refined: the element count or the time step dt/tau1.
@@ -52,11 +54,14 @@ pub struct ConvergeArgs {
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
-    /// Directory holding the scene files.
-    #[arg(long, default_value = "verification")]
-    scene_dir: PathBuf,
+    /// Directory of scene files: --scene names resolve there instead of among the
+    /// built-in scenes.
+    #[arg(long, value_name = "DIR")]
+    scene_dir: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    pub(super) sim: super::SimArgs,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -115,7 +120,8 @@ fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
         .as_deref()
         .map(parse_integrator)
         .transpose()?;
-    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
+    args.sim.apply(&mut scene);
     Ok(ConvergeOptions {
         scene,
         run: args.run,
@@ -189,11 +195,12 @@ fn print_observable(o: &ObservableSummary) {
 /// with the exact discrete references, the failed values, notes, warnings and files.
 fn print_summary(s: &ConvergeSummary, out: &Path) {
     eprintln!(
-        "{} / {} ({} with {} noise), over {} (h = {}), {}; errors against the {}",
+        "{} / {} ({} with {} noise, seed {}), over {} (h = {}), {}; errors against the {}",
         s.scene,
         s.run,
         s.integrator,
         s.noise,
+        s.seed,
         s.over.name(),
         s.h,
         s.fixed,

@@ -2,7 +2,9 @@
 
 mod check;
 mod converge;
+mod list;
 mod run;
+mod scene;
 mod stability;
 mod theory;
 mod verify;
@@ -11,7 +13,7 @@ mod work_precision;
 use clap::{Args, Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
-use langevin_fem::scene::{Scene, resolve_scenes};
+use langevin_fem::scene::Scene;
 use langevin_fem::work::WorkLimits;
 use std::path::Path;
 use std::str::FromStr;
@@ -46,6 +48,10 @@ enum Command {
     /// Apply a scene's statistical checks to trajectories written by any simulator in
     /// the trajectory data format (the format `run` writes).
     Check(check::CheckArgs),
+    /// List the scenes: the built-in ones, and with --scene-dir the files there.
+    List(list::ListArgs),
+    /// Inspect a scene.
+    Scene(scene::SceneArgs),
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
@@ -55,18 +61,22 @@ pub fn run() -> Result<i32> {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => {
             check_out_dir(&args.out)?;
+            args.sim.start()?;
             verify::run(args)
         }
         Command::Converge(args) => {
             check_out_dir(&args.out)?;
+            args.sim.start()?;
             converge::run(args)
         }
         Command::Stability(args) => {
             check_out_dir(&args.out)?;
+            args.sim.start()?;
             stability::run(args)
         }
         Command::WorkPrecision(args) => {
             check_out_dir(&args.out)?;
+            args.sim.start()?;
             work_precision::run(args)
         }
         Command::Run(args) => {
@@ -77,6 +87,8 @@ pub fn run() -> Result<i32> {
             check_out_dir(&args.out)?;
             check::run(args)
         }
+        Command::List(args) => list::run(args),
+        Command::Scene(args) => scene::run(args),
     }
 }
 
@@ -219,11 +231,52 @@ fn parse_list_or<T: FromStr + Clone>(
     text.map_or_else(|| Ok(default.to_vec()), |t| parse_list(flag, t, allowed))
 }
 
-/// Loads one scene given by name (in `scene_dir`) or path.
-fn resolve_scene(name: &str, scene_dir: &Path) -> Result<Scene> {
-    let path = resolve_scenes(&[name.to_string()], scene_dir)?
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::invalid("--scene", name, "a scene name or .toml path"))?;
-    Scene::load(&path)
+/// The seed and thread count of a command that simulates (`--seed`, `--threads`),
+/// flattened into each: `verify`, `converge`, `stability`, `work-precision`.
+#[derive(Debug, Args)]
+pub struct SimArgs {
+    /// Master seed, instead of the seed of every scene the command runs (any integer in
+    /// [0, 18446744073709551615]); the reports note the seed used.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = count_in::<0, { u64::MAX }>)]
+    seed: Option<u64>,
+    /// Worker threads of the parallel ensembles (1 to 256; default: rayon's, the number
+    /// of CPUs or RAYON_NUM_THREADS). Results are bit-identical whatever the count.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 256>)]
+    threads: Option<usize>,
+}
+
+impl SimArgs {
+    /// Sizes rayon's global pool if `--threads` was given; called before anything runs.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `--threads` if the pool cannot be built.
+    pub fn start(&self) -> Result<()> {
+        let Some(n) = self.threads else {
+            return Ok(());
+        };
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| {
+                Error::invalid(
+                    "--threads",
+                    n,
+                    format!("a thread count the system can start ({e})"),
+                )
+            })
+    }
+
+    /// Replaces the scene's seed with `--seed` if given; returns the note on the seed
+    /// used, for the reports: `seed N (--seed; the scene's own seed is M)` or
+    /// `seed N (the scene's own)`.
+    pub fn apply(&self, scene: &mut Scene) -> String {
+        let own = scene.seed;
+        match self.seed {
+            Some(seed) => {
+                scene.seed = seed;
+                format!("seed {seed} (--seed; the scene's own seed is {own})")
+            }
+            None => format!("seed {own} (the scene's own)"),
+        }
+    }
 }

@@ -2,7 +2,7 @@
 //! series in the trajectory data format ([`langevin_fem::data`]), ready for NumPy, pandas
 //! or `langevin-fem check`.
 
-use super::{resolve_scene, usize_in};
+use super::usize_in;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use langevin_fem::data::trajectory_columns;
@@ -44,15 +44,15 @@ pub struct RunArgs {
     /// File format of the trajectories.
     #[arg(long, value_enum, default_value = "npy")]
     format: FormatArg,
-    /// Master seed (default: the scene's).
-    #[arg(long, value_name = "N")]
-    seed: Option<u64>,
+    #[command(flatten)]
+    sim: super::SimArgs,
     /// Output directory: data.json (the sidecar), manifest.json and <run>/trajectory-NNNN.<format>.
     #[arg(long, default_value = "trajectories")]
     pub(super) out: PathBuf,
-    /// Directory holding the scene files.
-    #[arg(long, default_value = "verification")]
-    scene_dir: PathBuf,
+    /// Directory of scene files in which --scene NAME is looked up (default: the
+    /// built-in scenes).
+    #[arg(long, value_name = "DIR")]
+    scene_dir: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
 }
@@ -65,10 +65,9 @@ enum FormatArg {
 
 /// Runs the command; exit code 0.
 pub fn run(args: RunArgs) -> Result<i32> {
-    let mut scene = resolve_scene(&args.scene, &args.scene_dir)?;
-    if let Some(seed) = args.seed {
-        scene.seed = seed;
-    }
+    let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
+    args.sim.start()?;
+    let seed_note = args.sim.apply(&mut scene);
     if scene.compression.is_some() || scene.model == ModelKind::Compression {
         return Err(Error::invalid(
             "--scene",
@@ -201,6 +200,7 @@ pub fn run(args: RunArgs) -> Result<i32> {
             "run_id": report.run_id(),
             "budget": budget.name(),
             "seed": scene.seed,
+            "seed_note": seed_note,
             "tau1": tau1,
             "journal": "manifest.json",
             "record": provenance,

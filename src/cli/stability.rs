@@ -1,10 +1,11 @@
 //! `langevin-fem stability`: stability map (integrator × Δt·λ_max × element count) and
 //! the measured per-mode stationary bias against each integrator's exact formula.
 
-use super::{count_in, parse_list_or, resolve_scene, usize_in};
+use super::{count_in, parse_list_or, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
+use langevin_fem::scene::load_scene;
 use langevin_fem::studies::stability::{
     DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, ELEMENTS_RANGE, StabilityOptions,
     Status, run_stability,
@@ -14,8 +15,8 @@ use std::path::PathBuf;
 /// Command-line arguments of `langevin-fem stability`.
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
-    /// Linear finite-element scene supplying the filament and the seed (name or .toml
-    /// path).
+    /// Linear finite-element scene supplying the filament and the seed: a built-in
+    /// scene's name, a name in --scene-dir, or a path to a .toml file.
     #[arg(long, value_name = "NAME|PATH", default_value = "hinged-linear-2d")]
     scene: String,
     /// Comma-separated integrators (default: euler-maruyama, backward-euler,
@@ -44,11 +45,14 @@ pub struct StabilityArgs {
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
-    /// Directory holding the scene files.
-    #[arg(long, default_value = "verification")]
-    scene_dir: PathBuf,
+    /// Directory of scene files: --scene names resolve there instead of among the
+    /// built-in scenes.
+    #[arg(long, value_name = "DIR")]
+    scene_dir: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    pub(super) sim: super::SimArgs,
 }
 
 /// Runs the study and prints the map on stderr; exit code 0 if every formula comparison
@@ -87,7 +91,8 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         &DEFAULT_DT_LAMBDA_MAX,
         "comma-separated numbers in (0, 1e12]",
     )?;
-    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
+    args.sim.apply(&mut scene);
     let s = run_stability(&StabilityOptions {
         scene,
         integrators,
@@ -102,8 +107,8 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         limits: args.limits.limits(),
     })?;
     eprintln!(
-        "stability map of {} (consistent noise; {} trajectories x {} steps after {} burn-in)",
-        s.scene, s.trajectories, s.sampled_steps, s.burn_in_steps
+        "stability map of {} (consistent noise; {} trajectories x {} steps after {} burn-in; seed {})",
+        s.scene, s.trajectories, s.sampled_steps, s.burn_in_steps, s.seed
     );
     let mut last = String::new();
     for c in &s.cells {

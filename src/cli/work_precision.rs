@@ -1,11 +1,12 @@
 //! `langevin-fem work-precision`: error in ⟨w²(L/2)⟩ against wall time for every
 //! integrator and noise model, with the projected cost of reaching a tolerance.
 
-use super::{parse_list_or, resolve_scene, usize_in};
+use super::{parse_list_or, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::noise::NoiseModel;
+use langevin_fem::scene::load_scene;
 use langevin_fem::studies::work_precision::{
     DEFAULT_DT_TAU1, DEFAULT_EM_FRACTIONS, DEFAULT_METHODS, WorkPrecisionOptions,
     run_work_precision,
@@ -15,7 +16,8 @@ use std::path::PathBuf;
 /// Command-line arguments of `langevin-fem work-precision`.
 #[derive(Debug, Args)]
 pub struct WorkPrecisionArgs {
-    /// Linear finite-element scene (name or .toml path): filament, mesh, seed, burn-in.
+    /// Linear finite-element scene (a built-in scene's name, a name in --scene-dir, or a
+    /// .toml path): filament, mesh, seed, burn-in.
     #[arg(long, value_name = "NAME|PATH", default_value = "hinged-linear-2d")]
     scene: String,
     /// Comma-separated methods INTEGRATOR/NOISE (default: euler-maruyama/element-uniform,
@@ -47,11 +49,14 @@ pub struct WorkPrecisionArgs {
     /// Output directory.
     #[arg(long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
-    /// Directory holding the scene files.
-    #[arg(long, default_value = "verification")]
-    scene_dir: PathBuf,
+    /// Directory of scene files: --scene names resolve there instead of among the
+    /// built-in scenes.
+    #[arg(long, value_name = "DIR")]
+    scene_dir: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    pub(super) sim: super::SimArgs,
 }
 
 fn parse_method(text: &str) -> Result<(IntegratorKind, NoiseModel)> {
@@ -93,7 +98,8 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         &DEFAULT_EM_FRACTIONS,
         "comma-separated numbers in (0, 1)",
     )?;
-    let scene = resolve_scene(&args.scene, &args.scene_dir)?;
+    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
+    args.sim.apply(&mut scene);
     let s = run_work_precision(&WorkPrecisionOptions {
         scene,
         methods,
@@ -108,9 +114,10 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         limits: args.limits.limits(),
     })?;
     eprintln!(
-        "{} ({} elements): <w2(L/2)> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",
+        "{} ({} elements, seed {}): <w2(L/2)> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",
         s.scene,
         s.elements,
+        s.seed,
         s.continuum,
         s.trajectories,
         s.duration_tau1,

@@ -409,7 +409,7 @@ mod tests {
     #[test]
     fn null_numbers_read_back_and_render() {
         let text = json!({
-            "run_id": "r", "scene": "s", "elements": 10, "observable": "w2(L/2)", "continuum": null,
+            "run_id": "r", "scene": "s", "seed": 7, "elements": 10, "observable": "w2(L/2)", "continuum": null,
             "tolerance": 0.01, "trajectories": 2, "duration_tau1": 50.0,
             "em_duration_tau1": 4.0, "threads": 1, "sampling_floor": null, "points": [],
             "methods": [{

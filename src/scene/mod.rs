@@ -3,6 +3,9 @@
 //!
 //! - [`spec`]: the scene types ([`Scene`], [`RunSpec`], [`CompressionSpec`], …) and
 //!   loading.
+//! - [`builtin`]: the project's scenes compiled into the binary, and the one resolver of
+//!   `--scene NAME|PATH` ([`load_scene`], [`resolve_scenes`]).
+//! - [`keys`]: the documentation of every scene key (meaning, unit, range, default).
 //! - [`validate`]: the one validator of linear and compression scenes
 //!   ([`Scene::validate`]), with one per-run check shared by both and one check of every
 //!   name that becomes a path component of the outputs ([`validate::is_path_name`]).
@@ -14,12 +17,15 @@
 //! Both [`crate::verify`] (pass/fail checks) and [`crate::studies`] (parametric studies)
 //! are built on the runs prepared here.
 
+pub mod builtin;
 pub mod compression;
+pub mod keys;
 pub mod linear;
 pub mod spec;
 pub mod validate;
 
+pub use builtin::{BUILTIN, BuiltinScene, SceneSource, load_scene, load_scenes, resolve_scenes};
 pub use spec::{
     Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, PrecisionTarget, RunSpec,
-    Sampling, Scene, StepSearch, resolve_scenes,
+    Sampling, Scene, StepSearch,
 };

@@ -421,14 +421,20 @@ pub struct Scene {
     pub source_text: String,
     /// Discretization.
     pub mesh: MeshSpec,
-    /// Sampling plan (linear models).
-    #[serde(default)]
+    /// Sampling plan (linear models; left out when a compression scene is written).
+    #[serde(default, skip_serializing_if = "is_unused_sampling")]
     pub sampling: Sampling,
     /// Strains and sampling (compression model).
     #[serde(default)]
     pub compression: Option<CompressionSpec>,
     /// Integrator/noise/time-step combinations.
     pub runs: Vec<RunSpec>,
+}
+
+/// Whether a scene's `[sampling]` table is the default one that a compression scene
+/// (which does not read it) has: not written out.
+fn is_unused_sampling(s: &Sampling) -> bool {
+    *s == Sampling::default()
 }
 
 impl Scene {
@@ -477,15 +483,22 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] naming the file, key, value and allowed range.
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+        Scene::parse_named(text, path, name)
+    }
+
+    /// [`Scene::parse`] with the scene's name given rather than taken from the file stem
+    /// (a built-in scene, whose `path` is a label such as `hinged-linear-2d (built in)`:
+    /// see [`crate::scene::builtin`]).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `path`, the key, value and allowed range.
+    pub fn parse_named(text: &str, path: &Path, name: &str) -> Result<Scene> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| parse_error(text, path, &e))?;
         scene.physical = FilamentTable::physical(text);
         scene.source_text = text.to_string();
         scene.path = path.to_path_buf();
-        scene.name = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scene")
-            .to_string();
+        scene.name = name.to_string();
         scene.validate()?;
         Ok(scene)
     }
@@ -858,35 +871,4 @@ fn value_key(text: &str, offset: usize) -> Option<String> {
     let (start, line) = line_at(text, offset);
     let eq = line.find('=')?;
     (header_name(line).is_none() && offset > start + eq).then(|| key_at(text, offset))
-}
-
-/// Resolves `--scene` arguments (names or paths) against `scene_dir`.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] naming an unknown scene and listing the known ones.
-pub fn resolve_scenes(names: &[String], scene_dir: &Path) -> Result<Vec<PathBuf>> {
-    if names.is_empty() {
-        return Scene::discover(scene_dir);
-    }
-    names
-        .iter()
-        .map(|n| {
-            let p = PathBuf::from(n);
-            if p.extension().is_some_and(|x| x == "toml") && p.exists() {
-                return Ok(p);
-            }
-            let known = Scene::discover(scene_dir)?;
-            known
-                .iter()
-                .find(|k| k.file_stem().is_some_and(|s| s == n.as_str()))
-                .cloned()
-                .ok_or_else(|| {
-                    let names: Vec<String> = known
-                        .iter()
-                        .filter_map(|k| k.file_stem().map(|s| s.to_string_lossy().into_owned()))
-                        .collect();
-                    Error::invalid("--scene", n, format!("one of: {}", names.join(", ")))
-                })
-        })
-        .collect()
 }

@@ -871,6 +871,10 @@ pub struct ConvergeSummary {
     pub run_id: String,
     /// Scene name.
     pub scene: String,
+    /// Master seed of the study: the scene's `seed`, or `--seed` when given (0 in a
+    /// summary written before the seed was stored).
+    #[serde(default)]
+    pub seed: u64,
     /// Run name (with `-as-<integrator>` if the integrator was overridden).
     pub run: String,
     /// Integrator.
@@ -1227,6 +1231,7 @@ fn finish(
     let summary = ConvergeSummary {
         run_id: report.run_id(),
         scene: scene.name.clone(),
+        seed: scene.seed,
         run: label.to_string(),
         integrator: spec.integrator.name().to_string(),
         noise: spec.noise.name().to_string(),

@@ -256,6 +256,10 @@ pub struct StabilitySummary {
     pub run_id: String,
     /// Scene name.
     pub scene: String,
+    /// Master seed of the study: the scene's `seed`, or `--seed` when given (0 in a
+    /// summary written before the seed was stored).
+    #[serde(default)]
+    pub seed: u64,
     /// Noise model (consistent).
     pub noise: String,
     /// Family-wise level.
@@ -714,6 +718,7 @@ pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let summary = StabilitySummary {
         run_id: report.run_id(),
         scene: opts.scene.name.clone(),
+        seed: opts.scene.seed,
         noise: NoiseModel::Consistent.name().to_string(),
         alpha: opts.alpha,
         trajectories: opts.trajectories,

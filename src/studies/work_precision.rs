@@ -206,6 +206,10 @@ pub struct WorkPrecisionSummary {
     pub run_id: String,
     /// Scene name.
     pub scene: String,
+    /// Master seed of the study: the scene's `seed`, or `--seed` when given (0 in a
+    /// summary written before the seed was stored).
+    #[serde(default)]
+    pub seed: u64,
     /// Elements of the mesh.
     pub elements: usize,
     /// The observable.
@@ -390,6 +394,7 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     let summary = WorkPrecisionSummary {
         run_id: report.run_id(),
         scene: opts.scene.name.clone(),
+        seed: opts.scene.seed,
         elements: opts.scene.mesh.elements,
         observable: "w2(L/2)".to_string(),
         continuum: points.first().map_or(f64::NAN, |p| p.continuum),

@@ -55,8 +55,8 @@ use std::time::Instant;
 /// Options of a verification run.
 #[derive(Debug, Clone)]
 pub struct VerifyOptions {
-    /// Scene files to run.
-    pub scenes: Vec<PathBuf>,
+    /// The scenes to run, loaded and validated ([`crate::scene::load_scenes`]).
+    pub scenes: Vec<Scene>,
     /// Budget.
     pub budget: Budget,
     /// Output directory.
@@ -104,14 +104,10 @@ pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
 /// ([`Error::Diverged`]), estimator or set-up failures ([`Error::RunFailed`]), I/O
 /// failures.
 pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
-    let scenes: Vec<Scene> = opts
-        .scenes
-        .iter()
-        .map(|p| Scene::load(p))
-        .collect::<Result<_>>()?;
+    let scenes = &opts.scenes;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
-    opts.limits.check(&projected_work(&scenes, opts.budget))?;
+    opts.limits.check(&projected_work(scenes, opts.budget))?;
     // Prepare every run first so that bad input is reported before any long work.
     let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
     for (scene, work) in scenes.iter().zip(&prepared) {
@@ -123,7 +119,7 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     }
     let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
-    let bar = progress_bar(trajectory_count(&scenes, opts.budget), opts.progress);
+    let bar = progress_bar(trajectory_count(scenes, opts.budget), opts.progress);
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
     for (scene, work) in scenes.iter().zip(&prepared) {
