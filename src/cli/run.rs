@@ -68,13 +68,6 @@ pub fn run(args: RunArgs) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
-    if scene.compression.is_some() || scene.model == ModelKind::Compression {
-        return Err(Error::invalid(
-            "--scene",
-            &args.scene,
-            "a linear scene (model fem or spectral): the trajectory format has no compression runs yet",
-        ));
-    }
     if let Some(d) = args.duration_tau1
         && !(d.is_finite() && (1.0..=1e6).contains(&d))
     {
@@ -106,6 +99,9 @@ pub fn run(args: RunArgs) -> Result<i32> {
             args.duration_tau1.unwrap_or(e.duration_tau1),
         )
     };
+    if scene.compression.is_some() {
+        return run_compression(&args, &scene, budget, &chosen, &ensemble, seed_note);
+    }
     let runs = chosen
         .iter()
         .map(|&k| {
@@ -178,6 +174,7 @@ pub fn run(args: RunArgs) -> Result<i32> {
                 dt: Some(run.reference.dt),
             }),
             files,
+            strain_ratio: None,
         });
     }
     bar.finish_and_clear();
@@ -194,6 +191,7 @@ pub fn run(args: RunArgs) -> Result<i32> {
             bending_rigidity: f.bending_rigidity,
             drag: f.drag,
             kt: f.kt,
+            stretch_rigidity: None,
         },
         runs: data_runs,
         provenance: Some(serde_json::json!({
@@ -278,4 +276,177 @@ fn progress(total: u64) -> ProgressBar {
         bar.set_style(style);
     }
     bar
+}
+
+/// `run` of a compression scene: per run and strain, every trajectory's F and stored
+/// length after the burn-in (the samples `verify` takes, same seeds), one data run per
+/// strain in the sidecar. A budget by target precision chooses durations by a pilot:
+/// `--duration-tau1` is then required.
+fn run_compression(
+    args: &RunArgs,
+    scene: &Scene,
+    budget: Budget,
+    chosen: &[usize],
+    ensemble: &dyn Fn(usize) -> (usize, f64),
+    seed_note: String,
+) -> Result<i32> {
+    use langevin_fem::scene::compression::CompressionRun;
+    let Some(comp) = &scene.compression else {
+        return Ok(2);
+    };
+    for &k in chosen {
+        let e = scene.runs[k].ensemble(budget);
+        if e.precision_target().is_some() && args.duration_tau1.is_none() {
+            return Err(Error::invalid(
+                "--duration-tau1",
+                "not given",
+                format!(
+                    "a duration in tau1: the {} budget of run {} chooses its durations by a pilot (target precision), which run does not do",
+                    budget.name(),
+                    scene.runs[k].name
+                ),
+            ));
+        }
+    }
+    let tau1 = scene.filament.tau1();
+    let runs = chosen
+        .iter()
+        .map(|&k| {
+            CompressionRun::prepare(scene, comp, &scene.runs[k])
+                .map_err(|e| scene.run_error(k, "integrator", e))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut projection = WorkProjection {
+        command: "run".to_string(),
+        parts: scene.projected_work(budget),
+    };
+    projection.parts = chosen
+        .iter()
+        .map(|&k| {
+            let mut part = projection.parts[k].clone();
+            let (n, d) = ensemble(k);
+            let e = scene.runs[k].ensemble(budget);
+            let scale =
+                (n as f64 / e.trajectories.max(1) as f64) * (d / e.duration_tau1.max(1e-300));
+            if scale.is_finite() {
+                part.work.trajectory_steps *= scale.max(1.0);
+                part.work.dof_steps *= scale.max(1.0);
+            }
+            part
+        })
+        .collect();
+    args.limits.limits().check(&projection)?;
+    let mut provenance = Provenance::begin(&[scene]);
+    let report = ReportRun::begin(&args.out, "run", "manifest.json", &[SIDECAR])?;
+    report.set_provenance(provenance.clone())?;
+    let ext = match args.format {
+        FormatArg::Npy => "npy",
+        FormatArg::Csv => "csv",
+    };
+    let total: u64 = chosen
+        .iter()
+        .map(|&k| (ensemble(k).0 * comp.strain_ratios.len()) as u64)
+        .sum();
+    let bar = progress(total);
+    let columns: Vec<String> = langevin_fem::data::COMPRESSION_COLUMNS
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    let f = scene.filament;
+    let euler_strain =
+        std::f64::consts::PI.powi(2) * f.bending_rigidity / (f.stretch_rigidity * f.length.powi(2));
+    let mut data_runs = Vec::new();
+    for (&k, run) in chosen.iter().zip(&runs) {
+        let spec = &scene.runs[k];
+        bar.set_message(format!("{} / {}", scene.name, spec.name));
+        let (n, duration) = ensemble(k);
+        let steps: Vec<u64> = (0..run.points())
+            .map(|i| run.sampled_steps_at(i, duration * tau1))
+            .collect();
+        let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", spec.name));
+        let records = run
+            .simulate_ensemble_per_point(seed, n, &steps, || bar.inc(1))
+            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+        for (i, at_strain) in records.iter().enumerate() {
+            let ratio = comp.strain_ratios[i];
+            let strain = ratio * euler_strain;
+            let (dts, burn_in) = (run.sample_dt_at(i), run.burn_in_at(i));
+            let mut files = Vec::new();
+            for (j, rec) in at_strain.iter().enumerate() {
+                let rel = format!("{}/strain-{i:02}/trajectory-{j:04}.{ext}", spec.name);
+                let path = args.out.join(&rel);
+                report.record(&path)?;
+                let mut file = langevin_fem::data::TrajectoryFile::create(
+                    &path,
+                    &columns,
+                    rec.force_ratio.len() as u64,
+                )?;
+                for (r, fr) in rec.force_ratio.iter().enumerate() {
+                    let force = fr * run.euler_load;
+                    let stored = (strain - force / f.stretch_rigidity) * f.length;
+                    file.push_row(&[burn_in + (r + 1) as f64 * dts, force, stored])?;
+                }
+                file.commit()?;
+                files.push(rel);
+            }
+            data_runs.push(DataRun {
+                name: spec.name.clone(),
+                dt_sample: dts,
+                start: Start::Stationary,
+                burn_in,
+                positions: Vec::new(),
+                modes: 0,
+                discretization: Some(Discretization {
+                    model: "fem".to_string(),
+                    elements: Some(scene.mesh.elements),
+                    integrator: Some(spec.integrator.to_string()),
+                    noise: Some(spec.noise.name().to_string()),
+                    dt: Some(run.dt_at(i)),
+                }),
+                files,
+                strain_ratio: Some(ratio),
+            });
+        }
+    }
+    bar.finish_and_clear();
+    provenance.finish();
+    report.set_provenance(provenance.clone())?;
+    let sidecar = DataSidecar {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
+        dims: scene.dims,
+        filament: DataFilament {
+            length: f.length,
+            bending_rigidity: f.bending_rigidity,
+            drag: f.drag,
+            kt: f.kt,
+            stretch_rigidity: Some(f.stretch_rigidity),
+        },
+        runs: data_runs,
+        provenance: Some(serde_json::json!({
+            "run_id": report.run_id(),
+            "budget": budget.name(),
+            "seed": scene.seed,
+            "seed_note": seed_note,
+            "tau1": tau1,
+            "journal": "manifest.json",
+            "record": provenance,
+        })),
+        columns: Some(trajectory_columns()),
+    };
+    let text = serde_json::to_string_pretty(&sidecar)
+        .map_err(|e| Error::io(args.out.join(SIDECAR), e.into()))?
+        + "\n";
+    report.finish(&[(SIDECAR, text.as_bytes())])?;
+    println!(
+        "wrote {total} trajectories of {} ({} run(s) x {} strains) to {}; check them with: langevin-fem check --scene {} --data {}",
+        scene.name,
+        chosen.len(),
+        comp.strain_ratios.len(),
+        args.out.display(),
+        args.scene,
+        args.out.display()
+    );
+    Ok(0)
 }

@@ -94,6 +94,8 @@ pub fn trajectory_columns() -> serde_json::Value {
         { "name": "v_#", "unit": "[L]", "meaning": "3D: second transverse deflection v at positions[#]" },
         { "name": "aw_#", "unit": "[L]", "meaning": "modal amplitude a_n of w, w(x) = sum_n a_n sin(n pi x / L), n = #" },
         { "name": "av_#", "unit": "[L]", "meaning": "3D: modal amplitude a_n of v, n = #" },
+        { "name": "force", "unit": "[E]/[L]", "meaning": "compression runs: compressive axial force F (F_c0 = pi^2 EI/L^2)" },
+        { "name": "stored_length", "unit": "[L]", "meaning": "compression runs: stored length (eps - F/EA) L" },
         { "name": "positions (sidecar)", "unit": "[L]", "meaning": "positions of the deflection columns" },
         { "name": "dt_sample, burn_in, discretization.dt (sidecar)", "unit": "[T]", "meaning": "time between rows, burn-in, integration step" }
     ])
@@ -111,17 +113,21 @@ pub struct DataFilament {
     pub drag: f64,
     /// Thermal energy kT.
     pub kt: f64,
+    /// Stretching rigidity EA (force): compression data only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_rigidity: Option<f64>,
 }
 
 impl DataFilament {
     /// The filament parameters (EA at its default: the linear checks do not use it).
     pub fn params(&self) -> FilamentParams {
+        let default = FilamentParams::default();
         FilamentParams {
             length: self.length,
             bending_rigidity: self.bending_rigidity,
             drag: self.drag,
             kt: self.kt,
-            ..FilamentParams::default()
+            stretch_rigidity: self.stretch_rigidity.unwrap_or(default.stretch_rigidity),
         }
     }
 }
@@ -159,6 +165,25 @@ pub struct DataRun {
     pub discretization: Option<Discretization>,
     /// Trajectory files, relative to the data directory.
     pub files: Vec<String>,
+    /// Compression data: the imposed strain ε/ε_c0 of these trajectories (one data run
+    /// per strain, sharing the run name); their columns are [`COMPRESSION_COLUMNS`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strain_ratio: Option<f64>,
+}
+
+/// The columns of a compression run's files: time, the compressive force F (force
+/// units; F_c0 = π²EI/L² is the Euler load) and the stored length s·L = (ε − F/EA)·L
+/// (length units).
+pub const COMPRESSION_COLUMNS: [&str; 3] = ["t", "force", "stored_length"];
+
+impl DataRun {
+    /// The column names of this run's files.
+    pub fn column_names(&self, dims: usize) -> Vec<String> {
+        match self.strain_ratio {
+            Some(_) => COMPRESSION_COLUMNS.iter().map(|c| c.to_string()).collect(),
+            None => columns(dims, self.positions.len(), self.modes),
+        }
+    }
 }
 
 /// The discretization that produced a run's data.
@@ -250,6 +275,7 @@ impl DataSidecar {
         }
         let f = &self.filament;
         for (key, v) in [
+            ("stretch_rigidity", f.stretch_rigidity.unwrap_or(1.0)),
             ("length", f.length),
             ("bending_rigidity", f.bending_rigidity),
             ("drag", f.drag),
@@ -292,8 +318,24 @@ impl DataRun {
                 ),
             ));
         }
-        if earlier.any(|r| r.name == self.name) {
-            return Err((key("name"), format!("{:?} is used twice", self.name)));
+        if earlier.any(|r| r.name == self.name && r.strain_ratio == self.strain_ratio) {
+            return Err((
+                key("name"),
+                format!(
+                    "{:?} is used twice{}",
+                    self.name,
+                    self.strain_ratio
+                        .map_or(String::new(), |r| format!(" at strain_ratio {r}"))
+                ),
+            ));
+        }
+        if let Some(r) = self.strain_ratio
+            && !(r.is_finite() && (-1e6..=1e6).contains(&r))
+        {
+            return Err((
+                key("strain_ratio"),
+                format!("must be a finite ratio in [-1e6, 1e6], got {r}"),
+            ));
         }
         if !(self.dt_sample.is_finite() && self.dt_sample > 0.0) {
             return Err((

@@ -274,6 +274,18 @@ impl CompressionRun {
         self.plans[point].dt
     }
 
+    /// The time between samples of F at strain `point` (physical time).
+    pub fn sample_dt_at(&self, point: usize) -> f64 {
+        let p = &self.plans[point];
+        p.sample_every as f64 * p.dt
+    }
+
+    /// The burn-in before the first sample at strain `point` (physical time).
+    pub fn burn_in_at(&self, point: usize) -> f64 {
+        let p = &self.plans[point];
+        p.burn_in_steps as f64 * p.burn_in_dt
+    }
+
     /// This run with its own time step at every strain, `dt_tau1[i]` (units of τ1) at
     /// strain `i` (burn-in and sampling interval kept in physical time): the outcome of a
     /// step search, which only schemes exact at any Δt may use (validated with the scene).

@@ -23,6 +23,7 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
 use crate::params::FilamentParams;
+use crate::scene::compression::{CompressionRun, CompressionTheoryTable, ForceRecord};
 use crate::scene::linear::{
     LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
 };
@@ -86,6 +87,15 @@ pub fn prepare_data_check(
                 sidecar.dims
             ),
         });
+    }
+    if let Some(r) = data.strain_ratio {
+        return Err(key_err(
+            "strain_ratio",
+            format!(
+                "is for compression data; scene {} is linear (its data have no strain), got {r}",
+                scene.name
+            ),
+        ));
     }
     for (j, path) in data.paths(dir).iter().enumerate() {
         if !path.is_file() {
@@ -487,4 +497,169 @@ fn discretization_error(data: &DataRun, key: &str, d: &Discretization) -> Error 
         format!("{d:?}"),
         "an integrator (euler-maruyama, backward-euler, crank-nicolson, exact-modal) and noise (consistent, element-uniform) as in scene files",
     )
+}
+
+/// The compression data of one run name: every strain of the scene, the exact theory
+/// it is judged against and the force records read from the files.
+pub struct CompressionDataCheck {
+    /// The run (prepared on the data's filament and discretization, for the checks).
+    pub run: CompressionRun,
+    /// The exact theory (discrete: the producer's discretization when it is this tool's
+    /// finite elements; otherwise the continuum in both columns).
+    pub theory: CompressionTheoryTable,
+    /// Per strain of the scene, per trajectory, F/F_c0 after the burn-in.
+    pub records: Vec<Vec<ForceRecord>>,
+    /// What a reader should know.
+    pub notes: Vec<String>,
+}
+
+/// Prepares the force checks of compression data: one [`CompressionDataCheck`] per run
+/// name of the sidecar, each holding one data run per strain of the scene.
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar key when a strain of the scene has no data, a
+/// data run has no strain, or EA is missing; file errors as [`read_table`]; the
+/// preparation's and the theory's errors.
+pub fn prepare_compression_checks(
+    scene: &Scene,
+    sidecar: &DataSidecar,
+    dir: &Path,
+) -> Result<Vec<CompressionDataCheck>> {
+    let sidecar_path = dir.join(crate::data::SIDECAR);
+    let bad = |key: String, message: String| Error::Scene {
+        file: sidecar_path.clone(),
+        key,
+        message,
+    };
+    let Some(comp) = &scene.compression else {
+        return Err(bad(
+            "runs".into(),
+            "compression data need a compression scene".into(),
+        ));
+    };
+    if sidecar.dims != scene.dims {
+        return Err(bad(
+            "dims".into(),
+            format!(
+                "must equal the scene's dims = {}, got {}",
+                scene.dims, sidecar.dims
+            ),
+        ));
+    }
+    if sidecar.filament.stretch_rigidity.is_none() {
+        return Err(bad(
+            "filament.stretch_rigidity".into(),
+            "must be given for compression data (EA: the force-strain law depends on it)".into(),
+        ));
+    }
+    if let Some(k) = sidecar.runs.iter().position(|r| r.strain_ratio.is_none()) {
+        return Err(bad(
+            format!("runs[{k}].strain_ratio"),
+            format!("must be given: scene {} is a compression scene", scene.name),
+        ));
+    }
+    let mut names: Vec<&str> = Vec::new();
+    for r in &sidecar.runs {
+        if !names.contains(&r.name.as_str()) {
+            names.push(&r.name);
+        }
+    }
+    let mut out = Vec::new();
+    for name in names {
+        let runs: Vec<(usize, &DataRun)> = sidecar
+            .runs
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.name == name)
+            .collect();
+        let mut notes = Vec::new();
+        let mut by_strain = Vec::new();
+        for &ratio in &comp.strain_ratios {
+            let found = runs.iter().find(|(_, r)| {
+                r.strain_ratio
+                    .is_some_and(|s| (s - ratio).abs() <= MATCH * ratio.abs().max(1.0))
+            });
+            match found {
+                Some(&(k, r)) => by_strain.push((k, r)),
+                None => {
+                    return Err(bad(
+                        "runs".into(),
+                        format!(
+                            "must hold run {name:?} at every strain ratio of scene {} ({:?}); strain_ratio {ratio} is missing",
+                            scene.name, comp.strain_ratios
+                        ),
+                    ));
+                }
+            }
+        }
+        let first = by_strain[0].1;
+        let mut scene = scene.clone();
+        scene.filament = sidecar.filament.params();
+        let fem = first
+            .discretization
+            .as_ref()
+            .filter(|d| d.model == "fem")
+            .and_then(|d| d.elements);
+        if let Some(elements) = fem {
+            scene.mesh.elements = elements;
+            scene.mesh.grading = 1.0;
+        }
+        let spec = data_spec(&scene, first);
+        let run = CompressionRun::prepare(&scene, comp, &spec)?;
+        let mut theory = CompressionTheoryTable::new(&scene, comp)?;
+        match fem {
+            Some(e) => notes.push(format!(
+                "run {name}: references: the exact equilibrium theory of the producer's discretization ({e} elements) at every strain; the continuum beside it"
+            )),
+            None => {
+                theory.discrete.clone_from(&theory.continuum);
+                for c in &mut theory.curve {
+                    c.1 = c.2;
+                }
+                theory.distributions.iter_mut().for_each(|d| *d = None);
+                notes.push(format!(
+                    "run {name}: references: the continuum theory (the producer's discretization is not this tool's finite elements); the distribution of F is not checked (its exact law is known for the discretized filament only)"
+                ));
+            }
+        }
+        let euler_load = run.euler_load;
+        let cols: Vec<String> = crate::data::COMPRESSION_COLUMNS
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        let mut records = Vec::new();
+        for &(k, data) in &by_strain {
+            let mut at_strain = Vec::new();
+            for (j, path) in data.paths(dir).iter().enumerate() {
+                if !path.is_file() {
+                    return Err(bad(
+                        format!("runs[{k}].files[{j}]"),
+                        format!(
+                            "must name a trajectory file; {} is not a file",
+                            path.display()
+                        ),
+                    ));
+                }
+                let table = read_table(path, &cols)?;
+                let t0 = if table.rows > 0 { table.get(0, 0) } else { 0.0 };
+                let first_row = ((data.burn_in - t0) / data.dt_sample - MATCH)
+                    .ceil()
+                    .max(0.0) as usize;
+                at_strain.push(ForceRecord {
+                    force_ratio: (first_row..table.rows)
+                        .map(|r| table.get(r, 1) / euler_load)
+                        .collect(),
+                    ..ForceRecord::default()
+                });
+            }
+            records.push(at_strain);
+        }
+        out.push(CompressionDataCheck {
+            run,
+            theory,
+            records,
+            notes,
+        });
+    }
+    Ok(out)
 }

@@ -958,6 +958,9 @@ pub fn check_data(
     alpha: f64,
 ) -> Result<(Summary, ReportRun)> {
     let sidecar = crate::data::DataSidecar::load(data_dir)?;
+    if scene.compression.is_some() {
+        return check_compression_data(scene, &sidecar, data_dir, out, alpha);
+    }
     let prepared = (0..sidecar.runs.len())
         .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k))
         .collect::<Result<Vec<_>>>()?;
@@ -1003,6 +1006,88 @@ pub fn check_data(
             data.burn_in
         ));
         write_run_outputs(&dir, &dc.run, &est, &mut outputs)?;
+    }
+    let scene_summary = finish_scene(scene, outputs, start, alpha, out)?;
+    let summary = Summary {
+        run_id: report.run_id(),
+        budget: "data".to_string(),
+        alpha,
+        passed: scene_summary.passed,
+        scenes: vec![scene_summary],
+        files: report.files(),
+        provenance: report.provenance_ref(),
+    };
+    Ok((summary, report))
+}
+
+/// [`check_data`] of a compression scene: per run name of the data, ⟨F⟩ at every strain
+/// of the scene (and the distribution of F, against the producer's discretization)
+/// with the force checks of `verify`, `<run>-force-strain.csv` and the scene's
+/// force–strain figure.
+fn check_compression_data(
+    scene: &Scene,
+    sidecar: &crate::data::DataSidecar,
+    data_dir: &Path,
+    out: &Path,
+    alpha: f64,
+) -> Result<(Summary, ReportRun)> {
+    let checks = crate::verify::data::prepare_compression_checks(scene, sidecar, data_dir)?;
+    let provenance = Provenance::begin(&[scene]);
+    let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
+    report.set_provenance(provenance)?;
+    let start = Instant::now();
+    let dir = out.join(&scene.name);
+    let mut outputs = SceneOutputs::new(scene, &report);
+    outputs.notes.push(format!(
+        "checked data: {} (producer: {})",
+        data_dir.display(),
+        if sidecar.producer.is_empty() {
+            "not given"
+        } else {
+            &sidecar.producer
+        }
+    ));
+    let mut fig: Option<Figure> = None;
+    for c in &checks {
+        let name = &c.run.spec.name;
+        let failed = |e: Error| {
+            Error::run_failed(format!("data run {name}"), "force checks", e).with_advice(
+                "the data did not support the estimate; longer or more trajectories may help",
+            )
+        };
+        let est = force_estimates_diagnosed(&c.records, &scene.filament).map_err(failed)?;
+        outputs.checks.extend(
+            compression_checks(
+                &c.run,
+                c.run.spec.checks(scene),
+                &c.theory,
+                &c.records,
+                &est,
+            )
+            .map_err(failed)?,
+        );
+        outputs.notes.extend(c.notes.iter().cloned());
+        let rows = force_strain_rows(&c.theory, &est);
+        outputs.write_table(
+            dir.join(format!("{name}-force-strain.csv")),
+            &FORCE_STRAIN_HEADER,
+            &rows,
+        )?;
+        let f = fig
+            .take()
+            .unwrap_or_else(|| force_strain_figure(scene, &c.theory));
+        fig = Some(
+            f.series(
+                Series::markers(
+                    format!("data: {name} (±1 s.e.)"),
+                    rows.iter().map(|r| (r[0], r[1])).collect(),
+                )
+                .with_errors(rows.iter().map(|r| r[2]).collect()),
+            ),
+        );
+    }
+    if let Some(f) = fig {
+        outputs.write_figure(&f, dir.join("force-strain.svg"))?;
     }
     let scene_summary = finish_scene(scene, outputs, start, alpha, out)?;
     let summary = Summary {
