@@ -72,6 +72,7 @@ macro_rules! builtin {
 
 /// Every scene file of the project, top-level scenes first, each group sorted by name.
 pub const BUILTIN: &[BuiltinScene] = &[
+    builtin!("actin-10um"),
     builtin!("compression-2d"),
     builtin!("compression-3d"),
     builtin!("hinged-linear-2d"),
@@ -323,6 +324,7 @@ mod tests {
         assert_eq!(
             names,
             [
+                "actin-10um",
                 "compression-2d",
                 "compression-3d",
                 "hinged-linear-2d",
@@ -344,7 +346,7 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         let m = e.to_string();
         assert!(
-            m.starts_with("--scene must be one of: compression-2d, "),
+            m.starts_with("--scene must be one of: actin-10um, compression-2d, "),
             "{m}"
         );
         assert!(m.contains("hinged-stiff-2d (the built-in scenes)"), "{m}");
@@ -352,7 +354,11 @@ mod tests {
         let e = resolve("no/such/file.toml", None).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("no file no/such/file.toml"), "{e}");
-        assert!(e.to_string().contains("one of: compression-2d, "), "{e}");
+        assert!(
+            e.to_string()
+                .contains("one of: actin-10um, compression-2d, "),
+            "{e}"
+        );
         let bad = Scene::parse_named("seed = 1", &find("compression-2d").unwrap().label(), "x");
         let m = bad.unwrap_err().to_string();
         assert!(m.starts_with("compression-2d (built in): key "), "{m}");
