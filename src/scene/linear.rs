@@ -944,10 +944,32 @@ impl LinearRun {
             + for<'a, 'b> Observer<LaneOf<'a, FemBatch<'b>>>
             + for<'s> Observer<dyn Sampler + 's>,
     {
-        let batches = count.div_ceil(LANES as u64);
+        // Without a lockstep batch (the explicit scheme, the exact modal one, the spectral
+        // model) every trajectory is a task of its own, so that even an ensemble of
+        // [`LANES`] or fewer trajectories uses every core.
+        if self.batch()?.is_none() {
+            return par_indexed(count, |t| {
+                let j = first + t;
+                let mut rng = trajectory_rng(seed, j);
+                let mut obs = make(j);
+                let mut sampler = self.sampler()?;
+                self.schedule(sampled_steps)
+                    .run(0, &mut *sampler, &mut rng, &mut obs, |_| {
+                        self.divergence_detail()
+                    })?;
+                done(1);
+                Ok(obs)
+            });
+        }
+        // Up to LANES trajectories per batch, fewer when the ensemble would leave a core
+        // idle (8 trajectories on 2 cores: two batches of 4). Each lane's trajectory is
+        // bit-identical to its serial run whatever the batch it is in.
+        let threads = rayon::current_num_threads().max(1) as u64;
+        let lanes = count.div_ceil(threads).clamp(1, LANES as u64);
+        let batches = count.div_ceil(lanes);
         let per_batch = par_indexed(batches, |b| {
-            let start = first + b * LANES as u64;
-            let end = (start + LANES as u64).min(first + count);
+            let start = first + b * lanes;
+            let end = (start + lanes).min(first + count);
             let mut rngs: Vec<TrajectoryRng> =
                 (start..end).map(|j| trajectory_rng(seed, j)).collect();
             let mut observers: Vec<O> = (start..end).map(&make).collect();
