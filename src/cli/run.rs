@@ -5,17 +5,19 @@
 use super::usize_in;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use langevin_fem::data::trajectory_columns;
 use langevin_fem::data::{
-    DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR, Start, VERSION,
+    COMPRESSION_COLUMNS, DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR,
+    Start, TrajectoryFile, VERSION, trajectory_columns,
 };
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::banded::LANES;
 use langevin_fem::output::{Provenance, ReportRun};
 use langevin_fem::rng::derive_seed;
-use langevin_fem::scene::linear::LinearRun;
+use langevin_fem::scene::compression::CompressionRun;
+use langevin_fem::scene::linear::{LinearRun, RowPlan};
 use langevin_fem::scene::{Budget, ModelKind, Scene};
 use langevin_fem::work::{RunWork, WorkProjection};
+use std::f64::consts::PI;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -63,6 +65,111 @@ enum FormatArg {
     Csv,
 }
 
+/// What one `run` command does: the scene (seed applied), the chosen runs and their
+/// ensembles.
+struct Job<'a> {
+    args: &'a RunArgs,
+    scene: Scene,
+    seed_note: String,
+    budget: Budget,
+    /// Indices of the chosen runs in the scene.
+    chosen: Vec<usize>,
+}
+
+impl Job<'_> {
+    /// Trajectories and sampled duration (τ1) of run `k`: the flags, else the budget's.
+    fn ensemble(&self, k: usize) -> (usize, f64) {
+        let e = self.scene.runs[k].ensemble(self.budget);
+        (
+            self.args.trajectories.unwrap_or(e.trajectories),
+            self.args.duration_tau1.unwrap_or(e.duration_tau1),
+        )
+    }
+
+    /// The file extension of the trajectories.
+    fn ext(&self) -> &'static str {
+        match self.args.format {
+            FormatArg::Npy => "npy",
+            FormatArg::Csv => "csv",
+        }
+    }
+
+    /// Starts the report directory with its provenance.
+    fn begin(&self) -> Result<(Provenance, ReportRun)> {
+        let provenance = Provenance::begin(&[&self.scene]);
+        let report = ReportRun::begin(&self.args.out, "run", "manifest.json", &[SIDECAR])?;
+        report.set_provenance(provenance.clone())?;
+        Ok((provenance, report))
+    }
+
+    /// Completes the report directory: the final provenance, then the sidecar listing
+    /// `runs` (EA given for compression data), and the closing line naming `what`.
+    fn finish(
+        &self,
+        mut provenance: Provenance,
+        report: ReportRun,
+        runs: Vec<DataRun>,
+        stretch_rigidity: Option<f64>,
+        what: String,
+    ) -> Result<i32> {
+        provenance.finish();
+        report.set_provenance(provenance.clone())?;
+        let (scene, f) = (&self.scene, self.scene.filament);
+        let sidecar = DataSidecar {
+            format: FORMAT.to_string(),
+            version: VERSION,
+            producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
+            dims: scene.dims,
+            filament: DataFilament {
+                length: f.length,
+                bending_rigidity: f.bending_rigidity,
+                drag: f.drag,
+                kt: f.kt,
+                stretch_rigidity,
+            },
+            runs,
+            provenance: Some(serde_json::json!({
+                "run_id": report.run_id(),
+                "budget": self.budget.name(),
+                "seed": scene.seed,
+                "seed_note": self.seed_note,
+                "tau1": f.tau1(),
+                "journal": "manifest.json",
+                "record": provenance,
+            })),
+            columns: Some(trajectory_columns()),
+        };
+        let out = &self.args.out;
+        let text = serde_json::to_string_pretty(&sidecar)
+            .map_err(|e| Error::io(out.join(SIDECAR), e.into()))?
+            + "\n";
+        report.finish(&[(SIDECAR, text.as_bytes())])?;
+        println!(
+            "wrote {what} to {}; check them with: langevin-fem check --scene {} --data {}",
+            out.display(),
+            self.args.scene,
+            out.display()
+        );
+        Ok(0)
+    }
+
+    /// The discretization of run `k` at time step `dt`, as the sidecar records it.
+    fn discretization(&self, k: usize, dt: f64) -> Discretization {
+        let spec = &self.scene.runs[k];
+        Discretization {
+            model: match self.scene.model {
+                ModelKind::Spectral => "spectral",
+                _ => "fem",
+            }
+            .to_string(),
+            elements: Some(self.scene.mesh.elements),
+            integrator: Some(spec.integrator.to_string()),
+            noise: Some(spec.noise.name().to_string()),
+            dt: Some(dt),
+        }
+    }
+}
+
 /// Runs the command; exit code 0.
 pub fn run(args: RunArgs) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
@@ -87,153 +194,117 @@ pub fn run(args: RunArgs) -> Result<i32> {
             ));
         }
     }
-    let budget = args.budget.budget();
-    let tau1 = scene.filament.tau1();
     let chosen: Vec<usize> = (0..scene.runs.len())
         .filter(|&k| args.runs.is_empty() || args.runs.contains(&scene.runs[k].name))
         .collect();
-    let ensemble = |k: usize| {
-        let e = scene.runs[k].ensemble(budget);
-        (
-            args.trajectories.unwrap_or(e.trajectories),
-            args.duration_tau1.unwrap_or(e.duration_tau1),
-        )
+    let job = Job {
+        budget: args.budget.budget(),
+        args: &args,
+        scene,
+        seed_note,
+        chosen,
     };
-    if scene.compression.is_some() {
-        return run_compression(&args, &scene, budget, &chosen, &ensemble, seed_note);
+    if job.scene.compression.is_some() {
+        run_compression(&job)
+    } else {
+        run_linear(&job)
     }
-    let runs = chosen
+}
+
+/// `run` of a linear scene: every chosen run's trajectories from rest, streamed.
+fn run_linear(job: &Job<'_>) -> Result<i32> {
+    let (scene, args) = (&job.scene, job.args);
+    let tau1 = scene.filament.tau1();
+    let runs = job
+        .chosen
         .iter()
         .map(|&k| {
-            LinearRun::prepare(&scene, &scene.runs[k])
+            LinearRun::prepare(scene, &scene.runs[k])
                 .map_err(|e| scene.run_error(k, "integrator", e))
         })
         .collect::<Result<Vec<_>>>()?;
-    let ext = match args.format {
-        FormatArg::Npy => "npy",
-        FormatArg::Csv => "csv",
-    };
-    let plans = chosen
+    let plans = job
+        .chosen
         .iter()
         .zip(&runs)
         .map(|(&k, run)| {
-            let steps = run.sampled_steps(ensemble(k).1 * tau1);
-            run.row_plan(&scene, steps, args.every)
+            let steps = run.sampled_steps(job.ensemble(k).1 * tau1);
+            run.row_plan(scene, steps, args.every)
         })
         .collect::<Result<Vec<_>>>()?;
-    args.limits
-        .limits()
-        .check(&projection(&scene, budget, &chosen, &plans, &ensemble))?;
-    let mut provenance = Provenance::begin(&[&scene]);
-    let report = ReportRun::begin(&args.out, "run", "manifest.json", &[SIDECAR])?;
-    report.set_provenance(provenance.clone())?;
-    let total: u64 = chosen.iter().map(|&k| ensemble(k).0 as u64).sum();
+    args.limits.limits().check(&projection(job, &plans))?;
+    let (provenance, report) = job.begin()?;
+    let total: u64 = job.chosen.iter().map(|&k| job.ensemble(k).0 as u64).sum();
     let bar = progress(total);
     let mut data_runs = Vec::new();
-    for ((&k, run), plan) in chosen.iter().zip(&runs).zip(&plans) {
-        let spec = &scene.runs[k];
-        bar.set_message(format!("{} / {}", scene.name, spec.name));
-        let count = ensemble(k).0 as u64;
-        let files: Vec<String> = (0..count)
-            .map(|j| format!("{}/trajectory-{j:04}.{ext}", spec.name))
-            .collect();
-        for f in &files {
-            report.record(&args.out.join(f))?;
-        }
-        let seed = derive_seed(scene.seed, &spec.name);
-        run.write_ensemble(
-            seed,
-            count,
-            plan,
-            |j| args.out.join(&files[j as usize]),
-            |n| bar.inc(n),
-        )
-        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        if !std::io::stderr().is_terminal() {
-            eprintln!(
-                "{} / {}: {count} trajectories x {} rows",
-                scene.name, spec.name, plan.rows
-            );
-        }
-        data_runs.push(DataRun {
-            name: spec.name.clone(),
-            dt_sample: plan.every as f64 * run.reference.dt,
-            start: Start::Rest,
-            burn_in: run.burn_in_steps as f64 * run.reference.dt,
-            positions: plan.positions.clone(),
-            modes: run.reference.modes.len(),
-            discretization: Some(Discretization {
-                model: match scene.model {
-                    ModelKind::Spectral => "spectral",
-                    _ => "fem",
-                }
-                .to_string(),
-                elements: Some(scene.mesh.elements),
-                integrator: Some(spec.integrator.to_string()),
-                noise: Some(spec.noise.name().to_string()),
-                dt: Some(run.reference.dt),
-            }),
-            files,
-            strain_ratio: None,
-        });
+    for ((&k, run), plan) in job.chosen.iter().zip(&runs).zip(&plans) {
+        data_runs.push(write_linear_run(job, &report, k, run, plan, &bar)?);
     }
     bar.finish_and_clear();
-    provenance.finish();
-    report.set_provenance(provenance.clone())?;
-    let f = scene.filament;
-    let sidecar = DataSidecar {
-        format: FORMAT.to_string(),
-        version: VERSION,
-        producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
-        dims: scene.dims,
-        filament: DataFilament {
-            length: f.length,
-            bending_rigidity: f.bending_rigidity,
-            drag: f.drag,
-            kt: f.kt,
-            stretch_rigidity: None,
-        },
-        runs: data_runs,
-        provenance: Some(serde_json::json!({
-            "run_id": report.run_id(),
-            "budget": budget.name(),
-            "seed": scene.seed,
-            "seed_note": seed_note,
-            "tau1": tau1,
-            "journal": "manifest.json",
-            "record": provenance,
-        })),
-        columns: Some(trajectory_columns()),
-    };
-    let text = serde_json::to_string_pretty(&sidecar)
-        .map_err(|e| Error::io(args.out.join(SIDECAR), e.into()))?
-        + "\n";
-    report.finish(&[(SIDECAR, text.as_bytes())])?;
-    println!(
-        "wrote {} trajectories of {} ({} run(s)) to {}; check them with: langevin-fem check --scene {} --data {}",
-        total,
+    let what = format!(
+        "{total} trajectories of {} ({} run(s))",
         scene.name,
-        chosen.len(),
-        args.out.display(),
-        args.scene,
-        args.out.display()
+        job.chosen.len()
     );
-    Ok(0)
+    job.finish(provenance, report, data_runs, None, what)
+}
+
+/// Simulates and writes the trajectories of linear run `k`; returns its sidecar entry.
+fn write_linear_run(
+    job: &Job<'_>,
+    report: &ReportRun,
+    k: usize,
+    run: &LinearRun,
+    plan: &RowPlan,
+    bar: &ProgressBar,
+) -> Result<DataRun> {
+    let (scene, out) = (&job.scene, &job.args.out);
+    let spec = &scene.runs[k];
+    bar.set_message(format!("{} / {}", scene.name, spec.name));
+    let count = job.ensemble(k).0 as u64;
+    let files: Vec<String> = (0..count)
+        .map(|j| format!("{}/trajectory-{j:04}.{}", spec.name, job.ext()))
+        .collect();
+    for f in &files {
+        report.record(&out.join(f))?;
+    }
+    let seed = derive_seed(scene.seed, &spec.name);
+    run.write_ensemble(
+        seed,
+        count,
+        plan,
+        |j| out.join(&files[j as usize]),
+        |n| bar.inc(n),
+    )
+    .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    if !std::io::stderr().is_terminal() {
+        eprintln!(
+            "{} / {}: {count} trajectories x {} rows",
+            scene.name, spec.name, plan.rows
+        );
+    }
+    let dt = run.reference.dt;
+    Ok(DataRun {
+        name: spec.name.clone(),
+        dt_sample: plan.every as f64 * dt,
+        start: Start::Rest,
+        burn_in: run.burn_in_steps as f64 * dt,
+        positions: plan.positions.clone(),
+        modes: run.reference.modes.len(),
+        discretization: Some(job.discretization(k, dt)),
+        files,
+        strain_ratio: None,
+    })
 }
 
 /// The projected work: per chosen run, every trajectory's steps (burn-in included)
 /// times the unknowns each updates, at the cost per step of the scene's own projection.
-fn projection(
-    scene: &Scene,
-    budget: Budget,
-    chosen: &[usize],
-    plans: &[langevin_fem::scene::linear::RowPlan],
-    ensemble: &dyn Fn(usize) -> (usize, f64),
-) -> WorkProjection {
-    let parts = scene.projected_work(budget);
+fn projection(job: &Job<'_>, plans: &[RowPlan]) -> WorkProjection {
+    let parts = job.scene.projected_work(job.budget);
     WorkProjection {
         command: "run".to_string(),
-        parts: chosen
+        parts: job
+            .chosen
             .iter()
             .zip(plans)
             .map(|(&k, plan)| {
@@ -244,7 +315,7 @@ fn projection(
                 } else {
                     0.0
                 };
-                let n = ensemble(k).0 as f64;
+                let n = job.ensemble(k).0 as f64;
                 let steps = n * (plan.rows * plan.every) as f64;
                 part.work = RunWork {
                     trajectory_steps: steps,
@@ -282,171 +353,145 @@ fn progress(total: u64) -> ProgressBar {
 /// length after the burn-in (the samples `verify` takes, same seeds), one data run per
 /// strain in the sidecar. A budget by target precision chooses durations by a pilot:
 /// `--duration-tau1` is then required.
-fn run_compression(
-    args: &RunArgs,
-    scene: &Scene,
-    budget: Budget,
-    chosen: &[usize],
-    ensemble: &dyn Fn(usize) -> (usize, f64),
-    seed_note: String,
-) -> Result<i32> {
-    use langevin_fem::scene::compression::CompressionRun;
+fn run_compression(job: &Job<'_>) -> Result<i32> {
+    let (scene, args) = (&job.scene, job.args);
     let Some(comp) = &scene.compression else {
-        return Ok(2);
+        return run_linear(job);
     };
-    for &k in chosen {
-        let e = scene.runs[k].ensemble(budget);
+    for &k in &job.chosen {
+        let e = scene.runs[k].ensemble(job.budget);
         if e.precision_target().is_some() && args.duration_tau1.is_none() {
             return Err(Error::invalid(
                 "--duration-tau1",
                 "not given",
                 format!(
                     "a duration in tau1: the {} budget of run {} chooses its durations by a pilot (target precision), which run does not do",
-                    budget.name(),
+                    job.budget.name(),
                     scene.runs[k].name
                 ),
             ));
         }
     }
-    let tau1 = scene.filament.tau1();
-    let runs = chosen
+    let runs = job
+        .chosen
         .iter()
         .map(|&k| {
             CompressionRun::prepare(scene, comp, &scene.runs[k])
                 .map_err(|e| scene.run_error(k, "integrator", e))
         })
         .collect::<Result<Vec<_>>>()?;
-    let mut projection = WorkProjection {
-        command: "run".to_string(),
-        parts: scene.projected_work(budget),
-    };
-    projection.parts = chosen
+    args.limits.limits().check(&compression_projection(job))?;
+    let (provenance, report) = job.begin()?;
+    let strains = comp.strain_ratios.len();
+    let total: u64 = job
+        .chosen
         .iter()
-        .map(|&k| {
-            let mut part = projection.parts[k].clone();
-            let (n, d) = ensemble(k);
-            let e = scene.runs[k].ensemble(budget);
-            let scale =
-                (n as f64 / e.trajectories.max(1) as f64) * (d / e.duration_tau1.max(1e-300));
-            if scale.is_finite() {
-                part.work.trajectory_steps *= scale.max(1.0);
-                part.work.dof_steps *= scale.max(1.0);
-            }
-            part
-        })
-        .collect();
-    args.limits.limits().check(&projection)?;
-    let mut provenance = Provenance::begin(&[scene]);
-    let report = ReportRun::begin(&args.out, "run", "manifest.json", &[SIDECAR])?;
-    report.set_provenance(provenance.clone())?;
-    let ext = match args.format {
-        FormatArg::Npy => "npy",
-        FormatArg::Csv => "csv",
-    };
-    let total: u64 = chosen
-        .iter()
-        .map(|&k| (ensemble(k).0 * comp.strain_ratios.len()) as u64)
+        .map(|&k| (job.ensemble(k).0 * strains) as u64)
         .sum();
     let bar = progress(total);
-    let columns: Vec<String> = langevin_fem::data::COMPRESSION_COLUMNS
-        .iter()
-        .map(|c| c.to_string())
-        .collect();
-    let f = scene.filament;
-    let euler_strain =
-        std::f64::consts::PI.powi(2) * f.bending_rigidity / (f.stretch_rigidity * f.length.powi(2));
     let mut data_runs = Vec::new();
-    for (&k, run) in chosen.iter().zip(&runs) {
-        let spec = &scene.runs[k];
-        bar.set_message(format!("{} / {}", scene.name, spec.name));
-        let (n, duration) = ensemble(k);
-        let steps: Vec<u64> = (0..run.points())
-            .map(|i| run.sampled_steps_at(i, duration * tau1))
-            .collect();
-        let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", spec.name));
-        let records = run
-            .simulate_ensemble_per_point(seed, n, &steps, || bar.inc(1))
-            .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-        for (i, at_strain) in records.iter().enumerate() {
-            let ratio = comp.strain_ratios[i];
-            let strain = ratio * euler_strain;
-            let (dts, burn_in) = (run.sample_dt_at(i), run.burn_in_at(i));
-            let mut files = Vec::new();
-            for (j, rec) in at_strain.iter().enumerate() {
-                let rel = format!("{}/strain-{i:02}/trajectory-{j:04}.{ext}", spec.name);
-                let path = args.out.join(&rel);
-                report.record(&path)?;
-                let mut file = langevin_fem::data::TrajectoryFile::create(
-                    &path,
-                    &columns,
-                    rec.force_ratio.len() as u64,
-                )?;
-                for (r, fr) in rec.force_ratio.iter().enumerate() {
-                    let force = fr * run.euler_load;
-                    let stored = (strain - force / f.stretch_rigidity) * f.length;
-                    file.push_row(&[burn_in + (r + 1) as f64 * dts, force, stored])?;
-                }
-                file.commit()?;
-                files.push(rel);
-            }
-            data_runs.push(DataRun {
-                name: spec.name.clone(),
-                dt_sample: dts,
-                start: Start::Stationary,
-                burn_in,
-                positions: Vec::new(),
-                modes: 0,
-                discretization: Some(Discretization {
-                    model: "fem".to_string(),
-                    elements: Some(scene.mesh.elements),
-                    integrator: Some(spec.integrator.to_string()),
-                    noise: Some(spec.noise.name().to_string()),
-                    dt: Some(run.dt_at(i)),
-                }),
-                files,
-                strain_ratio: Some(ratio),
-            });
-        }
+    for (&k, run) in job.chosen.iter().zip(&runs) {
+        data_runs.extend(write_compression_run(job, &report, k, run, &bar)?);
     }
     bar.finish_and_clear();
-    provenance.finish();
-    report.set_provenance(provenance.clone())?;
-    let sidecar = DataSidecar {
-        format: FORMAT.to_string(),
-        version: VERSION,
-        producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
-        dims: scene.dims,
-        filament: DataFilament {
-            length: f.length,
-            bending_rigidity: f.bending_rigidity,
-            drag: f.drag,
-            kt: f.kt,
-            stretch_rigidity: Some(f.stretch_rigidity),
-        },
-        runs: data_runs,
-        provenance: Some(serde_json::json!({
-            "run_id": report.run_id(),
-            "budget": budget.name(),
-            "seed": scene.seed,
-            "seed_note": seed_note,
-            "tau1": tau1,
-            "journal": "manifest.json",
-            "record": provenance,
-        })),
-        columns: Some(trajectory_columns()),
-    };
-    let text = serde_json::to_string_pretty(&sidecar)
-        .map_err(|e| Error::io(args.out.join(SIDECAR), e.into()))?
-        + "\n";
-    report.finish(&[(SIDECAR, text.as_bytes())])?;
-    println!(
-        "wrote {total} trajectories of {} ({} run(s) x {} strains) to {}; check them with: langevin-fem check --scene {} --data {}",
+    let what = format!(
+        "{total} trajectories of {} ({} run(s) x {strains} strains)",
         scene.name,
-        chosen.len(),
-        comp.strain_ratios.len(),
-        args.out.display(),
-        args.scene,
-        args.out.display()
+        job.chosen.len()
     );
-    Ok(0)
+    job.finish(
+        provenance,
+        report,
+        data_runs,
+        Some(scene.filament.stretch_rigidity),
+        what,
+    )
+}
+
+/// The projected work of the chosen compression runs: the scene's projection at the
+/// budget, scaled up to the flags' trajectories and duration.
+fn compression_projection(job: &Job<'_>) -> WorkProjection {
+    let parts = job.scene.projected_work(job.budget);
+    WorkProjection {
+        command: "run".to_string(),
+        parts: job
+            .chosen
+            .iter()
+            .map(|&k| {
+                let mut part = parts[k].clone();
+                let (n, d) = job.ensemble(k);
+                let e = job.scene.runs[k].ensemble(job.budget);
+                let scale =
+                    (n as f64 / e.trajectories.max(1) as f64) * (d / e.duration_tau1.max(1e-300));
+                if scale.is_finite() {
+                    part.work.trajectory_steps *= scale.max(1.0);
+                    part.work.dof_steps *= scale.max(1.0);
+                }
+                part
+            })
+            .collect(),
+    }
+}
+
+/// Simulates compression run `k` at every strain and writes each trajectory's F and
+/// stored length; returns one sidecar entry per strain.
+fn write_compression_run(
+    job: &Job<'_>,
+    report: &ReportRun,
+    k: usize,
+    run: &CompressionRun,
+    bar: &ProgressBar,
+) -> Result<Vec<DataRun>> {
+    let scene = &job.scene;
+    let (Some(comp), f) = (&scene.compression, scene.filament) else {
+        return Ok(Vec::new());
+    };
+    let spec = &scene.runs[k];
+    bar.set_message(format!("{} / {}", scene.name, spec.name));
+    let (n, duration) = job.ensemble(k);
+    let steps: Vec<u64> = (0..run.points())
+        .map(|i| run.sampled_steps_at(i, duration * f.tau1()))
+        .collect();
+    let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", spec.name));
+    let records = run
+        .simulate_ensemble_per_point(seed, n, &steps, || bar.inc(1))
+        .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    let columns: Vec<String> = COMPRESSION_COLUMNS.iter().map(|c| c.to_string()).collect();
+    let euler_strain = PI.powi(2) * f.bending_rigidity / (f.stretch_rigidity * f.length.powi(2));
+    let mut data_runs = Vec::new();
+    for (i, at_strain) in records.iter().enumerate() {
+        let ratio = comp.strain_ratios[i];
+        let strain = ratio * euler_strain;
+        let (dts, burn_in) = (run.sample_dt_at(i), run.burn_in_at(i));
+        let mut files = Vec::new();
+        for (j, rec) in at_strain.iter().enumerate() {
+            let rel = format!(
+                "{}/strain-{i:02}/trajectory-{j:04}.{}",
+                spec.name,
+                job.ext()
+            );
+            let path = job.args.out.join(&rel);
+            report.record(&path)?;
+            let mut file = TrajectoryFile::create(&path, &columns, rec.force_ratio.len() as u64)?;
+            for (r, fr) in rec.force_ratio.iter().enumerate() {
+                let force = fr * run.euler_load;
+                let stored = (strain - force / f.stretch_rigidity) * f.length;
+                file.push_row(&[burn_in + (r + 1) as f64 * dts, force, stored])?;
+            }
+            file.commit()?;
+            files.push(rel);
+        }
+        data_runs.push(DataRun {
+            name: spec.name.clone(),
+            dt_sample: dts,
+            start: Start::Stationary,
+            burn_in,
+            positions: Vec::new(),
+            modes: 0,
+            discretization: Some(job.discretization(k, run.dt_at(i))),
+            files,
+            strain_ratio: Some(ratio),
+        });
+    }
+    Ok(data_runs)
 }
