@@ -25,35 +25,13 @@ static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 /// [`Error::Io`] naming `path` if a directory cannot be created or the file cannot be
 /// written or renamed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let file_name = path.file_name().ok_or_else(|| {
-        Error::io(
-            path,
-            io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
-        )
-    })?;
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-
-    let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-    let mut temp_name = std::ffi::OsString::from(".");
-    temp_name.push(file_name);
-    temp_name.push(format!(".tmp.{}.{n}", std::process::id()));
-    let temp = dir.join(temp_name);
-
-    let result = write_and_sync(&temp, bytes).and_then(|()| fs::rename(&temp, path));
-    if let Err(e) = result {
-        let _ = fs::remove_file(&temp);
-        return Err(Error::io(path, e));
-    }
-    sync_dir(&dir);
-    Ok(())
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    file.commit()
 }
 
 /// A file written by streaming and made visible atomically: the bytes go to a temporary
-/// file in the destination directory (named as [`write_atomic`] names its own, so
+/// file in the destination directory, `.<name>.tmp.<pid>.<n>` (so
 /// [`remove_stale_temporaries`] removes it after an interruption), and
 /// [`AtomicFile::commit`] syncs it and renames it over the destination. Dropped without
 /// a commit, the temporary file is removed.
@@ -201,12 +179,6 @@ fn is_stale_temporary(path: &Path) -> bool {
             .and_then(|t| t.elapsed().ok())
             .is_some_and(|age| age.as_secs() > 86_400)
     }
-}
-
-fn write_and_sync(temp: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut file = OpenOptions::new().write(true).create_new(true).open(temp)?;
-    file.write_all(bytes)?;
-    file.sync_all()
 }
 
 /// Makes the rename durable where the platform allows it (best effort: a failure here

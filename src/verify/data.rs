@@ -62,13 +62,75 @@ pub fn prepare_data_check(
     dir: &Path,
     k: usize,
 ) -> Result<DataCheck> {
-    let sidecar_path = dir.join(crate::data::SIDECAR);
+    check_linear_data(scene, sidecar, dir, k)?;
     let data = &sidecar.runs[k];
-    let key_err = |key: &str, message: String| Error::Scene {
-        file: sidecar_path.clone(),
+    let filament = sidecar.filament.params();
+    let continuum = HingedBeam::new(filament)?;
+    let mut notes = Vec::new();
+    let discrete = discrete_run(scene, filament, data, &mut notes)?;
+    let spec = data_spec(scene, data);
+    let (modes, scale, discrete) = mode_references(scene, data, &continuum, discrete, &mut notes);
+    let d = discrete.as_ref();
+    let profile = profile_references(scene, data, filament.length, &continuum, d, &mut notes);
+    let (two_time, tt_cols) =
+        two_time_references(scene, data, filament, &continuum, d, &mut notes)?;
+    let dts = data.dt_sample;
+    let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
+    let mode_every: Vec<u64> = modes
+        .iter()
+        .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))
+        .collect();
+    let rate1 = continuum.mode_rate(1);
+    let profile_every = every(4.0 * rate1);
+    let max_rate = modes.last().map_or(rate1, |m| m.rate_continuum);
+    let components = scene.dims - 1;
+    let reference = LinearReference {
+        modes,
+        profile_x: profile.0,
+        profile_discrete: profile.1,
+        profile_continuum: profile.2,
+        two_time,
+        dt: dts,
+        max_rate,
+    };
+    let run = LinearRun::for_data(
+        spec,
+        components,
+        reference,
+        mode_every,
+        profile_every,
+        scale,
+    );
+    let layout = Layout {
+        n_positions: data.positions.len(),
+        n_modes_data: data.modes,
+        profile_cols: profile.3,
+        tt_cols,
+    };
+    let (records, products) = read_records(&run, sidecar, dir, k, &layout)?;
+    Ok(DataCheck {
+        run,
+        records,
+        two_time: products,
+        notes,
+    })
+}
+
+/// The error of key `runs[k].<key>` of the sidecar in `dir`.
+fn sidecar_error(dir: &Path, k: usize, key: &str, message: String) -> Error {
+    Error::Scene {
+        file: dir.join(crate::data::SIDECAR),
         key: format!("runs[{k}].{key}"),
         message,
-    };
+    }
+}
+
+/// Refuses data run `k` unless `scene` is linear, the dimensions agree, the run has no
+/// strain and every listed file exists.
+fn check_linear_data(scene: &Scene, sidecar: &DataSidecar, dir: &Path, k: usize) -> Result<()> {
+    let sidecar_path = dir.join(crate::data::SIDECAR);
+    let data = &sidecar.runs[k];
+    let key_err = |key: &str, message: String| sidecar_error(dir, k, key, message);
     if scene.compression.is_some() || scene.model == ModelKind::Compression {
         return Err(Error::Scene {
             file: scene.path.clone(),
@@ -97,9 +159,16 @@ pub fn prepare_data_check(
             ),
         ));
     }
+    require_files(data, dir, k)
+}
+
+/// Refuses data run `k` unless every file it lists exists.
+fn require_files(data: &DataRun, dir: &Path, k: usize) -> Result<()> {
     for (j, path) in data.paths(dir).iter().enumerate() {
         if !path.is_file() {
-            return Err(key_err(
+            return Err(sidecar_error(
+                dir,
+                k,
                 &format!("files[{j}]"),
                 format!(
                     "must name a trajectory file in the data directory; {} is not a file",
@@ -108,12 +177,19 @@ pub fn prepare_data_check(
             ));
         }
     }
-    let filament = sidecar.filament.params();
-    let continuum = HingedBeam::new(filament)?;
-    let tau1 = filament.tau1();
-    let mut notes = Vec::new();
-    let discrete = discrete_run(scene, filament, data, &mut notes)?;
-    let spec = data_spec(scene, data);
+    Ok(())
+}
+
+/// The mode references of data run `data` in rows of the data, and the factors that
+/// turn its aₙ into their units: the producer's discretization's (`discrete`, kept only
+/// if a row is a whole number of its steps) or the continuum's; the notes say which.
+fn mode_references(
+    scene: &Scene,
+    data: &DataRun,
+    continuum: &HingedBeam,
+    discrete: Option<LinearRun>,
+    notes: &mut Vec<String>,
+) -> (Vec<ModeReference>, Vec<f64>, Option<LinearRun>) {
     let n_modes = scene.sampling.modes.min(data.modes);
     if data.modes < scene.sampling.modes {
         notes.push(format!(
@@ -180,20 +256,34 @@ pub fn prepare_data_check(
             data.name
         ));
     }
-    let length = filament.length;
-    let column_of = |x: f64| {
-        data.positions
-            .iter()
-            .position(|&p| (p - x).abs() <= MATCH * length)
-    };
+    (modes, scale, discrete)
+}
+
+/// The column of the data's position `x`, if any.
+fn column_of(data: &DataRun, length: f64, x: f64) -> Option<usize> {
+    data.positions
+        .iter()
+        .position(|&p| (p - x).abs() <= MATCH * length)
+}
+
+/// The scene's profile points among the data's positions: x, discrete and continuum
+/// references, column; the others are noted as not checked.
+fn profile_references(
+    scene: &Scene,
+    data: &DataRun,
+    length: f64,
+    continuum: &HingedBeam,
+    discrete: Option<&LinearRun>,
+    notes: &mut Vec<String>,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<usize>) {
     // Profile points present in the data.
     let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (j, f) in scene.sampling.profile_points.iter().enumerate() {
         let x = f * length;
-        match column_of(x) {
+        match column_of(data, length, x) {
             Some(col) => {
                 profile.0.push(x);
-                profile.1.push(match &discrete {
+                profile.1.push(match discrete {
                     Some(d) => d.reference.profile_discrete[j],
                     None => continuum.profile_variance(x),
                 });
@@ -206,13 +296,28 @@ pub fn prepare_data_check(
             )),
         }
     }
+    profile
+}
+
+/// The scene's two-time points on the data's rows and positions, from rest only: the
+/// references (with row indices as steps) and the columns of x and y; the others are
+/// noted as not checked.
+fn two_time_references(
+    scene: &Scene,
+    data: &DataRun,
+    filament: FilamentParams,
+    continuum: &HingedBeam,
+    discrete: Option<&LinearRun>,
+    notes: &mut Vec<String>,
+) -> Result<TwoTimeRefs> {
+    let (length, tau1, dts) = (filament.length, filament.tau1(), data.dt_sample);
     // Two-time points on the rows, from rest only.
     let mut two_time = Vec::new();
     let mut tt_cols = Vec::new();
     if data.start == Start::Rest {
         for (j, q) in scene.sampling.two_time.iter().enumerate() {
             let (x, y) = (q[0] * length, q[1] * length);
-            let (t, eta) = match &discrete {
+            let (t, eta) = match discrete {
                 Some(d) => (d.reference.two_time[j].t, d.reference.two_time[j].eta),
                 None => (q[2] * tau1, q[3] * tau1),
             };
@@ -220,7 +325,12 @@ pub fn prepare_data_check(
                 let r = time / dts;
                 ((r - r.round()).abs() <= MATCH * r.max(1.0)).then(|| r.round() as u64)
             };
-            match (column_of(x), column_of(y), row(t), row(eta)) {
+            match (
+                column_of(data, length, x),
+                column_of(data, length, y),
+                row(t),
+                row(eta),
+            ) {
                 (Some(cx), Some(cy), Some(rt), Some(re)) => {
                     two_time.push(TwoTimeReference {
                         x,
@@ -229,7 +339,7 @@ pub fn prepare_data_check(
                         eta,
                         t_step: rt,
                         eta_step: re,
-                        discrete: match &discrete {
+                        discrete: match discrete {
                             Some(d) => d.reference.two_time[j].discrete,
                             None => continuum.correlation(x, y, t, eta, 1e-12)?.value,
                         },
@@ -249,43 +359,28 @@ pub fn prepare_data_check(
             data.name
         ));
     }
-    let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
-    let mode_every: Vec<u64> = modes
-        .iter()
-        .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))
-        .collect();
-    let rate1 = continuum.mode_rate(1);
-    let profile_every = every(4.0 * rate1);
-    let max_rate = modes.last().map_or(rate1, |m| m.rate_continuum);
-    let components = scene.dims - 1;
-    let reference = LinearReference {
-        modes,
-        profile_x: profile.0,
-        profile_discrete: profile.1,
-        profile_continuum: profile.2,
-        two_time,
-        dt: dts,
-        max_rate,
-    };
-    let run = LinearRun::for_data(
-        spec,
-        components,
-        reference,
-        mode_every,
-        profile_every,
-        scale,
-    );
+    Ok((two_time, tt_cols))
+}
+
+/// Two-time references and the columns of their x and y.
+type TwoTimeRefs = (Vec<TwoTimeReference>, Vec<(usize, usize)>);
+
+/// Reads every file of data run `k` into records and two-time products; refuses
+/// trajectories too short for the sparsest checked series.
+fn read_records(
+    run: &LinearRun,
+    sidecar: &DataSidecar,
+    dir: &Path,
+    k: usize,
+    layout: &Layout,
+) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
+    let data = &sidecar.runs[k];
+    let dts = data.dt_sample;
     let cols = columns(sidecar.dims, data.positions.len(), data.modes);
-    let layout = Layout {
-        n_positions: data.positions.len(),
-        n_modes_data: data.modes,
-        profile_cols: profile.3,
-        tt_cols,
-    };
     let mut records = Vec::new();
     let mut products = Vec::new();
     for path in data.paths(dir) {
-        let (rec, tt) = read_record(&run, data, &path, &cols, &layout)?;
+        let (rec, tt) = read_record(run, data, &path, &cols, layout)?;
         records.push(rec);
         products.push(tt);
     }
@@ -298,7 +393,9 @@ pub fn prepare_data_check(
         && shortest < MIN_SERIES_LEN
     {
         let sparsest = run.mode_every.iter().copied().max().unwrap_or(1);
-        return Err(key_err(
+        return Err(sidecar_error(
+            dir,
+            k,
             "files",
             format!(
                 "each trajectory needs at least {} stationary rows after burn_in = {} (mode 1 is taken every {sparsest} rows of dt_sample = {dts}, {MIN_SERIES_LEN} samples at least), got {}; write longer trajectories",
@@ -308,12 +405,7 @@ pub fn prepare_data_check(
             ),
         ));
     }
-    Ok(DataCheck {
-        run,
-        records,
-        two_time: products,
-        notes,
-    })
+    Ok((records, products))
 }
 
 /// The columns the checks read from a file.

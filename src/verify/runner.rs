@@ -964,22 +964,11 @@ pub fn check_data(
     let prepared = (0..sidecar.runs.len())
         .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k))
         .collect::<Result<Vec<_>>>()?;
-    let provenance = Provenance::begin(&[scene]);
-    let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
-    report.set_provenance(provenance)?;
+    let report = begin_check(scene, out)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
-    outputs.notes.push(format!(
-        "checked data: {} (producer: {}), {} run(s)",
-        data_dir.display(),
-        if sidecar.producer.is_empty() {
-            "not given"
-        } else {
-            &sidecar.producer
-        },
-        sidecar.runs.len()
-    ));
+    outputs.notes.push(data_note(&sidecar, data_dir));
     for (data, dc) in sidecar.runs.iter().zip(&prepared) {
         let est = apply_linear_checks(scene, &dc.run, &dc.records, &dc.two_time, &mut outputs)
             .map_err(|e| {
@@ -1007,8 +996,43 @@ pub fn check_data(
         ));
         write_run_outputs(&dir, &dc.run, &est, &mut outputs)?;
     }
+    let summary = finish_check(scene, outputs, start, alpha, out, &report)?;
+    Ok((summary, report))
+}
+
+/// Starts the report of a `check` run in `out`, with the provenance of `scene`.
+fn begin_check(scene: &Scene, out: &Path) -> Result<ReportRun> {
+    let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
+    report.set_provenance(Provenance::begin(&[scene]))?;
+    Ok(report)
+}
+
+/// The note naming the data a `check` run read.
+fn data_note(sidecar: &crate::data::DataSidecar, data_dir: &Path) -> String {
+    format!(
+        "checked data: {} (producer: {}), {} run(s)",
+        data_dir.display(),
+        if sidecar.producer.is_empty() {
+            "not given"
+        } else {
+            &sidecar.producer
+        },
+        sidecar.runs.len()
+    )
+}
+
+/// The summary of a `check` run (budget `data`): the family-wise correction over the
+/// scene's checks.
+fn finish_check(
+    scene: &Scene,
+    outputs: SceneOutputs<'_>,
+    start: Instant,
+    alpha: f64,
+    out: &Path,
+    report: &ReportRun,
+) -> Result<Summary> {
     let scene_summary = finish_scene(scene, outputs, start, alpha, out)?;
-    let summary = Summary {
+    Ok(Summary {
         run_id: report.run_id(),
         budget: "data".to_string(),
         alpha,
@@ -1016,8 +1040,7 @@ pub fn check_data(
         scenes: vec![scene_summary],
         files: report.files(),
         provenance: report.provenance_ref(),
-    };
-    Ok((summary, report))
+    })
 }
 
 /// [`check_data`] of a compression scene: per run name of the data, ⟨F⟩ at every strain
@@ -1032,21 +1055,11 @@ fn check_compression_data(
     alpha: f64,
 ) -> Result<(Summary, ReportRun)> {
     let checks = crate::verify::data::prepare_compression_checks(scene, sidecar, data_dir)?;
-    let provenance = Provenance::begin(&[scene]);
-    let report = ReportRun::begin(out, "check", MANIFEST, &ENTRY_POINTS)?;
-    report.set_provenance(provenance)?;
+    let report = begin_check(scene, out)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
-    outputs.notes.push(format!(
-        "checked data: {} (producer: {})",
-        data_dir.display(),
-        if sidecar.producer.is_empty() {
-            "not given"
-        } else {
-            &sidecar.producer
-        }
-    ));
+    outputs.notes.push(data_note(sidecar, data_dir));
     let mut fig: Option<Figure> = None;
     for c in &checks {
         let name = &c.run.spec.name;
@@ -1089,16 +1102,7 @@ fn check_compression_data(
     if let Some(f) = fig {
         outputs.write_figure(&f, dir.join("force-strain.svg"))?;
     }
-    let scene_summary = finish_scene(scene, outputs, start, alpha, out)?;
-    let summary = Summary {
-        run_id: report.run_id(),
-        budget: "data".to_string(),
-        alpha,
-        passed: scene_summary.passed,
-        scenes: vec![scene_summary],
-        files: report.files(),
-        provenance: report.provenance_ref(),
-    };
+    let summary = finish_check(scene, outputs, start, alpha, out, &report)?;
     Ok((summary, report))
 }
 
