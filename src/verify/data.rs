@@ -27,7 +27,7 @@ use crate::scene::compression::{CompressionRun, CompressionTheoryTable, ForceRec
 use crate::scene::linear::{
     LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
 };
-use crate::scene::{ModelKind, RunSpec, Scene};
+use crate::scene::{CompressionSpec, ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
 use crate::stats::moments::MIN_SERIES_LEN;
 use std::path::Path;
@@ -656,102 +656,120 @@ pub fn prepare_compression_checks(
             names.push(&r.name);
         }
     }
-    let mut out = Vec::new();
-    for name in names {
-        let runs: Vec<(usize, &DataRun)> = sidecar
-            .runs
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| r.name == name)
-            .collect();
-        let mut notes = Vec::new();
-        let mut by_strain = Vec::new();
-        for &ratio in &comp.strain_ratios {
-            let found = runs.iter().find(|(_, r)| {
-                r.strain_ratio
-                    .is_some_and(|s| (s - ratio).abs() <= MATCH * ratio.abs().max(1.0))
-            });
-            match found {
-                Some(&(k, r)) => by_strain.push((k, r)),
-                None => {
-                    return Err(bad(
-                        "runs".into(),
-                        format!(
-                            "must hold run {name:?} at every strain ratio of scene {} ({:?}); strain_ratio {ratio} is missing",
-                            scene.name, comp.strain_ratios
-                        ),
-                    ));
-                }
-            }
-        }
-        let first = by_strain[0].1;
-        let mut scene = scene.clone();
-        scene.filament = sidecar.filament.params();
-        let fem = first
-            .discretization
-            .as_ref()
-            .filter(|d| d.model == "fem")
-            .and_then(|d| d.elements);
-        if let Some(elements) = fem {
-            scene.mesh.elements = elements;
-            scene.mesh.grading = 1.0;
-        }
-        let spec = data_spec(&scene, first);
-        let run = CompressionRun::prepare(&scene, comp, &spec)?;
-        let mut theory = CompressionTheoryTable::new(&scene, comp)?;
-        match fem {
-            Some(e) => notes.push(format!(
-                "run {name}: references: the exact equilibrium theory of the producer's discretization ({e} elements) at every strain; the continuum beside it"
-            )),
+    names
+        .into_iter()
+        .map(|name| compression_data_check(scene, comp, sidecar, dir, name))
+        .collect()
+}
+
+/// The [`CompressionDataCheck`] of the data runs named `name`: one per strain of the
+/// scene (refused if one is missing), judged against the discrete theory of the
+/// producer's finite elements or the continuum.
+fn compression_data_check(
+    scene: &Scene,
+    comp: &CompressionSpec,
+    sidecar: &DataSidecar,
+    dir: &Path,
+    name: &str,
+) -> Result<CompressionDataCheck> {
+    let sidecar_path = dir.join(crate::data::SIDECAR);
+    let bad = |key: String, message: String| Error::Scene {
+        file: sidecar_path.clone(),
+        key,
+        message,
+    };
+    let runs: Vec<(usize, &DataRun)> = sidecar
+        .runs
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.name == name)
+        .collect();
+    let mut notes = Vec::new();
+    let mut by_strain = Vec::new();
+    for &ratio in &comp.strain_ratios {
+        let found = runs.iter().find(|(_, r)| {
+            r.strain_ratio
+                .is_some_and(|s| (s - ratio).abs() <= MATCH * ratio.abs().max(1.0))
+        });
+        match found {
+            Some(&(k, r)) => by_strain.push((k, r)),
             None => {
-                theory.discrete.clone_from(&theory.continuum);
-                for c in &mut theory.curve {
-                    c.1 = c.2;
-                }
-                theory.distributions.iter_mut().for_each(|d| *d = None);
-                notes.push(format!(
-                    "run {name}: references: the continuum theory (the producer's discretization is not this tool's finite elements); the distribution of F is not checked (its exact law is known for the discretized filament only)"
+                return Err(bad(
+                    "runs".into(),
+                    format!(
+                        "must hold run {name:?} at every strain ratio of scene {} ({:?}); strain_ratio {ratio} is missing",
+                        scene.name, comp.strain_ratios
+                    ),
                 ));
             }
         }
-        let euler_load = run.euler_load;
-        let cols: Vec<String> = crate::data::COMPRESSION_COLUMNS
-            .iter()
-            .map(|c| c.to_string())
-            .collect();
-        let mut records = Vec::new();
-        for &(k, data) in &by_strain {
-            let mut at_strain = Vec::new();
-            for (j, path) in data.paths(dir).iter().enumerate() {
-                if !path.is_file() {
-                    return Err(bad(
-                        format!("runs[{k}].files[{j}]"),
-                        format!(
-                            "must name a trajectory file; {} is not a file",
-                            path.display()
-                        ),
-                    ));
-                }
-                let table = read_table(path, &cols)?;
-                let t0 = if table.rows > 0 { table.get(0, 0) } else { 0.0 };
-                let first_row = ((data.burn_in - t0) / data.dt_sample - MATCH)
-                    .ceil()
-                    .max(0.0) as usize;
-                at_strain.push(ForceRecord {
-                    force_ratio: (first_row..table.rows)
-                        .map(|r| table.get(r, 1) / euler_load)
-                        .collect(),
-                    ..ForceRecord::default()
-                });
-            }
-            records.push(at_strain);
-        }
-        out.push(CompressionDataCheck {
-            run,
-            theory,
-            records,
-            notes,
-        });
     }
-    Ok(out)
+    let first = by_strain[0].1;
+    let mut scene = scene.clone();
+    scene.filament = sidecar.filament.params();
+    let fem = first
+        .discretization
+        .as_ref()
+        .filter(|d| d.model == "fem")
+        .and_then(|d| d.elements);
+    if let Some(elements) = fem {
+        scene.mesh.elements = elements;
+        scene.mesh.grading = 1.0;
+    }
+    let spec = data_spec(&scene, first);
+    let run = CompressionRun::prepare(&scene, comp, &spec)?;
+    let mut theory = CompressionTheoryTable::new(&scene, comp)?;
+    match fem {
+        Some(e) => notes.push(format!(
+            "run {name}: references: the exact equilibrium theory of the producer's discretization ({e} elements) at every strain; the continuum beside it"
+        )),
+        None => {
+            theory.discrete.clone_from(&theory.continuum);
+            for c in &mut theory.curve {
+                c.1 = c.2;
+            }
+            theory.distributions.iter_mut().for_each(|d| *d = None);
+            notes.push(format!(
+                "run {name}: references: the continuum theory (the producer's discretization is not this tool's finite elements); the distribution of F is not checked (its exact law is known for the discretized filament only)"
+            ));
+        }
+    }
+    let euler_load = run.euler_load;
+    let cols: Vec<String> = crate::data::COMPRESSION_COLUMNS
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    let mut records = Vec::new();
+    for &(k, data) in &by_strain {
+        let mut at_strain = Vec::new();
+        for (j, path) in data.paths(dir).iter().enumerate() {
+            if !path.is_file() {
+                return Err(bad(
+                    format!("runs[{k}].files[{j}]"),
+                    format!(
+                        "must name a trajectory file; {} is not a file",
+                        path.display()
+                    ),
+                ));
+            }
+            let table = read_table(path, &cols)?;
+            let t0 = if table.rows > 0 { table.get(0, 0) } else { 0.0 };
+            let first_row = ((data.burn_in - t0) / data.dt_sample - MATCH)
+                .ceil()
+                .max(0.0) as usize;
+            at_strain.push(ForceRecord {
+                force_ratio: (first_row..table.rows)
+                    .map(|r| table.get(r, 1) / euler_load)
+                    .collect(),
+                ..ForceRecord::default()
+            });
+        }
+        records.push(at_strain);
+    }
+    Ok(CompressionDataCheck {
+        run,
+        theory,
+        records,
+        notes,
+    })
 }
