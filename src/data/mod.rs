@@ -349,6 +349,14 @@ impl DataRun {
                 format!("must be a finite time >= 0, got {}", self.burn_in),
             ));
         }
+        self.validate_layout(k, length)
+    }
+
+    /// The columns and files of run `k` (for a filament of length `length`): positions
+    /// within [0, L], the mode count, relative `.csv`/`.npy` paths and the
+    /// discretization's step; on failure (key, message).
+    fn validate_layout(&self, k: usize, length: f64) -> std::result::Result<(), (String, String)> {
+        let key = |s: &str| format!("runs[{k}].{s}");
         if self.positions.len() > 10_000 {
             return Err((
                 key("positions"),
