@@ -754,6 +754,14 @@ impl LinearRun {
         })
     }
 
+    /// Whether the stationary process obeys detailed balance, so that its two-point
+    /// correlations are symmetric under time reversal: the spectral model, and a model
+    /// with consistent noise (the paper's element-uniform noise is not proportional to
+    /// the damping matrix, and its modes are driven by correlated noise).
+    pub fn reversible(&self) -> bool {
+        matches!(self.model, Model::Spectral { .. }) || self.spec.noise == NoiseModel::Consistent
+    }
+
     /// Number of sampling steps for a sampled duration (physical time units).
     pub fn sampled_steps(&self, duration: f64) -> u64 {
         ((duration / self.reference.dt).round() as u64).max(1)

@@ -61,6 +61,27 @@ fn check(
     CheckResult::statistical(name, kind, values, continuum, outcome.p_value, detail)
 }
 
+/// A t-test that independent values (one per trajectory or series) have mean zero: the
+/// checks of a symmetry (zero mean, vanishing cross-correlation, time reversal), whose
+/// error is estimated from the spread of the independent values, so that it holds for
+/// short series too (Student's t with n − 1 degrees of freedom).
+fn zero_mean_check(name: String, values: &[f64], what: &str) -> Result<CheckResult> {
+    let m = stats::ensemble_mean(values)?;
+    let o = stats::t_test(m.mean, 0.0, m.std_error, values.len())?;
+    Ok(check(
+        name,
+        "t-test",
+        (m.mean, 0.0, m.std_error),
+        &o,
+        Some(0.0),
+        format!(
+            "{what}: mean of {} independent values (one per series), Student t with {} dof",
+            values.len(),
+            values.len() - 1
+        ),
+    ))
+}
+
 /// Thinned, effectively independent samples of series pooled over trajectories:
 /// every `stride`-th value.
 fn thin(series: &[&[f64]], stride: usize) -> Vec<f64> {
@@ -283,6 +304,44 @@ fn profile_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         ));
         ctx.est.profile.push((mean, se));
     }
+    if ctx.run.reversible() {
+        time_reversal_checks(ctx)?;
+    }
+    Ok(())
+}
+
+/// Time-reversal symmetry of the stationary process (detailed balance, which holds
+/// with consistent noise): ⟨w(x, t+τ) w(y, t)⟩ = ⟨w(y, t+τ) w(x, t)⟩ for every pair of
+/// profile points, at τ one profile sample; per series the time average of
+/// `w(x,t+τ)w(y,t) − w(y,t+τ)w(x,t)`, t-tested against zero.
+fn time_reversal_checks(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let r = &ctx.run.reference;
+    let prefix = &ctx.run.spec.name;
+    let (c, np) = (ctx.run.components, r.profile_x.len());
+    for a in 0..np {
+        for b in a + 1..np {
+            let values: Vec<f64> = ctx
+                .records
+                .iter()
+                .flat_map(|t| {
+                    (0..c).map(move |k| {
+                        let (x, y) = (&t.profile[k * np + a], &t.profile[k * np + b]);
+                        let n = x.len().saturating_sub(1).max(1);
+                        (0..x.len().saturating_sub(1))
+                            .map(|i| x[i + 1] * y[i] - y[i + 1] * x[i])
+                            .sum::<f64>()
+                            / n as f64
+                    })
+                })
+                .collect();
+            let (x, y) = (r.profile_x[a], r.profile_x[b]);
+            ctx.out.push(zero_mean_check(
+                format!("{prefix}/time-reversal/x={x:.4},y={y:.4}"),
+                &values,
+                "w(x,t+tau)w(y,t) - w(y,t+tau)w(x,t) at tau = one profile sample (zero under detailed balance)",
+            )?);
+        }
+    }
     Ok(())
 }
 
@@ -311,6 +370,29 @@ fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Res
             mean / mr.variance_equipartition
         ),
     ));
+    let means: Vec<f64> = m
+        .series
+        .iter()
+        .map(|s| s.iter().sum::<f64>() / s.len() as f64)
+        .collect();
+    ctx.out.push(zero_mean_check(
+        format!("{prefix}/mode-mean/n={}", mr.n),
+        &means,
+        "time average of the mode amplitude (zero in equilibrium)",
+    )?);
+    if ctx.run.components == 2 {
+        // The series alternate between the two transverse components of a trajectory.
+        let cross: Vec<f64> = m
+            .series
+            .chunks_exact(2)
+            .map(|p| p[0].iter().zip(p[1]).map(|(a, b)| a * b).sum::<f64>() / p[0].len() as f64)
+            .collect();
+        ctx.out.push(zero_mean_check(
+            format!("{prefix}/mode-cross/n={}", mr.n),
+            &cross,
+            "time average of the product of the two transverse components' amplitudes (independent in equilibrium)",
+        )?);
+    }
     let thinned = &m.thinned;
     let o = stats::chi2_variance_test(thinned, mr.variance_discrete, Some(0.0))?;
     let s2 = thinned.iter().map(|q| q * q).sum::<f64>() / thinned.len() as f64;

@@ -13,6 +13,7 @@
 pub mod checks;
 pub mod compression;
 pub mod data;
+pub mod oracle;
 pub mod runner;
 pub mod summary;
 

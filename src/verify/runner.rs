@@ -46,6 +46,7 @@ use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scen
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
+use crate::verify::oracle::{Oracle, compression_oracle, linear_oracle};
 use crate::verify::summary::{CheckResult, SceneSummary, Summary};
 use crate::work::{WorkLimits, WorkProjection};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -111,9 +112,13 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     // Prepare every run first so that bad input is reported before any long work.
     let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
     for (scene, work) in scenes.iter().zip(&prepared) {
-        if let Prepared::Linear(runs) = work {
+        if let Prepared::Linear(runs, oracles) = work {
+            // A run whose references fail the oracle is not simulated: its sampling
+            // plan (from wrong rates) is not the user's to fix.
             for (k, run) in runs.iter().enumerate() {
-                check_sample_counts(scene, k, run, opts.budget)?;
+                if oracles[k].passed() {
+                    check_sample_counts(scene, k, run, opts.budget)?;
+                }
             }
         }
     }
@@ -125,10 +130,18 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     for (scene, work) in scenes.iter().zip(&prepared) {
         bar.set_message(scene.name.clone());
         summaries.push(match work {
-            Prepared::Linear(runs) => run_scene(scene, runs, opts, &report, &bar)?,
-            Prepared::Compression(theory, runs) => {
-                run_compression_scene(scene, theory, runs, opts, &report, &bar, &mut curves)?
+            Prepared::Linear(runs, oracles) => {
+                run_scene(scene, runs, oracles, opts, &report, &bar)?
             }
+            Prepared::Compression(theory, oracle, runs) => run_compression_scene(
+                scene,
+                (theory, oracle),
+                runs,
+                opts,
+                &report,
+                &bar,
+                &mut curves,
+            )?,
         });
     }
     bar.finish_and_clear();
@@ -252,10 +265,13 @@ fn check_sample_counts(scene: &Scene, k: usize, run: &LinearRun, budget: Budget)
     Ok(())
 }
 
-/// The prepared work of one scene.
+/// The prepared work of one scene: the runs, their exact references and the oracle's
+/// verdict on those references ([`oracle`]).
 enum Prepared {
-    Linear(Vec<LinearRun>),
-    Compression(CompressionTheoryTable, Vec<CompressionRun>),
+    /// A linear scene: its runs and, per run, the oracle of its references.
+    Linear(Vec<LinearRun>, Vec<Oracle>),
+    /// A compression scene: the exact theory, its oracle, the runs.
+    Compression(CompressionTheoryTable, Oracle, Vec<CompressionRun>),
 }
 
 /// Prepares every run of `scene` (and the exact theory of a compression scene); errors
@@ -269,8 +285,9 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
             .map(|(i, spec)| {
                 LinearRun::prepare(scene, spec).map_err(|e| prepare_error(scene, i, e))
             })
-            .collect::<Result<_>>()?;
-        return Ok(Prepared::Linear(runs));
+            .collect::<Result<Vec<_>>>()?;
+        let oracles = runs.iter().map(|r| linear_oracle(scene, r)).collect();
+        return Ok(Prepared::Linear(runs, oracles));
     };
     let runs = scene
         .runs
@@ -288,7 +305,14 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
         ),
         other => scene.run_error(0, "integrator", other),
     })?;
-    Ok(Prepared::Compression(theory, runs))
+    let oracle = compression_oracle(scene, comp).map_err(|e| {
+        Error::run_failed(
+            scene.path.display().to_string(),
+            "oracle of the compression theory (before any run)",
+            e,
+        )
+    })?;
+    Ok(Prepared::Compression(theory, oracle, runs))
 }
 
 /// Trajectories of all scenes at `budget` (per strain for compression scenes), for the
@@ -398,7 +422,7 @@ const FORCE_STRAIN_HEADER: [&str; 5] = [
 /// force–strain figure, the Δt-halving check, and `fig2.svg` (updated in `curves`).
 fn run_compression_scene(
     scene: &Scene,
-    theory: &CompressionTheoryTable,
+    (theory, oracle): (&CompressionTheoryTable, &Oracle),
     runs: &[CompressionRun],
     opts: &VerifyOptions,
     report: &ReportRun,
@@ -408,6 +432,12 @@ fn run_compression_scene(
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, report);
+    outputs.checks.extend(oracle.checks.iter().cloned());
+    outputs.notes.extend(oracle.notes.iter().cloned());
+    if !oracle.passed() {
+        outputs.notes.push(oracle.not_simulated_note("(every run)"));
+        return finish_scene(scene, outputs, start, opts.alpha, &opts.out);
+    }
     let mut estimates = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     let mut fig = force_strain_figure(scene, theory);
@@ -843,8 +873,11 @@ fn finish_scene(
         tables,
         notes,
     } = outputs;
-    let p: Vec<f64> = checks.iter().map(|c| c.p_value.unwrap_or(1.0)).collect();
-    for (c, (adj, reject)) in checks.iter_mut().zip(stats::holm(&p, alpha)) {
+    // Holm over the statistical checks; a deterministic check (no p-value, e.g. the
+    // oracle's) keeps its own verdict and is not part of the family.
+    let p: Vec<f64> = checks.iter().filter_map(|c| c.p_value).collect();
+    let statistical = checks.iter_mut().filter(|c| c.p_value.is_some());
+    for (c, (adj, reject)) in statistical.zip(stats::holm(&p, alpha)) {
         c.p_adjusted = Some(adj);
         c.passed = !reject;
     }
@@ -875,6 +908,7 @@ fn finish_scene(
 fn run_scene(
     scene: &Scene,
     runs: &[LinearRun],
+    oracles: &[Oracle],
     opts: &VerifyOptions,
     report: &ReportRun,
     bar: &ProgressBar,
@@ -891,7 +925,15 @@ fn run_scene(
             .position(|r| r.spec.noise == NoiseModel::ElementUniform),
         ModelKind::Spectral | ModelKind::Compression => None,
     };
-    for (k, run) in runs.iter().enumerate() {
+    for (k, (run, oracle)) in runs.iter().zip(oracles).enumerate() {
+        outputs.checks.extend(oracle.checks.iter().cloned());
+        outputs.notes.extend(oracle.notes.iter().cloned());
+        if !oracle.passed() {
+            outputs
+                .notes
+                .push(oracle.not_simulated_note(&run.spec.name));
+            continue;
+        }
         let e = run.spec.ensemble(opts.budget);
         let (records, two_time) = simulate_linear(scene, k, run, &e, bar)?;
         let budget_key = format!("{}.duration_tau1", opts.budget.name());
