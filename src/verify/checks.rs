@@ -15,6 +15,10 @@ const CONFIDENCE: f64 = 0.95;
 /// is at most this (ln 100 ≈ 4.6 relaxation times): residual dependence then changes the
 /// null distribution of KS and χ² by far less than their sampling error.
 const MAX_THINNED_CORRELATION: f64 = 0.01;
+/// Fewest independent series for an error from their spread (Student t); with fewer,
+/// the variance and profile checks use the within-series (IAT) error and a z-test, and
+/// the symmetry checks are skipped (listed in the notes).
+const MIN_SERIES_FOR_T: usize = 4;
 /// Welch segment length (samples) of the spectrum check.
 pub const SEGMENT_LEN: usize = 64;
 /// Shortest Welch segment accepted.
@@ -61,14 +65,61 @@ fn check(
     CheckResult::statistical(name, kind, values, continuum, outcome.p_value, detail)
 }
 
+/// The test of an average over independent series against `reference`: a t-test with
+/// the error from the spread of the series' averages when there are at least
+/// [`MIN_SERIES_FOR_T`] series, else a z-test with the within-series (IAT) errors.
+/// Returns (estimate, error, outcome, kind, how the error was obtained).
+fn series_average_test(
+    parts: &[stats::MeanEstimate],
+    reference: f64,
+) -> Result<(f64, f64, TestOutcome, &'static str, String)> {
+    let (mean_iat, se_iat) = stats::combine_independent(parts);
+    if parts.len() < MIN_SERIES_FOR_T {
+        let o = stats::z_test(mean_iat, reference, se_iat)?;
+        return Ok((
+            mean_iat,
+            se_iat,
+            o,
+            "z-test",
+            format!("{} series, within-series (IAT) error", parts.len()),
+        ));
+    }
+    let values: Vec<f64> = parts.iter().map(|p| p.mean).collect();
+    let between = stats::ensemble_mean(&values)?;
+    let o = stats::t_test(between.mean, reference, between.std_error, values.len())?;
+    Ok((
+        between.mean,
+        between.std_error,
+        o,
+        "t-test",
+        format!(
+            "{} independent series, error from their spread (t, {} dof; within-series IAT error {se_iat:.3e})",
+            values.len(),
+            values.len() - 1
+        ),
+    ))
+}
+
 /// A t-test that independent values (one per trajectory or series) have mean zero: the
 /// checks of a symmetry (zero mean, vanishing cross-correlation, time reversal), whose
 /// error is estimated from the spread of the independent values, so that it holds for
 /// short series too (Student's t with n − 1 degrees of freedom).
-fn zero_mean_check(name: String, values: &[f64], what: &str) -> Result<CheckResult> {
+fn zero_mean_check(
+    ctx: &mut LinearContext<'_>,
+    name: String,
+    values: &[f64],
+    what: &str,
+) -> Result<()> {
+    if values.len() < MIN_SERIES_FOR_T {
+        ctx.est.skipped.push(format!(
+            "{name}: needs at least {MIN_SERIES_FOR_T} independent series, the data have {}",
+            values.len()
+        ));
+        return Ok(());
+    }
     let m = stats::ensemble_mean(values)?;
     let o = stats::t_test(m.mean, 0.0, m.std_error, values.len())?;
-    Ok(check(
+    ctx.out.push(check(
         name,
         "t-test",
         (m.mean, 0.0, m.std_error),
@@ -79,7 +130,8 @@ fn zero_mean_check(name: String, values: &[f64], what: &str) -> Result<CheckResu
             values.len(),
             values.len() - 1
         ),
-    ))
+    ));
+    Ok(())
 }
 
 /// Thinned, effectively independent samples of series pooled over trajectories:
@@ -285,22 +337,18 @@ fn profile_check(ctx: &mut LinearContext<'_>) -> Result<()> {
                 parts.push(stats::mean_with_error(&sq)?);
             }
         }
-        let (mean, se) = stats::combine_independent(&parts);
-        let means: Vec<f64> = parts.iter().map(|m| m.mean).collect();
-        let between = stats::ensemble_mean(&means)?;
-        let o = stats::z_test(mean, r.profile_discrete[j], se)?;
+        // The error from the spread of the independent series' averages where there are
+        // enough: an error estimated within short series (IAT) is itself uncertain and
+        // correlated with the estimate, which makes z-tails heavier than normal.
+        let (mean, se, o, kind, how) = series_average_test(&parts, r.profile_discrete[j])?;
         let x = r.profile_x[j];
         ctx.out.push(check(
             format!("{prefix}/profile/x={x:.4}"),
-            "z-test",
+            kind,
             (mean, r.profile_discrete[j], se),
             &o,
             Some(r.profile_continuum[j]),
-            format!(
-                "<w^2(x)> over {} series (IAT error); between-series error {:.3e}",
-                means.len(),
-                between.std_error
-            ),
+            format!("<w^2(x)> over {how}"),
         ));
         ctx.est.profile.push((mean, se));
     }
@@ -335,11 +383,12 @@ fn time_reversal_checks(ctx: &mut LinearContext<'_>) -> Result<()> {
                 })
                 .collect();
             let (x, y) = (r.profile_x[a], r.profile_x[b]);
-            ctx.out.push(zero_mean_check(
+            zero_mean_check(
+                ctx,
                 format!("{prefix}/time-reversal/x={x:.4},y={y:.4}"),
                 &values,
                 "w(x,t+tau)w(y,t) - w(y,t+tau)w(x,t) at tau = one profile sample (zero under detailed balance)",
-            )?);
+            )?;
         }
     }
     Ok(())
@@ -355,18 +404,17 @@ fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Res
         .iter()
         .map(|s| stats::variance_with_error(s, Some(0.0)))
         .collect::<Result<Vec<_>>>()?;
-    let (mean, se) = stats::combine_independent(&parts);
+    // As for the profile: the error from the spread of the independent series.
+    let (mean, se, o, kind, how) = series_average_test(&parts, mr.variance_discrete)?;
     m.me.variance = (mean, se);
-    let o = stats::z_test(mean, mr.variance_discrete, se)?;
     ctx.out.push(check(
         format!("{prefix}/mode-variance/n={}", mr.n),
-        "z-test",
+        kind,
         (mean, mr.variance_discrete, se),
         &o,
         Some(mr.variance_continuum),
         format!(
-            "time average of q^2 over {} series, IAT error; ratio to equipartition {:.4}",
-            m.series.len(),
+            "time average of q^2 over {how}; ratio to equipartition {:.4}",
             mean / mr.variance_equipartition
         ),
     ));
@@ -375,11 +423,12 @@ fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Res
         .iter()
         .map(|s| s.iter().sum::<f64>() / s.len() as f64)
         .collect();
-    ctx.out.push(zero_mean_check(
+    zero_mean_check(
+        ctx,
         format!("{prefix}/mode-mean/n={}", mr.n),
         &means,
         "time average of the mode amplitude (zero in equilibrium)",
-    )?);
+    )?;
     if ctx.run.components == 2 {
         // The series alternate between the two transverse components of a trajectory.
         let cross: Vec<f64> = m
@@ -387,11 +436,12 @@ fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Res
             .chunks_exact(2)
             .map(|p| p[0].iter().zip(p[1]).map(|(a, b)| a * b).sum::<f64>() / p[0].len() as f64)
             .collect();
-        ctx.out.push(zero_mean_check(
+        zero_mean_check(
+            ctx,
             format!("{prefix}/mode-cross/n={}", mr.n),
             &cross,
             "time average of the product of the two transverse components' amplitudes (independent in equilibrium)",
-        )?);
+        )?;
     }
     let thinned = &m.thinned;
     let o = stats::chi2_variance_test(thinned, mr.variance_discrete, Some(0.0))?;
