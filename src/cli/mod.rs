@@ -1,5 +1,6 @@
 //! Argument parsing (clap) and dispatch.
 
+mod calibrate;
 mod check;
 mod converge;
 mod list;
@@ -33,6 +34,9 @@ enum Command {
     Theory(theory::TheoryArgs),
     /// Run verification scenes and write reports.
     Verify(verify::VerifyArgs),
+    /// Each scene's verification at N seeds: the false-alarm rate per scene (exact
+    /// binomial interval) and the uniformity of the checks' p-values per check kind.
+    Calibrate(calibrate::CalibrateArgs),
     /// Convergence study of a finite-element scene (linear or compression) over the
     /// element count or the time step.
     Converge(converge::ConvergeArgs),
@@ -63,6 +67,11 @@ pub fn run() -> Result<i32> {
             check_out_dir(&args.out)?;
             args.sim.start()?;
             verify::run(args)
+        }
+        Command::Calibrate(args) => {
+            check_out_dir(&args.out)?;
+            args.start()?;
+            calibrate::run(args)
         }
         Command::Converge(args) => {
             check_out_dir(&args.out)?;

@@ -59,7 +59,8 @@ const fn col(name: &'static str, unit: &'static str, meaning: &'static str) -> C
     }
 }
 
-/// Every kind of CSV table `verify`, `converge`, `stability` and `work-precision` write.
+/// Every kind of CSV table `verify`, `converge`, `stability`, `work-precision` and
+/// `calibrate` write.
 pub const TABLES: &[TableKind] = &[
     TableKind {
         suffix: "-mode-statistics.csv",
@@ -300,6 +301,35 @@ pub const TABLES: &[TableKind] = &[
                 "seconds_to_tolerance",
                 "s",
                 "projected wall time to reach the tolerance (empty: never)",
+            ),
+        ],
+    },
+    TableKind {
+        suffix: "p-values.csv",
+        meaning: "calibrate: one line per check per seed: its raw and Holm-adjusted p-values",
+        columns: &[
+            col("scene", "text", "scene name"),
+            col(
+                "seed",
+                "1",
+                "master seed of the scene's run (verify --seed)",
+            ),
+            col("check", "text", "check name, unique within the scene"),
+            col(
+                "kind",
+                "text",
+                "check kind (z-test, ks, chi2-variance, ...)",
+            ),
+            col("p_value", "1", "raw p-value (empty: the check has none)"),
+            col(
+                "p_adjusted",
+                "1",
+                "Holm-adjusted p-value within the scene at that seed",
+            ),
+            col(
+                "passed",
+                "text",
+                "true or false, at the family-wise level alpha",
             ),
         ],
     },

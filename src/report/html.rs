@@ -176,7 +176,7 @@ fn index_html(out_dir: &Path, summary: &Summary) -> String {
 }
 
 /// The provenance box: what produced the report.
-fn provenance_box(h: &mut String, p: &ProvenanceRef) {
+pub(crate) fn provenance_box(h: &mut String, p: &ProvenanceRef) {
     let dirty = match p.dirty {
         Some(true) => " <b>(dirty: built with uncommitted changes to tracked files)</b>",
         Some(false) => "",
@@ -412,7 +412,7 @@ fn file_name(path: &str) -> &str {
 
 /// A number to 4 significant digits: fixed-point for magnitudes in `[1e-3, 1e5)`,
 /// scientific otherwise; `—` for `None`.
-fn fmt4(value: Option<f64>) -> String {
+pub(crate) fn fmt4(value: Option<f64>) -> String {
     let Some(v) = value else {
         return "—".to_string();
     };
@@ -449,7 +449,7 @@ fn fmt_alpha(alpha: f64) -> String {
     }
 }
 
-fn fmt_seconds(seconds: f64) -> String {
+pub(crate) fn fmt_seconds(seconds: f64) -> String {
     if !seconds.is_finite() {
         "—".to_string()
     } else if seconds < 10.0 {

@@ -10,6 +10,7 @@
 //! writes the per-scene CSV tables and SVG figures; the HTML index is the report layer's
 //! ([`crate::report`]).
 
+pub mod calibrate;
 pub mod checks;
 pub mod compression;
 pub mod data;

@@ -124,7 +124,11 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     }
     let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
-    let bar = progress_bar(trajectory_count(scenes, opts.budget), opts.progress);
+    let bar = progress_bar(
+        trajectory_count(scenes, opts.budget),
+        "trajectories",
+        opts.progress,
+    );
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
     for (scene, work) in scenes.iter().zip(&prepared) {
@@ -339,16 +343,17 @@ fn trajectory_count(scenes: &[Scene], budget: Budget) -> u64 {
         .sum()
 }
 
-/// A progress bar over `total` trajectories on stderr, or a hidden one.
-fn progress_bar(total: u64, show: bool) -> ProgressBar {
+/// A progress bar over `total` things (`unit`: `trajectories`, `runs`) on stderr, or a
+/// hidden one.
+pub fn progress_bar(total: u64, unit: &str, show: bool) -> ProgressBar {
     let bar = if show {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {
         ProgressBar::hidden()
     };
-    if let Ok(style) = ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories  {msg}",
-    ) {
+    if let Ok(style) = ProgressStyle::with_template(&format!(
+        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {unit}  {{msg}}"
+    )) {
         bar.set_style(style);
     }
     bar
