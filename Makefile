@@ -10,13 +10,14 @@
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
 #   make converge          convergence studies (orders in h and dt), reports/convergence/
 #   make bench-peers       Fig. 2 against a plain NumPy implementation: CPU times and ratio
+#   make power             fault injection: detection rate of each catalogued fault over seeds
 
 CARGO  ?= cargo
 BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check
+.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check power
 
 all: build
 
@@ -55,6 +56,16 @@ check:
 
 bench:
 	$(CARGO) bench --locked
+
+# Fault injection (src/fault.rs, issue #16): every catalogued simulator fault, per scene
+# and size, verified at POWER_SEEDS fixed seeds at the quick budget; detection rates with
+# Clopper-Pearson intervals in $(POWER_OUT)/power.{csv,json,md}. Builds with
+# `--features faults`, which replaces target/release/langevin-fem by the faults build (a
+# later `make verify` or `make build` relinks it without). About 25 min on 2 cores.
+POWER_OUT   ?= $(OUT)/power
+POWER_SEEDS ?= 20
+power:
+	$(CARGO) run --release --locked --features faults -- power --seeds $(POWER_SEEDS) --budget quick --out $(POWER_OUT)
 
 golden:
 	INSTA_UPDATE=always $(CARGO) test --release --locked --test golden
