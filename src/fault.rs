@@ -205,14 +205,14 @@ impl FaultKind {
         matches!(self, FaultKind::IntegratorHinge | FaultKind::SharedHinge)
     }
 
-    /// The sizes `power` measures: stated/4, stated/2, stated, 2·stated, those allowed
-    /// ([`Fault::new`]); a switch has the one size 1.
+    /// The sizes `power` measures, ascending: stated/16, stated/8, stated/4, stated/2,
+    /// stated, 2·stated, those allowed ([`Fault::new`]); a switch has the one size 1.
     pub fn ladder(self) -> Vec<f64> {
         if self.is_switch() {
             return vec![1.0];
         }
         let s = self.stated_size();
-        [0.25, 0.5, 1.0, 2.0]
+        [0.0625, 0.125, 0.25, 0.5, 1.0, 2.0]
             .iter()
             .map(|f| f * s)
             .filter(|&x| Fault::new(self, x).is_ok())
