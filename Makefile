@@ -12,13 +12,14 @@
 #   make bench-peers       Fig. 2 against a plain NumPy implementation: CPU times and ratio
 #   make calibrate         the verifier's false-alarm rate and p-value uniformity over
 #                          SEEDS seeds (default 100), reports/calibration/
+#   make power             fault injection: detection rate of each catalogued fault over seeds
 
 CARGO  ?= cargo
 BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check calibrate
+.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check calibrate power
 
 all: build
 
@@ -68,6 +69,16 @@ check:
 
 bench:
 	$(CARGO) bench --locked
+
+# Fault injection (src/fault.rs, issue #16): every catalogued simulator fault, per scene
+# and size, verified at POWER_SEEDS fixed seeds at the quick budget; detection rates with
+# Clopper-Pearson intervals in $(POWER_OUT)/power.{csv,json,md}. Builds with
+# `--features faults`, which replaces target/release/langevin-fem by the faults build (a
+# later `make verify` or `make build` relinks it without). About 25 min on 2 cores.
+POWER_OUT   ?= $(OUT)/power
+POWER_SEEDS ?= 20
+power:
+	$(CARGO) run --release --locked --features faults -- power --seeds $(POWER_SEEDS) --budget quick --out $(POWER_OUT)
 
 golden:
 	INSTA_UPDATE=always $(CARGO) test --release --locked --test golden

@@ -54,6 +54,8 @@
 pub mod data;
 pub mod dynamics;
 pub mod error;
+#[cfg(any(test, feature = "faults"))]
+pub mod fault;
 pub mod fem;
 pub mod output;
 pub mod params;

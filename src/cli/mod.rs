@@ -4,6 +4,8 @@ mod calibrate;
 mod check;
 mod converge;
 mod list;
+#[cfg(feature = "faults")]
+mod power;
 mod run;
 mod scene;
 mod stability;
@@ -56,6 +58,11 @@ enum Command {
     List(list::ListArgs),
     /// Inspect a scene.
     Scene(scene::SceneArgs),
+    /// Fault injection (a `--features faults` build only): the detection rate of every
+    /// catalogued simulator fault over seeds, per scene and size, with Clopper-Pearson
+    /// intervals; writes power.csv, power.json and power.md.
+    #[cfg(feature = "faults")]
+    Power(power::PowerArgs),
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
@@ -98,6 +105,11 @@ pub fn run() -> Result<i32> {
         }
         Command::List(args) => list::run(args),
         Command::Scene(args) => scene::run(args),
+        #[cfg(feature = "faults")]
+        Command::Power(args) => {
+            check_out_dir(&args.out)?;
+            power::run(args)
+        }
     }
 }
 

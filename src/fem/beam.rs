@@ -77,6 +77,17 @@ impl BeamModel {
     /// [`Error::InvalidParameter`] if the parameters are invalid or the mesh length
     /// differs from `params.length` (relative tolerance 1e-12).
     pub fn new(params: FilamentParams, mesh: Mesh) -> Result<Self> {
+        Self::assemble(params, mesh, free_index)
+    }
+
+    /// [`BeamModel::new`] with the free-DOF numbering `free(g, n_nodes)` (global DOF `g`
+    /// to its free index, `None` where constrained): the hinged one, [`free_index`], or a
+    /// fault's ([`crate::fault`]).
+    fn assemble(
+        params: FilamentParams,
+        mesh: Mesh,
+        free: impl Fn(usize, usize) -> Option<usize>,
+    ) -> Result<Self> {
         params.validate()?;
         let l = mesh.length();
         if (l - params.length).abs() > 1e-12 * params.length {
@@ -94,7 +105,7 @@ impl BeamModel {
         let mut loads = Vec::with_capacity(mesh.n_elements());
         for e in 0..mesh.n_elements() {
             let h = mesh.element_length(e);
-            let dofs: [Option<usize>; 4] = std::array::from_fn(|a| free_index(2 * e + a, n_nodes));
+            let dofs: [Option<usize>; 4] = std::array::from_fn(|a| free(2 * e + a, n_nodes));
             let ke = hermite::bending_matrix(h, params.bending_rigidity);
             let ce = hermite::damping_matrix(h, params.drag);
             let ge = hermite::geometric_matrix(h);
@@ -118,6 +129,37 @@ impl BeamModel {
             geometric: g,
             loads,
         })
+    }
+
+    /// A fault's model ([`crate::fault`]; test and `faults` builds only): the matrices
+    /// assembled with the free-DOF numbering `free` instead of the hinged one (e.g. the
+    /// hinge at x = L on the rotation). The node-index methods
+    /// ([`Self::node_deflection_index`], [`Self::node_rotation_index`]) keep the hinged
+    /// numbering; interpolation ([`Self::deflection_at`]) follows `free`.
+    ///
+    /// # Errors
+    /// As [`BeamModel::new`].
+    #[cfg(any(test, feature = "faults"))]
+    pub(crate) fn with_free_numbering(
+        params: FilamentParams,
+        mesh: Mesh,
+        free: impl Fn(usize, usize) -> Option<usize>,
+    ) -> Result<Self> {
+        Self::assemble(params, mesh, free)
+    }
+
+    /// A fault's model ([`crate::fault`]; test and `faults` builds only): this model with
+    /// `K`, `C` and `G` multiplied by `k`, `c` and `g` (the element loads unchanged).
+    ///
+    /// # Errors
+    /// As [`SymBanded::linear_combination`].
+    #[cfg(any(test, feature = "faults"))]
+    pub(crate) fn with_scaled_matrices(mut self, k: f64, c: f64, g: f64) -> Result<Self> {
+        let scale = |m: &SymBanded, f: f64| SymBanded::linear_combination(f, m, 0.0, m);
+        self.stiffness = scale(&self.stiffness, k)?;
+        self.damping = scale(&self.damping, c)?;
+        self.geometric = scale(&self.geometric, g)?;
+        Ok(self)
     }
 
     /// The physical parameters.

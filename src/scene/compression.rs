@@ -232,6 +232,8 @@ impl CompressionRun {
         let tau1 = p.tau1();
         let dt = spec.dt_tau1 * tau1;
         let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
+        #[cfg(any(test, feature = "faults"))]
+        let beam = crate::fault::compression_model(scene.fault, beam)?;
         let models: Vec<CompressedFilament> = comp
             .strain_ratios
             .iter()

@@ -450,6 +450,9 @@ pub struct LinearRun {
     /// spectral model.
     pub amplitude_scale: Vec<f64>,
     model: Model,
+    /// The injected fault of the scene ([`crate::fault`]; test and `faults` builds only).
+    #[cfg(any(test, feature = "faults"))]
+    fault: Option<crate::fault::Fault>,
 }
 
 enum Model {
@@ -558,6 +561,8 @@ impl Setup<'_> {
         let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
         let kt = p.kt;
         let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
+        #[cfg(any(test, feature = "faults"))]
+        let beam = crate::fault::shared_model(self.scene.fault, beam)?;
         // An explicit step above its limit fails at once (λ_max by an O(n)
         // inertia bisection), before the O(n³) eigen-decomposition.
         if spec.integrator.stability_limit(1.0).is_some() {
@@ -751,6 +756,8 @@ impl LinearRun {
             burn_in_steps,
             amplitude_scale: prepared.amplitude_scale,
             model: prepared.model,
+            #[cfg(any(test, feature = "faults"))]
+            fault: scene.fault,
         })
     }
 
@@ -824,23 +831,36 @@ impl LinearRun {
                 projector,
                 noise,
                 integrator,
-            } => Box::new(FemSampler {
-                beam,
-                projector,
-                filament: Components::at_rest(
-                    build_integrator(
-                        *integrator,
+            } => {
+                let stepper = build_integrator(
+                    *integrator,
+                    beam,
+                    *noise,
+                    self.reference.dt,
+                    self.reference.max_rate,
+                    modes.as_ref(),
+                )?;
+                #[cfg(any(test, feature = "faults"))]
+                let stepper = crate::fault::linear_integrator(
+                    self.fault,
+                    stepper,
+                    crate::fault::IntegratorParts {
+                        kind: *integrator,
                         beam,
-                        *noise,
-                        self.reference.dt,
-                        self.reference.max_rate,
-                        modes.as_ref(),
-                    )?,
-                    self.components,
-                    beam.n_dofs(),
-                ),
-            }),
+                        noise: *noise,
+                        dt: self.reference.dt,
+                        components: self.components,
+                    },
+                )?;
+                Box::new(FemSampler {
+                    beam,
+                    projector,
+                    filament: Components::at_rest(stepper, self.components, beam.n_dofs()),
+                })
+            }
             Model::Spectral { beam, n_modes } => {
+                #[cfg(any(test, feature = "faults"))]
+                let beam = &crate::fault::spectral_simulator(self.fault, *beam)?;
                 let mut sims = Vec::new();
                 for _ in 0..self.components {
                     let mut s = ModalSimulator::new(*beam, *n_modes, self.reference.dt)?;
@@ -1022,6 +1042,11 @@ impl LinearRun {
         else {
             return Ok(None);
         };
+        // A fault that replaces the integrator steps one trajectory at a time.
+        #[cfg(any(test, feature = "faults"))]
+        if crate::fault::replaces_integrator(self.fault) {
+            return Ok(None);
+        }
         let r = &self.reference;
         let batch = ThetaBatch::build(*integrator, beam, *noise, r.dt, r.max_rate)?;
         Ok(batch.map(|t| FemBatch {
@@ -1085,6 +1110,8 @@ impl LinearRun {
             burn_in_steps: 0,
             amplitude_scale,
             model: Model::Data,
+            #[cfg(any(test, feature = "faults"))]
+            fault: None,
         }
     }
 }

@@ -429,6 +429,12 @@ pub struct Scene {
     pub compression: Option<CompressionSpec>,
     /// Integrator/noise/time-step combinations.
     pub runs: Vec<RunSpec>,
+    /// A simulator fault injected into every run of this scene
+    /// ([`crate::fault`]; never read from a file). Test and `--features faults` builds
+    /// only: set with [`Scene::with_fault`].
+    #[cfg(any(test, feature = "faults"))]
+    #[serde(skip)]
+    pub fault: Option<crate::fault::Fault>,
 }
 
 /// Whether a scene's `[sampling]` table is the default one that a compression scene
