@@ -1089,7 +1089,8 @@ mod tests {
     /// **Statistical faults fail `verify`.** The cheapest scenes at the quick budget, one
     /// seed each (the scene's own): `hinged-linear-3d` restricted to its Crank–Nicolson
     /// run passes without a fault and fails its checks under the noise-variance,
-    /// stiffness, drag and correlated-noise faults at their stated sizes; the integrator's
+    /// stiffness, drag, correlated-noise and component-noise-sharing faults (the last
+    /// through the cross-correlation check) at their stated sizes; the integrator's
     /// misplaced hinge is detected (today as a run failure, exit 3: an estimator finds no
     /// autocorrelation window, a weak detection that `make power` counts apart), never
     /// refused as bad input; `compression-2d` passes without a fault and fails under the
@@ -1105,6 +1106,7 @@ mod tests {
             FaultKind::IntegratorStiffness,
             FaultKind::IntegratorDrag,
             FaultKind::CorrelatedNoise,
+            FaultKind::ComponentNoiseSharing,
         ] {
             let v = verify(linear.clone().with_fault(Fault::stated(kind)), kind.name());
             assert_eq!(v, Verdict::FailedChecks, "{kind} at its stated size");
@@ -1123,5 +1125,36 @@ mod tests {
         let kind = FaultKind::VonKarmanStrain;
         let v = verify(compression.with_fault(Fault::stated(kind)), kind.name());
         assert_eq!(v, Verdict::FailedChecks, "{kind} at its stated size");
+    }
+
+    /// **A bug in the shared model fails `verify` (exit 1) at the quick budget.** A 2 %
+    /// error in the shared stiffness matrix, or the hinge at x = L on the rotation instead
+    /// of the deflection, moves the simulation and its exact discrete references together:
+    /// no statistical check can see it. The oracle ([`crate::verify::oracle`]) compares
+    /// the references with closed forms from the parameters alone: both faults fail it in
+    /// every fem scene (`hinged-linear-2d`, `hinged-linear-3d`, `actin-10um`), naming the
+    /// oracle checks, the faulty runs are not simulated, and the verdict is failed checks
+    /// (exit 1), never an input error or a run failure. Deterministic.
+    #[test]
+    fn shared_model_faults_fail_verify_through_the_oracle() {
+        for name in ["hinged-linear-2d", "hinged-linear-3d", "actin-10um"] {
+            let scene = builtin::find(name).unwrap().load().unwrap();
+            for fault in [
+                Fault::stated(FaultKind::SharedStiffness),
+                Fault::new(FaultKind::SharedStiffness, -0.02).unwrap(),
+                Fault::stated(FaultKind::SharedHinge),
+            ] {
+                let tag = format!("{name}-{}-{}", fault.kind.name(), fault.size);
+                let v = verify(scene.clone().with_fault(fault), &tag);
+                assert_eq!(v, Verdict::FailedChecks, "{tag}");
+                // The oracle is what fails: every run of the scene fails it.
+                for spec in &scene.runs {
+                    let faulty = scene.clone().with_fault(fault);
+                    let run = crate::scene::linear::LinearRun::prepare(&faulty, spec).unwrap();
+                    let o = crate::verify::oracle::linear_oracle(&faulty, &run);
+                    assert!(!o.passed(), "{tag}: run {} passes the oracle", spec.name);
+                }
+            }
+        }
     }
 }
