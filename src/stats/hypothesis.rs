@@ -239,6 +239,25 @@ pub fn t_test(estimate: f64, reference: f64, std_error: f64, n: usize) -> Result
     })
 }
 
+/// The standard normal score with the same two-sided p-value and sign as a test
+/// statistic (e.g. a t statistic): `sign(statistic)·Φ⁻¹(1 − p/2)`, computed as
+/// `−Φ⁻¹(p/2)` so that small p keep their precision. Under the null it is exactly
+/// standard normal whenever p is exactly uniform, so such scores can be combined by
+/// [`chi2_sum_test`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a p-value outside (0, 1] or a non-finite statistic.
+pub fn equivalent_z(statistic: f64, p_value: f64) -> Result<f64> {
+    if !statistic.is_finite() {
+        return Err(Error::invalid("statistic", statistic, "finite"));
+    }
+    if !(p_value > 0.0 && p_value <= 1.0) {
+        return Err(Error::invalid("p_value", p_value, "in (0, 1]"));
+    }
+    let z = -normal(0.0, 1.0)?.inverse_cdf(p_value / 2.0);
+    Ok(if statistic < 0.0 { -z } else { z })
+}
+
 /// Combines independent z-scores: T = Σ z_i² is χ²(m) under the null (m = number of
 /// scores); p = P(χ²(m) ≥ T) (upper tail). Detects a common misfit spread over many
 /// checks that no single z-test flags.
@@ -287,6 +306,21 @@ mod tests {
     //! Hand-worked examples (exact values) and error paths; the false-rejection rates and
     //! power are validated over many seeds in `tests/stats_validation.rs`.
     use super::*;
+
+    #[test]
+    fn equivalent_z_by_hand() {
+        // p = 0.05 two-sided is |z| = 1.959964; the sign follows the statistic.
+        assert!((equivalent_z(2.5, 0.05).unwrap() - 1.959_963_984_540_054).abs() < 1e-9);
+        assert!((equivalent_z(-0.1, 0.05).unwrap() + 1.959_963_984_540_054).abs() < 1e-9);
+        assert_eq!(equivalent_z(1.0, 1.0).unwrap(), 0.0);
+        // A z-test's own statistic comes back.
+        let o = z_test(2.2, 0.0, 1.0).unwrap();
+        assert!((equivalent_z(o.statistic, o.p_value).unwrap() - 2.2).abs() < 1e-9);
+        // Tiny p keep their precision: p = 1e-20 is |z| = 9.262340.
+        assert!((equivalent_z(1.0, 1e-20).unwrap() - 9.262_340_089_798_408).abs() < 1e-6);
+        assert!(equivalent_z(1.0, 0.0).is_err());
+        assert!(equivalent_z(f64::NAN, 0.5).is_err());
+    }
 
     #[test]
     fn holm_hand_example() {
