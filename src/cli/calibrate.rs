@@ -30,7 +30,7 @@ use langevin_fem::verify::calibrate::{
 };
 use langevin_fem::verify::runner::progress_bar;
 use langevin_fem::verify::{SceneSummary, VerifyOptions, projected_work, run_verification};
-use langevin_fem::work::WorkProjection;
+use langevin_fem::work::{WorkLimits, WorkProjection};
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -145,52 +145,7 @@ pub fn run(args: CalibrateArgs) -> Result<i32> {
         budget.name(),
         args.alpha
     );
-    let bar = progress_bar(
-        n * scenes.len() as u64,
-        "runs",
-        std::io::stderr().is_terminal(),
-    );
-    let mut tallies: Vec<SceneTally> = scenes.iter().map(|_| SceneTally::default()).collect();
-    let mut rows: Vec<PValueRow> = Vec::new();
-    for (k, &seed) in plan.seeds.iter().enumerate() {
-        for (scene, tally) in scenes.iter().zip(&mut tallies) {
-            bar.set_message(format!("seed {} of {n} ({seed}): {}", k + 1, scene.name));
-            let mut one = scene.clone();
-            one.seed = seed;
-            let outcome = run_verification(&VerifyOptions {
-                scenes: vec![one],
-                budget,
-                out: scratch.clone(),
-                alpha: args.alpha,
-                progress: false,
-                limits,
-            });
-            remove_scratch(&scratch)?;
-            match outcome {
-                Ok((summary, _unfinished)) => {
-                    for s in &summary.scenes {
-                        record_scene(s, seed, tally, &mut rows, &bar);
-                    }
-                }
-                Err(err @ Error::Io { .. }) => return Err(err),
-                Err(err) if k == 0 && err.exit_code() == 2 => return Err(err),
-                Err(err) => {
-                    let message = err.to_string();
-                    bar.suspend(|| {
-                        eprintln!("{} seed {seed}: run failed: {message}", scene.name);
-                    });
-                    tally.run_failures += 1;
-                    tally.failed.push(FailedSeed {
-                        seed,
-                        failed_checks: Vec::new(),
-                        run_failure: Some(message),
-                    });
-                }
-            }
-            bar.inc(1);
-        }
-    }
-    bar.finish_and_clear();
+    let (tallies, rows) = verify_seeds(&scenes, &plan, budget, args.alpha, limits, &scratch)?;
     let per_check = p_values_per_check(&rows);
     let kinds = uniformity_by_kind(&per_check)?;
     let mut scene_results = Vec::with_capacity(scenes.len());
@@ -240,6 +195,70 @@ pub fn run(args: CalibrateArgs) -> Result<i32> {
         summary.run_id
     );
     Ok(if passed { 0 } else { 1 })
+}
+
+/// Verifies every scene at every seed of `plan` in `scratch` (removed after each), in
+/// turn: per scene its tally, and one p-value row per check per seed. A run failure at a
+/// seed is recorded, not returned; bad input at the first seed and I/O errors stop.
+///
+/// # Errors
+/// Input errors at the first seed (exit 2), I/O errors.
+fn verify_seeds(
+    scenes: &[Scene],
+    plan: &SeedPlan,
+    budget: Budget,
+    alpha: f64,
+    limits: WorkLimits,
+    scratch: &Path,
+) -> Result<(Vec<SceneTally>, Vec<PValueRow>)> {
+    let n = plan.seeds.len() as u64;
+    let bar = progress_bar(
+        n * scenes.len() as u64,
+        "runs",
+        std::io::stderr().is_terminal(),
+    );
+    let mut tallies: Vec<SceneTally> = scenes.iter().map(|_| SceneTally::default()).collect();
+    let mut rows: Vec<PValueRow> = Vec::new();
+    for (k, &seed) in plan.seeds.iter().enumerate() {
+        for (scene, tally) in scenes.iter().zip(&mut tallies) {
+            bar.set_message(format!("seed {} of {n} ({seed}): {}", k + 1, scene.name));
+            let mut one = scene.clone();
+            one.seed = seed;
+            let outcome = run_verification(&VerifyOptions {
+                scenes: vec![one],
+                budget,
+                out: scratch.to_path_buf(),
+                alpha,
+                progress: false,
+                limits,
+            });
+            remove_scratch(scratch)?;
+            match outcome {
+                Ok((summary, _unfinished)) => {
+                    for s in &summary.scenes {
+                        record_scene(s, seed, tally, &mut rows, &bar);
+                    }
+                }
+                Err(err @ Error::Io { .. }) => return Err(err),
+                Err(err) if k == 0 && err.exit_code() == 2 => return Err(err),
+                Err(err) => {
+                    let message = err.to_string();
+                    bar.suspend(|| {
+                        eprintln!("{} seed {seed}: run failed: {message}", scene.name);
+                    });
+                    tally.run_failures += 1;
+                    tally.failed.push(FailedSeed {
+                        seed,
+                        failed_checks: Vec::new(),
+                        run_failure: Some(message),
+                    });
+                }
+            }
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok((tallies, rows))
 }
 
 /// The work of `n` verifications of every scene, one after the other: each part's

@@ -284,7 +284,8 @@ pub struct KindUniformity {
 
 /// The uniformity of the p-values per check kind, kinds sorted by name, checks in input
 /// order ([`UNIFORMITY_RULE`]). Non-finite p-values are dropped, the others clamped to
-/// [0, 1].
+/// [0, 1]. A kind none of whose checks has a p-value (a deterministic kind, e.g. the
+/// oracle's) has no p-values to calibrate and is left out.
 ///
 /// # Errors
 /// [`Error::Numerical`] if the KS test fails (not expected for finite input).
@@ -293,6 +294,7 @@ pub fn uniformity_by_kind(checks: &[CheckPValues]) -> Result<Vec<KindUniformity>
     for c in checks {
         kinds.entry(c.kind.as_str()).or_default().push(c);
     }
+    kinds.retain(|_, list| list.iter().any(|c| !c.p_values.is_empty()));
     kinds
         .into_iter()
         .map(|(kind, list)| kind_uniformity(kind, &list))
