@@ -683,6 +683,7 @@ mod tests {
     use crate::rng::trajectory_rng;
     use crate::scene::builtin;
     use crate::scene::linear::LinearRun;
+    use crate::verify::summary::CheckResult;
     use crate::verify::{VerifyOptions, run_verification};
     use crate::work::WorkLimits;
 
@@ -1125,6 +1126,52 @@ mod tests {
         let kind = FaultKind::VonKarmanStrain;
         let v = verify(compression.with_fault(Fault::stated(kind)), kind.name());
         assert_eq!(v, Verdict::FailedChecks, "{kind} at its stated size");
+    }
+
+    /// **The axial equilibrium residual finds a von Kármán strain error far below the
+    /// statistical checks' reach.** `compression-2d` with its stored length 1e-4 too
+    /// large (the fault at s = 5e-5; `make power` finds 0.0125 with the force checks
+    /// alone): every run's `axial-equilibrium` check fails, and it is the only check
+    /// that fails; without the fault it passes. Deterministic (fixed seed).
+    #[test]
+    fn axial_residual_check_finds_a_tiny_von_karman_strain_error() {
+        let scene = builtin::find("compression-2d").unwrap().load().unwrap();
+        let summary = |scene: Scene, tag: &str| {
+            let out = std::env::temp_dir()
+                .join(format!("langevin-fem-axial-{}-{tag}", std::process::id()));
+            let (summary, _) = run_verification(&VerifyOptions {
+                scenes: vec![scene],
+                budget: crate::scene::Budget::Quick,
+                out: out.clone(),
+                alpha: 0.01,
+                progress: false,
+                limits: WorkLimits::default(),
+            })
+            .unwrap();
+            let _ = std::fs::remove_dir_all(&out);
+            summary.scenes.into_iter().next().unwrap().checks
+        };
+        let axial = |checks: &[CheckResult]| -> Vec<bool> {
+            checks
+                .iter()
+                .filter(|c| c.name.ends_with("/axial-equilibrium"))
+                .map(|c| c.passed)
+                .collect()
+        };
+        let clean = summary(scene.clone(), "clean");
+        assert_eq!(axial(&clean), vec![true; scene.runs.len()]);
+        let fault = Fault::new(FaultKind::VonKarmanStrain, 5e-5).unwrap();
+        let faulty = summary(scene.clone().with_fault(fault), "vk");
+        assert_eq!(axial(&faulty), vec![false; scene.runs.len()]);
+        let failed: Vec<_> = faulty
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| &c.name)
+            .collect();
+        assert!(
+            failed.iter().all(|n| n.ends_with("/axial-equilibrium")),
+            "{failed:?}"
+        );
     }
 
     /// **A bug in the shared model fails `verify` (exit 1) at the quick budget.** A 2 %

@@ -91,8 +91,28 @@ impl CompressionTheoryTable {
     }
 }
 
+/// Samples between two evaluations of the axial equilibrium residual
+/// ([`CompressedFilament::axial_residual`], O(n²) on the modal chain): the first sample of
+/// a trajectory and every 20th after it, about 40 states per trajectory at the quick
+/// budget, so that the residual check costs a few per cent of the chain.
+pub const AXIAL_RESIDUAL_EVERY: usize = 20;
+
+/// The largest axial equilibrium residual of a trajectory and the number of states it
+/// was evaluated at.
+fn note_axial_residual(rec: &mut ForceRecord, residual: f64) {
+    let worst = rec.axial_residual.unwrap_or(0.0);
+    // NaN (a non-finite state) is kept: it fails the check.
+    rec.axial_residual = Some(if residual.is_nan() || residual > worst {
+        residual
+    } else {
+        worst
+    });
+    rec.axial_states += 1;
+}
+
 /// The observer of [`CompressionRun::simulate`]: F/F_c0 and the nodal slopes at every
-/// sample, the Metropolis counts at the end.
+/// sample, the axial equilibrium residual every [`AXIAL_RESIDUAL_EVERY`] samples, the
+/// Metropolis counts at the end.
 struct ForceRecorder<'m> {
     model: &'m CompressedFilament,
     euler_load: f64,
@@ -104,6 +124,9 @@ impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
         let (model, w) = (self.model, &state.w);
         let f = model.compressive_force(model.stored_length(w));
         self.rec.force_ratio.push(f / self.euler_load);
+        if self.rec.slope_samples.is_multiple_of(AXIAL_RESIDUAL_EVERY) {
+            note_axial_residual(&mut self.rec, model.axial_residual(w, f));
+        }
         for c in w {
             add_slope_squares(model.beam(), c, &mut self.rec.slope_squares);
         }
@@ -117,19 +140,26 @@ impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
 }
 
 /// The observer of [`CompressionRun::simulate_modal`]: F/F_c0 and the squared rotation
-/// amplitude per wavenumber at every sample.
-struct ModalForceRecorder {
+/// amplitude per wavenumber at every sample, the axial equilibrium residual of the nodal
+/// state every [`AXIAL_RESIDUAL_EVERY`] samples (the chain itself never forms u).
+struct ModalForceRecorder<'m> {
+    model: &'m CompressedFilament,
     euler_load: f64,
-    force_ratio: Vec<f64>,
+    rec: ForceRecord,
     block_squares: Vec<f64>,
-    samples: usize,
 }
 
-impl Observer<ModalMetropolis<'_>> for ModalForceRecorder {
+impl Observer<ModalMetropolis<'_>> for ModalForceRecorder<'_> {
     fn on_sample(&mut self, _: usize, _: u64, chain: &ModalMetropolis<'_>) {
-        self.force_ratio.push(chain.force() / self.euler_load);
+        self.rec.force_ratio.push(chain.force() / self.euler_load);
         chain.add_block_rotation_squares(&mut self.block_squares);
-        self.samples += 1;
+        if self.rec.slope_samples.is_multiple_of(AXIAL_RESIDUAL_EVERY) {
+            let r = self
+                .model
+                .axial_residual(&chain.nodal_state(), chain.force());
+            note_axial_residual(&mut self.rec, r);
+        }
+        self.rec.slope_samples += 1;
     }
 }
 
@@ -220,6 +250,12 @@ pub struct ForceRecord {
     pub slope_squares: Vec<f64>,
     /// Number of samples in `slope_squares`.
     pub slope_samples: usize,
+    /// The largest axial equilibrium residual over the states evaluated
+    /// ([`CompressedFilament::axial_residual`]); `None` if none was (data from another
+    /// program).
+    pub axial_residual: Option<f64>,
+    /// Number of states the residual was evaluated at.
+    pub axial_states: u64,
 }
 
 impl CompressionRun {
@@ -440,10 +476,13 @@ impl CompressionRun {
         chain.proposed = 0;
         chain.accepted = 0;
         let mut recorder = ModalForceRecorder {
+            model,
             euler_load: self.euler_load,
-            force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
+            rec: ForceRecord {
+                force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
+                ..Default::default()
+            },
             block_squares: vec![0.0; modes.pairs().len() + modes.singles().len()],
-            samples: 0,
         };
         Driver::new(plan.dt, 0, sampled_steps, plan.sample_every).run(
             point,
@@ -455,11 +494,10 @@ impl CompressionRun {
         let mut slope_squares = vec![0.0; model.beam().mesh().n_nodes()];
         modes.add_rotation_squares(&recorder.block_squares, &mut slope_squares);
         Ok(ForceRecord {
-            force_ratio: recorder.force_ratio,
             proposed: chain.proposed,
             accepted: chain.accepted,
             slope_squares,
-            slope_samples: recorder.samples,
+            ..recorder.rec
         })
     }
 

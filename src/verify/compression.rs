@@ -175,7 +175,68 @@ fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> 
         ),
     ));
     out.push(mean_bias_check(name, &x.est.force, &theory.discrete)?);
+    out.extend(axial_residual_check(name, x.records, &theory.strain_ratios));
     Ok(())
+}
+
+/// Round-off allowance of the axial equilibrium residual per degree of freedom squared,
+/// in units of the machine epsilon: the stored length is a quadratic form summed over
+/// n DOFs (modal blocks or the assembled G in the chain, element matrices in the axial
+/// solve), whose relative round-off is at most about n·ε per sum, and the tridiagonal
+/// solve adds n·ε per unknown; n²·ε with a factor 64 bounds both with room for the modal
+/// basis's conditioning. Measured: below 3e-15 on the scenes (10 elements).
+const AXIAL_RESIDUAL_ROUND_OFF: f64 = 64.0;
+
+/// The axial equilibrium residual of the sampled states (issue: the field u is never
+/// formed by the chain): per run, the largest [`ForceRecord::axial_residual`] over the
+/// strains and trajectories against the round-off bound `64 n² ε` (n the free DOFs per
+/// component). Deterministic (no p-value, outside the Holm family): a simulator whose
+/// stored length or force law departs from the elements' von Kármán strain, or an axial
+/// solve that does not balance, fails it at any size above round-off. `None` when no
+/// record carries a residual (data from another program).
+fn axial_residual_check(
+    name: &str,
+    records: &[Vec<ForceRecord>],
+    strain_ratios: &[f64],
+) -> Option<CheckResult> {
+    let (mut worst, mut states, mut at) = (0.0f64, 0u64, 0);
+    for (i, point) in records.iter().enumerate() {
+        for r in point {
+            let Some(v) = r.axial_residual else { continue };
+            states += r.axial_states;
+            if v.is_nan() || v > worst {
+                (worst, at) = (v, i);
+            }
+        }
+    }
+    if states == 0 {
+        return None;
+    }
+    let dofs = records
+        .iter()
+        .flatten()
+        .map(|r| 2 * r.slope_squares.len().saturating_sub(1))
+        .max()
+        .unwrap_or(0) as f64;
+    let tolerance = AXIAL_RESIDUAL_ROUND_OFF * dofs * dofs * f64::EPSILON;
+    Some(CheckResult {
+        name: format!("{name}/axial-equilibrium"),
+        kind: "residual".to_string(),
+        passed: worst <= tolerance,
+        p_value: None,
+        p_adjusted: None,
+        estimate: Some(worst),
+        reference: Some(0.0),
+        std_error: None,
+        continuum: None,
+        reference_kind: "discrete".to_string(),
+        detail: format!(
+            "largest max_e |N_e + F| / (EA (|eps| + s)) over {states} sampled states (axial \
+             field u solved at fixed w, step i), at strain_ratio={}; allowed up to {tolerance:.2e} \
+             (round-off, 64 n^2 eps with n = {dofs} DOFs)",
+            strain_ratios.get(at).copied().unwrap_or(f64::NAN)
+        ),
+    })
 }
 
 /// The time-step bias of ⟨F⟩ bounded against the exact discrete theory: the mean over
@@ -324,7 +385,7 @@ pub fn halving_check(
 
 #[cfg(test)]
 mod tests {
-    use super::mean_bias_check;
+    use super::{ForceRecord, axial_residual_check, mean_bias_check};
     use crate::fem::noise::standard_normal;
     use crate::rng::trajectory_rng;
 
@@ -367,5 +428,37 @@ mod tests {
             "false rejections {rejected}/{reps}"
         );
         assert!(found as f64 / n > 0.8, "shift found in {found}/{reps}");
+    }
+
+    /// The residual check: the worst record over strains and trajectories, passing at
+    /// round-off (20 DOFs: bound 64·20²·ε = 5.7e-12), failing above it or on NaN, named
+    /// by the strain of the worst record; no check for records without residuals (data
+    /// from another program).
+    #[test]
+    fn axial_residual_check_takes_the_worst_state_and_fails_above_round_off() {
+        let rec = |r: Option<f64>| ForceRecord {
+            slope_squares: vec![0.0; 11],
+            axial_residual: r,
+            axial_states: u64::from(r.is_some()) * 40,
+            ..ForceRecord::default()
+        };
+        let ratios = [0.0, 3.0];
+        let records = |worst: f64| {
+            vec![
+                vec![rec(Some(1e-15)), rec(Some(2e-15))],
+                vec![rec(Some(worst)), rec(Some(3e-15))],
+            ]
+        };
+        let c = axial_residual_check("run", &records(4e-15), &ratios).unwrap();
+        assert!(c.passed && c.p_value.is_none(), "{c:?}");
+        assert_eq!(c.estimate, Some(4e-15));
+        assert!(c.detail.contains("160 sampled states") && c.detail.contains("strain_ratio=3"));
+        assert!(c.detail.contains("5.68e-12"), "{}", c.detail);
+        for bad in [1e-11, f64::NAN] {
+            let c = axial_residual_check("run", &records(bad), &ratios).unwrap();
+            assert!(!c.passed, "{bad}: {c:?}");
+        }
+        let none = vec![vec![rec(None)]];
+        assert!(axial_residual_check("run", &none, &ratios).is_none());
     }
 }
