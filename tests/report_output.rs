@@ -275,7 +275,13 @@ fn figure_with_nan_and_nonpositive_on_log_axis_does_not_fail() {
 fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
     CheckResult {
         name: name.to_string(),
+        run: String::new(),
+        check: String::new(),
+        parameter: String::new(),
         kind: "chi2-variance".to_string(),
+        statistic: Some(4.2),
+        dof: Some(3.0),
+        unit: "[L]^2".to_string(),
         passed,
         p_value: p,
         p_adjusted: p.map(|p| (3.0 * p).min(1.0)),
@@ -305,6 +311,7 @@ fn sample_summary() -> Summary {
                 ],
                 tables: vec!["clamped_free/mode_variance.csv".to_string()],
                 warnings: vec![],
+                skipped: vec![],
                 notes: vec!["ratio → 1 as elements increase".to_string()],
                 checks: vec![
                     check("mode-variance/n=1", true, Some(0.42)),
@@ -318,6 +325,7 @@ fn sample_summary() -> Summary {
                 figures: vec!["pinned/msd.svg".to_string()],
                 tables: vec![],
                 warnings: vec![],
+                skipped: vec![],
                 notes: vec![],
                 checks: vec![
                     check("msd/<script>alert(1)</script>", true, Some(0.3)),

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::scene::CheckKind;
 use crate::scene::linear::{LinearRun, TrajectoryRecord};
 use crate::stats::{self, TestOutcome};
-use crate::verify::summary::CheckResult;
+use crate::verify::summary::{CheckResult, SkippedCheck};
 
 /// Confidence level of the intervals reported in details.
 const CONFIDENCE: f64 = 0.95;
@@ -50,7 +50,7 @@ pub struct LinearEstimates {
     pub two_time: Vec<(f64, f64)>,
     /// Checks that could not be evaluated with this budget's data, and why. They are
     /// listed in the report's notes; they count neither as passed nor as failed.
-    pub skipped: Vec<String>,
+    pub skipped: Vec<SkippedCheck>,
 }
 
 /// A check result before the family-wise correction (see [`CheckResult::statistical`]).
@@ -62,7 +62,7 @@ fn check(
     continuum: Option<f64>,
     detail: String,
 ) -> CheckResult {
-    CheckResult::statistical(name, kind, values, continuum, outcome.p_value, detail)
+    CheckResult::statistical(name, kind, values, continuum, outcome, detail)
 }
 
 /// The test of an average over independent series against `reference`: a t-test with
@@ -124,10 +124,13 @@ fn zero_mean_check(
     what: &str,
 ) -> Result<()> {
     if values.len() < MIN_SERIES_FOR_T {
-        ctx.est.skipped.push(format!(
-            "{name}: needs at least {MIN_SERIES_FOR_T} independent series, the data have {}",
-            values.len()
-        ));
+        ctx.est.skipped.push(SkippedCheck {
+            name,
+            reason: format!(
+                "needs at least {MIN_SERIES_FOR_T} independent series, the data have {}",
+                values.len()
+            ),
+        });
         return Ok(());
     }
     let m = stats::ensemble_mean(values)?;
@@ -488,7 +491,7 @@ fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) ->
     ctx.out.push(check(
         format!("{prefix}/mode-ks/n={}", mr.n),
         "ks",
-        (o.statistic, f64::NAN, f64::NAN),
+        (f64::NAN, f64::NAN, f64::NAN),
         &o,
         None,
         format!(
@@ -502,7 +505,7 @@ fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) ->
     ctx.out.push(check(
         format!("{prefix}/mode-chi2-gof/n={}", mr.n),
         "chi2-gof",
-        (o.statistic, o.dof.unwrap_or(f64::NAN), f64::NAN),
+        (f64::NAN, f64::NAN, f64::NAN),
         &o,
         None,
         format!(
@@ -539,10 +542,10 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
                 ),
             ));
         }
-        Err(e) => ctx
-            .est
-            .skipped
-            .push(format!("{prefix}/decay-rate/n={}: {e}", mr.n)),
+        Err(e) => ctx.est.skipped.push(SkippedCheck {
+            name: format!("{prefix}/decay-rate/n={}", mr.n),
+            reason: e.to_string(),
+        }),
     }
     Ok(())
 }
@@ -563,9 +566,10 @@ fn spectrum_checks(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<
         )
     {
         let prefix = &ctx.run.spec.name;
-        ctx.est
-            .skipped
-            .push(format!("{prefix}/spectrum/n={}: {e}", mr.n));
+        ctx.est.skipped.push(SkippedCheck {
+            name: format!("{prefix}/spectrum/n={}", mr.n),
+            reason: e.to_string(),
+        });
     }
     Ok(())
 }

@@ -157,7 +157,7 @@ fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> 
             kind,
             (mean, theory.discrete[i], se),
             Some(theory.continuum[i]),
-            o.p_value,
+            &o,
             format!("<F>/F_c0 over {how}"),
         ));
     }
@@ -165,9 +165,9 @@ fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> 
     out.push(CheckResult::statistical(
         format!("{name}/force-strain-chi2"),
         "chi2-sum",
-        (o.statistic, z.len() as f64, f64::NAN),
+        (f64::NAN, f64::NAN, f64::NAN),
         None,
-        o.p_value,
+        &o,
         format!(
             "sum of squared z over {} strains against chi2({})",
             z.len(),
@@ -221,7 +221,13 @@ fn axial_residual_check(
     let tolerance = AXIAL_RESIDUAL_ROUND_OFF * dofs * dofs * f64::EPSILON;
     Some(CheckResult {
         name: format!("{name}/axial-equilibrium"),
+        run: String::new(),
+        check: String::new(),
+        parameter: String::new(),
         kind: "residual".to_string(),
+        statistic: None,
+        dof: None,
+        unit: String::new(),
         passed: worst <= tolerance,
         p_value: None,
         p_adjusted: None,
@@ -266,7 +272,7 @@ pub fn mean_bias_check(name: &str, force: &[(f64, f64)], discrete: &[f64]) -> Re
         "z-test",
         (mean, 0.0, se),
         None,
-        o.p_value,
+        &o,
         format!(
             "mean of <F>/F_c0 - exact discrete theory over {} strains: 95% bound on |time-step bias| {bound:.2e} {} the largest point standard error {max_se:.2e}",
             force.len(),
@@ -297,9 +303,9 @@ fn force_distribution_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult
         out.push(CheckResult::statistical(
             format!("{name}/force-ks/strain_ratio={}", x.theory.strain_ratios[i]),
             "ks",
-            (o.statistic, f64::NAN, f64::NAN),
+            (f64::NAN, f64::NAN, f64::NAN),
             None,
-            o.p_value,
+            &o,
             format!(
                 "{} samples thinned every {stride} (>= {KS_THINNING_TAU} IAT)",
                 samples.len()
@@ -372,7 +378,7 @@ pub fn halving_check(
             "chi2-sum",
             (mean_diff, 0.0, se),
             None,
-            o.p_value,
+            &o,
             format!(
                 "per-strain z of the difference, sum of z^2 = {:.2} against chi2({})",
                 o.statistic,

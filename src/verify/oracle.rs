@@ -104,7 +104,13 @@ fn oracle_check(
     let gap = observed - predicted;
     CheckResult {
         name,
+        run: String::new(),
+        check: String::new(),
+        parameter: String::new(),
         kind: ORACLE_KIND.to_string(),
+        statistic: None,
+        dof: None,
+        unit: String::new(),
         passed: gap.is_finite() && gap >= band.0 && gap <= band.1,
         p_value: None,
         p_adjusted: None,

@@ -47,7 +47,7 @@ use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
 use crate::verify::oracle::{Oracle, compression_oracle, linear_oracle};
-use crate::verify::summary::{CheckResult, SceneSummary, Summary};
+use crate::verify::summary::{CheckResult, SceneSummary, SkippedCheck, Summary};
 use crate::work::{WorkLimits, WorkProjection};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -372,6 +372,8 @@ struct SceneOutputs<'r> {
     tables: Vec<PathBuf>,
     /// Notes for a reader; the first is the scene's description.
     notes: Vec<String>,
+    /// Checks not evaluated (budget or data too small for them), with the reason.
+    skipped: Vec<SkippedCheck>,
 }
 
 impl<'r> SceneOutputs<'r> {
@@ -381,6 +383,7 @@ impl<'r> SceneOutputs<'r> {
             checks: Vec::new(),
             figures: Vec::new(),
             tables: Vec::new(),
+            skipped: Vec::new(),
             notes: std::iter::once(scene.description.clone())
                 .chain(
                     scene
@@ -877,7 +880,12 @@ fn finish_scene(
         figures,
         tables,
         notes,
+        skipped,
     } = outputs;
+    let runs: Vec<&str> = scene.runs.iter().map(|r| r.name.as_str()).collect();
+    for c in &mut checks {
+        c.locate(&runs);
+    }
     // Holm over the statistical checks; a deterministic check (no p-value, e.g. the
     // oracle's) keeps its own verdict and is not part of the family.
     let p: Vec<f64> = checks.iter().filter_map(|c| c.p_value).collect();
@@ -904,6 +912,7 @@ fn finish_scene(
         tables: rel(tables),
         notes,
         warnings: Vec::new(),
+        skipped,
         checks,
     })
 }
@@ -949,11 +958,7 @@ fn run_scene(
         {
             largest_slope = Some((run.spec.name.clone(), slope));
         }
-        outputs.notes.extend(
-            est.skipped
-                .iter()
-                .map(|s| format!("not evaluated at this budget: {s}")),
-        );
+        outputs.skipped.extend(est.skipped.iter().cloned());
         outputs.notes.push(linear_run_note(scene, run, &e));
         write_run_outputs(&dir, run, &est, &mut outputs)?;
         if noise_study_after == Some(k) {
@@ -1023,11 +1028,7 @@ pub fn check_data(
                     "the data did not support the estimate; longer or more trajectories may help",
                 )
             })?;
-        outputs.notes.extend(
-            est.skipped
-                .iter()
-                .map(|s| format!("not evaluated with these data: {s}")),
-        );
+        outputs.skipped.extend(est.skipped.iter().cloned());
         outputs.notes.extend(dc.notes.iter().cloned());
         outputs.notes.push(format!(
             "run {}: {} trajectories {}, rows every {:e} (time units of the filament), burn-in {:e}",

@@ -4,15 +4,36 @@
 //! clear), the budget, the scenes and their checks.
 
 use crate::output::ProvenanceRef;
+use crate::stats::TestOutcome;
 use serde::{Deserialize, Serialize};
 
 /// One statistical or deterministic check.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckResult {
-    /// Unique name within the scene, e.g. `mode-variance/n=3`.
+    /// Unique name within the scene, `run/check/parameter`, e.g.
+    /// `paper/mode-variance/n=3` (the three parts are also given apart below).
     pub name: String,
-    /// Kind of check, e.g. `chi2-variance`, `ks`, `z-test`, `deterministic`.
+    /// The run the check belongs to; empty for a check of the scene (the oracle's
+    /// checks of the scene's theory, the Δt-halving comparison of two runs).
+    #[serde(default)]
+    pub run: String,
+    /// What is checked, e.g. `mode-variance`, `decay-rate`, `force`,
+    /// `oracle-eigenvalue` (the name without run and parameter).
+    #[serde(default)]
+    pub check: String,
+    /// Where it is checked, e.g. `n=3`, `x=0.2500`, `strain_ratio=1.5`; empty if the
+    /// check has no parameter.
+    #[serde(default)]
+    pub parameter: String,
+    /// The test, e.g. `t-test`, `z-test`, `chi2-variance`, `chi2-gof`, `chi2-sum`, `ks`;
+    /// `oracle` and `residual` for deterministic checks.
     pub kind: String,
+    /// The test statistic (t, z, χ², KS distance D); `None` for a deterministic check.
+    #[serde(default)]
+    pub statistic: Option<f64>,
+    /// Degrees of freedom of the statistic's null distribution, where it has any.
+    #[serde(default)]
+    pub dof: Option<f64>,
     /// Whether the check passed (after the family-wise correction).
     pub passed: bool,
     /// Raw (unadjusted) p-value, for statistical checks.
@@ -31,8 +52,47 @@ pub struct CheckResult {
     /// Which reference is used: `discrete` (exact for the discretized system and
     /// integrator) or `continuum`.
     pub reference_kind: String,
+    /// Unit of `estimate`, `reference`, `std_error` and `continuum`, in the scene's base
+    /// dimensions as in the column dictionary ([`crate::output::columns`]): `[L]^2`,
+    /// `1/[T]`, `F_c0`, `1`, …; empty when the check has no estimate (a χ² or KS test,
+    /// whose result is its statistic).
+    #[serde(default)]
+    pub unit: String,
     /// Free-text detail for a reader (what was compared, sample size, …).
     pub detail: String,
+}
+
+/// A check the scene asks for that was not evaluated, with the reason (e.g. the series at
+/// this budget are too short for a decay-rate window). Counted apart: neither passed nor
+/// failed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedCheck {
+    /// The name the check would have had (`run/check/parameter`).
+    pub name: String,
+    /// Why it was not evaluated.
+    pub reason: String,
+}
+
+/// The unit of the estimate of check `check` (see [`CheckResult::unit`]), empty for a
+/// check whose result is its statistic.
+pub fn unit_of_check(check: &str) -> &'static str {
+    match check {
+        "mode-variance" | "mode-variance-chi2" | "mode-cross" | "profile" | "time-reversal"
+        | "two-time" | "oracle-profile" => "[L]^2",
+        "mode-mean" => "[L]",
+        "decay-rate" => "1/[T]",
+        "force" | "force-mean-bias" | "oracle-force" => "F_c0",
+        "spectrum-low"
+        | "spectrum-high"
+        | "oracle-eigenvalue"
+        | "oracle-variance"
+        | "oracle-multiplier"
+        | "oracle-noise"
+        | "oracle-stored-length"
+        | "axial-equilibrium" => "1",
+        _ if check.starts_with("oracle") => "1",
+        _ => "",
+    }
 }
 
 impl CheckResult {
@@ -40,20 +100,27 @@ impl CheckResult {
     /// runner's Holm step). `values` is (estimate, reference, standard error) against the
     /// exact discrete reference; a non-finite entry means "not applicable" (e.g. the
     /// reference of a KS distance) and is stored as `None`.
+    /// The test's statistic, degrees of freedom and p-value are `outcome`'s.
     pub fn statistical(
         name: String,
         kind: &str,
         values: (f64, f64, f64),
         continuum: Option<f64>,
-        p_value: f64,
+        outcome: &TestOutcome,
         detail: String,
     ) -> Self {
         let finite = |v: f64| v.is_finite().then_some(v);
         CheckResult {
             name,
+            run: String::new(),
+            check: String::new(),
+            parameter: String::new(),
             kind: kind.to_string(),
+            statistic: finite(outcome.statistic),
+            dof: outcome.dof,
+            unit: String::new(),
             passed: true,
-            p_value: Some(p_value),
+            p_value: Some(outcome.p_value),
             p_adjusted: None,
             estimate: finite(values.0),
             reference: finite(values.1),
@@ -61,6 +128,31 @@ impl CheckResult {
             continuum,
             reference_kind: "discrete".to_string(),
             detail,
+        }
+    }
+
+    /// Fills [`Self::run`], [`Self::check`], [`Self::parameter`] and [`Self::unit`] from
+    /// the name `run/check/parameter` (`run` one of `runs`; a name whose first part is
+    /// not a run is a check of the scene), unless they are set.
+    pub fn locate(&mut self, runs: &[&str]) {
+        if !self.check.is_empty() {
+            return;
+        }
+        let mut rest = self.name.as_str();
+        if let Some((first, tail)) = rest.split_once('/')
+            && runs.contains(&first)
+        {
+            self.run = first.to_string();
+            rest = tail;
+        }
+        let (check, parameter) = match rest.rsplit_once('/') {
+            Some((c, p)) if p.contains('=') => (c, p),
+            _ => (rest, ""),
+        };
+        self.check = check.to_string();
+        self.parameter = parameter.to_string();
+        if self.unit.is_empty() {
+            self.unit = unit_of_check(check).to_string();
         }
     }
 }
@@ -84,6 +176,9 @@ pub struct SceneSummary {
     /// physics (e.g. slopes too large for the small-slope approximation).
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// Checks the scene asks for that were not evaluated (neither passed nor failed).
+    #[serde(default)]
+    pub skipped: Vec<SkippedCheck>,
     /// The checks.
     pub checks: Vec<CheckResult>,
 }
