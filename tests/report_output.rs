@@ -312,6 +312,7 @@ fn sample_summary() -> Summary {
                 tables: vec!["clamped_free/mode_variance.csv".to_string()],
                 warnings: vec![],
                 skipped: vec![],
+                captions: vec![],
                 notes: vec!["ratio → 1 as elements increase".to_string()],
                 checks: vec![
                     check("mode-variance/n=1", true, Some(0.42)),
@@ -326,6 +327,7 @@ fn sample_summary() -> Summary {
                 tables: vec![],
                 warnings: vec![],
                 skipped: vec![],
+                captions: vec![],
                 notes: vec![],
                 checks: vec![
                     check("msd/<script>alert(1)</script>", true, Some(0.3)),

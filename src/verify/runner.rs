@@ -908,6 +908,7 @@ fn finish_scene(
         name: scene.name.clone(),
         passed: checks.iter().all(|c| c.passed),
         wall_seconds: start.elapsed().as_secs_f64(),
+        captions: vec![String::new(); figures.len()],
         figures: rel(figures),
         tables: rel(tables),
         notes,

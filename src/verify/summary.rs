@@ -168,6 +168,10 @@ pub struct SceneSummary {
     pub wall_seconds: f64,
     /// Relative paths (from the output directory) of the figures written for the scene.
     pub figures: Vec<String>,
+    /// The caption of each figure, in the order of `figures`: what is plotted and what a
+    /// reader should see (empty for a figure without one).
+    #[serde(default)]
+    pub captions: Vec<String>,
     /// Relative paths of the CSV tables written for the scene.
     pub tables: Vec<String>,
     /// Notes for a reader (e.g. how a ratio changes with element count).
