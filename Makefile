@@ -3,7 +3,8 @@
 #   make verify            quick verification suite (CI), reports in reports/
 #   make verify BUDGET=full   publication-grade error bars
 #   make test              all tests (unit, integration, statistical validation, golden),
-#                          then `check` against the NumPy example simulator
+#                          then `check` against the NumPy example simulator, then the
+#                          reports rendered in headless Chromium (browser-check)
 #   make check             fmt --check, clippy -D warnings, tests
 #   make bench             benchmarks (benches/), see README performance table
 #   make golden            re-run golden snapshots, accept changes, show the diff
@@ -19,7 +20,7 @@ BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check calibrate power
+.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check browser-check calibrate power
 
 all: build
 
@@ -52,6 +53,7 @@ calibrate: build
 test:
 	$(CARGO) test --release --locked
 	$(MAKE) --no-print-directory example-check
+	$(MAKE) --no-print-directory browser-check
 
 # `check` against an independent simulator (examples/numpy-simulator, NumPy in a venv):
 # passes at a small time step, fails naming the biased modes at a large one; NumPy reads
@@ -61,6 +63,24 @@ example-check: build
 	test -x $(PEERS_VENV)/bin/python || python3 -m venv $(PEERS_VENV)
 	$(PEERS_VENV)/bin/python -c "import numpy" 2>/dev/null || $(PEERS_VENV)/bin/python -m pip install -q numpy==$(PEERS_NUMPY)
 	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
+
+# The reports as a reader sees them (issue #14): a quick verification of every default
+# scene (passing) and the example check's failing report (NumPy at a large step) rendered
+# in headless Chromium (Debian's package, installed here if missing; playwright-core from
+# the npm registry, pinned in tests/browser/package-lock.json): no console errors, failed
+# requests or broken links; the verdict and the failures first; under 10 screen heights
+# collapsed; every figure loads with a caption. Screenshots in $(BROWSER_SHOTS) (CI
+# artefacts). Part of `make test`, after example-check (whose failing report it reads).
+CHROMIUM      ?= /usr/bin/chromium
+BROWSER_SHOTS ?= $(OUT)/browser
+BROWSER_OUT   ?= target/browser-check
+SUDO          := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+browser-check: build
+	test -x $(CHROMIUM) || $(SUDO) apt-get install -y -q chromium || { $(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q chromium; }
+	cd tests/browser && npm ci --no-audit --no-fund --loglevel=error
+	$(BIN) verify --out $(BROWSER_OUT)/passed > $(BROWSER_OUT).log 2>&1 || { cat $(BROWSER_OUT).log; exit 1; }
+	CHROMIUM=$(CHROMIUM) node tests/browser/check-index.mjs --report $(BROWSER_OUT)/passed --expect passed --shots $(BROWSER_SHOTS) --name verify-passed
+	CHROMIUM=$(CHROMIUM) node tests/browser/check-index.mjs --report $(EXAMPLE_OUT)/large-dt-report --expect failed --shots $(BROWSER_SHOTS) --name check-failed
 
 check:
 	$(CARGO) fmt --check

@@ -374,11 +374,22 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
     assert!(!html.contains("<script"), "unescaped script tag");
     assert!(html.contains("msd/&lt;script&gt;alert(1)&lt;/script&gt;"));
     assert!(html.contains("n = 4000 samples &amp; 3 lags"));
-    // The failing check's row is marked, and so are its scene and the whole run.
-    assert!(html.contains("<tr class=\"fail\"><td>msd/late-time</td>"));
+    // The failing check's row is marked, and so are its scene and the whole run; the
+    // verdict comes first, then the failures (the failing check, linked to its scene),
+    // then the scenes.
+    assert!(html.contains("<tr class=\"check fail\"><td><a href=\"#scene-1\">pinned</a></td>"));
     assert!(html.contains("<td class=\"fail\">FAIL</td>"));
-    assert!(html.contains("<tr class=\"pass\"><td>mode-variance/n=1</td>"));
-    assert!(html.contains("Overall result: <span class=\"badge fail\">FAIL</span>"));
+    assert!(html.contains("<tr class=\"check pass\"><td>(scene)</td>"));
+    let at = |s: &str| html.find(s).unwrap_or_else(|| panic!("missing {s}"));
+    assert!(
+        at("<div class=\"verdict fail\" id=\"verdict\"><span class=\"word\">FAILED</span>")
+            < at("id=\"failures\"")
+    );
+    assert!(at("id=\"failures\"") < at("id=\"scenes\""));
+    assert!(html.contains("3 passed, 1 failed, 0 skipped"));
+    // The check tables are collapsed; columns keep one meaning (statistic, dof, unit).
+    assert!(html.contains("<details class=\"checks\"><summary>All 2 checks"));
+    assert!(html.contains(">4.200<") && html.contains(">3<") && html.contains(">[L]^2<"));
     // The run id, as in summary.json.
     assert!(html.contains("<code id=\"run-id\">20250101T120000Z-4242-1a2b3c4d</code>"));
     // Numbers to 4 significant digits, a dash where there is no value, Holm mentioned.
@@ -391,7 +402,13 @@ fn index_html_lists_figures_and_checks_and_escapes_text() {
     let tmp = TempDir::new("index");
     let dir = tmp.path();
     write_index(dir, &summary).expect("write index");
-    assert_eq!(fs::read_to_string(dir.join("index.html")).unwrap(), html);
+    let written = fs::read_to_string(dir.join("index.html")).unwrap();
+    // As rendered, with the convergence section saying how to make it (no link to a
+    // folder that does not exist).
+    assert!(!written.contains("href=\"convergence/index.html\""));
+    assert!(written.contains("id=\"convergence\""));
+    let (a, b) = html.split_once("<!-- convergence -->\n").unwrap();
+    assert!(written.starts_with(a) && written.ends_with(b));
     assert_eq!(file_names(dir), vec!["index.html"]);
 }
 

@@ -47,7 +47,7 @@ pub struct Target {
 }
 
 /// The scenes each fault is measured in: the cheapest that exercise it; noise variance
-/// and stiffness errors in every kind of scene (the smallest detectable size per scene).
+/// and stiffness errors in every default scene (the smallest detectable size per scene).
 /// To keep `make power` within about 30 minutes on 2 cores, the linear finite-element
 /// scenes are restricted to one run each: their Crank–Nicolson run (consistent noise;
 /// `hinged-linear-2d` takes about 10 s a quick verify in full), and the exact-modal run
@@ -61,8 +61,10 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
         FaultKind::NoiseVariance | FaultKind::IntegratorStiffness => vec![
             t("hinged-linear-3d", CN),
             t("hinged-linear-2d", CN),
+            t("actin-10um", CN),
             t("spectral-reference", ALL),
             t("compression-2d", ALL),
+            t("compression-3d", ALL),
         ],
         FaultKind::NoiseTimeScaling => vec![t("hinged-linear-3d", &["exact-modal"])],
         FaultKind::IntegratorDrag

@@ -374,6 +374,9 @@ struct SceneOutputs<'r> {
     notes: Vec<String>,
     /// Checks not evaluated (budget or data too small for them), with the reason.
     skipped: Vec<SkippedCheck>,
+    /// The names of the runs whose checks these are (the scene's, or the data's for
+    /// `check`): the first part of a check's name when it is one of them.
+    runs: Vec<String>,
 }
 
 impl<'r> SceneOutputs<'r> {
@@ -384,6 +387,7 @@ impl<'r> SceneOutputs<'r> {
             figures: Vec::new(),
             tables: Vec::new(),
             skipped: Vec::new(),
+            runs: scene.runs.iter().map(|r| r.name.clone()).collect(),
             notes: std::iter::once(scene.description.clone())
                 .chain(
                     scene
@@ -881,8 +885,9 @@ fn finish_scene(
         tables,
         notes,
         skipped,
+        runs,
     } = outputs;
-    let runs: Vec<&str> = scene.runs.iter().map(|r| r.name.as_str()).collect();
+    let runs: Vec<&str> = runs.iter().map(String::as_str).collect();
     for c in &mut checks {
         c.locate(&runs);
     }
@@ -1023,6 +1028,7 @@ pub fn check_data(
     let mut outputs = SceneOutputs::new(scene, &report);
     outputs.notes.push(data_note(&sidecar, data_dir));
     for (data, dc) in sidecar.runs.iter().zip(&prepared) {
+        outputs.runs.push(data.name.clone());
         let est = apply_linear_checks(scene, &dc.run, &dc.records, &dc.two_time, &mut outputs)
             .map_err(|e| {
                 Error::run_failed(format!("data run {}", data.name), "checks", e).with_advice(
@@ -1112,6 +1118,7 @@ fn check_compression_data(
     let mut fig: Option<Figure> = None;
     for c in &checks {
         let name = &c.run.spec.name;
+        outputs.runs.push(name.clone());
         let failed = |e: Error| {
             Error::run_failed(format!("data run {name}"), "force checks", e).with_advice(
                 "the data did not support the estimate; longer or more trajectories may help",
