@@ -687,6 +687,12 @@ fn good_scenes_run_and_write_documented_outputs() {
         let s = verify_scene(&scene, out.path(), None);
         let ctx = format!("scene {}", scene.display());
 
+        // The shape the repository's JSON Schema states (src/verify/summary.schema.json).
+        let v = common::schema::violations(&common::schema::summary_schema(), &s);
+        assert!(
+            v.is_empty(),
+            "{ctx}: summary.json departs from its schema: {v:#?}"
+        );
         assert_eq!(s["budget"], "quick", "{ctx}");
         assert_eq!(s["alpha"].as_f64(), Some(0.01), "{ctx}");
         let scenes = s["scenes"].as_array().expect("scenes is an array");

@@ -345,6 +345,38 @@ fn sample_summary() -> Summary {
     }
 }
 
+/// `summary.json` follows its JSON Schema (src/verify/summary.schema.json), and the
+/// validator rejects what departs from it: a key missing, a key not in the schema, a
+/// wrong type, a value outside an enum.
+#[test]
+fn summary_json_follows_its_schema_and_departures_are_found() {
+    let schema = common::schema::summary_schema();
+    let value = serde_json::to_value(sample_summary()).unwrap();
+    let v = common::schema::violations(&schema, &value);
+    assert!(v.is_empty(), "{v:#?}");
+    let broken = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut b = value.clone();
+        f(&mut b);
+        common::schema::violations(&schema, &b)
+    };
+    let v = broken(&|b| {
+        b["scenes"][0]["checks"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("dof");
+    });
+    assert!(v.iter().any(|e| e.contains("required key dof")), "{v:?}");
+    let v = broken(&|b| b["scenes"][1]["extra"] = serde_json::json!(1));
+    assert!(
+        v.iter().any(|e| e.contains("key extra not in the schema")),
+        "{v:?}"
+    );
+    let v = broken(&|b| b["scenes"][0]["checks"][1]["statistic"] = serde_json::json!("4.2"));
+    assert!(v.iter().any(|e| e.contains("statistic")), "{v:?}");
+    let v = broken(&|b| b["scenes"][0]["checks"][0]["reference_kind"] = serde_json::json!("x"));
+    assert!(v.iter().any(|e| e.contains("not one of")), "{v:?}");
+}
+
 /// index.html embeds every figure, names every check (HTML-escaped, so a `<script>` in a
 /// check name stays text), marks the failing check, and write_index writes the same page.
 #[test]

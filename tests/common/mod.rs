@@ -2,6 +2,7 @@
 //! and uses what it needs.
 //!
 //! - [`seeds`]: every fixed seed of the suite, as named constants in one place;
+//! - [`schema`]: the JSON Schema of `summary.json` and a validator of its subset;
 //! - [`filament`]: the filament parameter sets the tests are written for;
 //! - paths into the crate ([`manifest_dir`], [`fixture`], [`scene`]);
 //! - [`TempDir`], a unique temporary directory removed on drop, and [`write_scene`];
@@ -20,6 +21,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{SystemTime, UNIX_EPOCH};
 
 pub mod filament;
+pub mod schema;
 pub mod seeds;
 
 /// The `langevin-fem` binary built for these tests.
