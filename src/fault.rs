@@ -1075,7 +1075,7 @@ mod tests {
             budget: crate::scene::Budget::Quick,
             out: out.clone(),
             alpha: 0.01,
-            progress: false,
+            progress: crate::progress::ProgressOptions::HIDDEN,
             limits: WorkLimits::default(),
         });
         let _ = std::fs::remove_dir_all(&out);
@@ -1144,7 +1144,7 @@ mod tests {
                 budget: crate::scene::Budget::Quick,
                 out: out.clone(),
                 alpha: 0.01,
-                progress: false,
+                progress: crate::progress::ProgressOptions::HIDDEN,
                 limits: WorkLimits::default(),
             })
             .unwrap();

@@ -8,8 +8,9 @@
 //! Layers, from the bottom up (each imports only from the layers below it):
 //!
 //! 1. Foundation: [`params`], [`rng`], [`error`] (physical parameters, deterministic
-//!    randomness, errors), [`output`] (domain-free SVG figures and atomic file writers)
-//!    and [`work`] (the caps on a command's projected total work and memory).
+//!    randomness, errors), [`output`] (domain-free SVG figures and atomic file writers),
+//!    [`work`] (the caps on a command's projected total work and memory) and
+//!    [`progress`] (progress on stderr, weighted by that work).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
 //!    (2)–(4)).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
@@ -59,6 +60,7 @@ pub mod fault;
 pub mod fem;
 pub mod output;
 pub mod params;
+pub mod progress;
 pub mod report;
 pub mod rng;
 pub mod scene;

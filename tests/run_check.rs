@@ -152,6 +152,14 @@ fn an_injected_bias_fails_naming_the_checks() {
         stdout.contains("failed: crank-nicolson/mode-variance/n=2"),
         "{stdout}"
     );
+    // The closing totals line (#14): the checks of summary.json, counted.
+    let n_failed = failed.len();
+    let totals = format!("{} passed, {n_failed} failed, ", results.len() - n_failed);
+    let last = stdout.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with(&totals) && last.contains(" skipped in ") && last.ends_with(" s"),
+        "{last:?}, expected {totals:?}..."
+    );
 }
 
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.

@@ -737,12 +737,13 @@ fn refusals() -> Vec<Refusal> {
                 "work-precision",
                 "--trajectories",
                 "1024",
+                // The old spelling, a hidden alias of --duration-tau1 (#14).
                 "--duration",
                 "1e6",
             ],
             names: vec![
-                "(--methods, --dt-tau1, --trajectories, --duration)",
-                "--trajectories 1024 x --duration = 1000000 tau1 at dt/tau1 = 3e-4",
+                "(--methods, --dt-tau1, --trajectories, --duration-tau1)",
+                "--trajectories 1024 x --duration-tau1 = 1000000 tau1 at dt/tau1 = 3e-4",
                 "and 1.0 GiB of samples",
             ],
             over_work: true,
@@ -763,7 +764,7 @@ fn refusals() -> Vec<Refusal> {
                 "euler-maruyama/consistent",
             ],
             names: vec![
-                "(--methods, --em-fractions, --trajectories, --em-duration)",
+                "(--methods, --em-fractions, --trajectories, --em-duration-tau1)",
                 "euler-maruyama (consistent) at dt/tau1 = 3.478896108357276e-14",
                 "1000 elements",
                 "years at 5e7 DOF-steps/s",

@@ -16,11 +16,13 @@
 //! seed-dependent error such as a divergence, whose input passed at the first seed — is
 //! recorded as a failure of that seed with its message (a *run failure*), not an abort.
 
+use super::Verbosity;
 use super::verify::BudgetArg;
 use super::{count_in, usize_in};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::output::{Provenance, ReportRun};
+use langevin_fem::progress::{Progress, ProgressOptions};
 use langevin_fem::report::write_calibration_report;
 use langevin_fem::scene::{Budget, Scene, load_scenes};
 use langevin_fem::verify::calibrate::{
@@ -28,11 +30,9 @@ use langevin_fem::verify::calibrate::{
     P_VALUES_CSV, PValueRow, SceneCalibration, SeedPlan, UNIFORMITY_LEVEL, UNIFORMITY_RULE,
     false_alarms, p_value_figure, p_values_csv, p_values_per_check, uniformity_by_kind,
 };
-use langevin_fem::verify::runner::progress_bar;
 use langevin_fem::verify::{SceneSummary, VerifyOptions, projected_work, run_verification};
 use langevin_fem::work::{WorkLimits, WorkProjection};
 use std::collections::BTreeMap;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// The first seed when `--first-seed` is not given.
@@ -43,13 +43,23 @@ pub const DEFAULT_FIRST_SEED: u64 = 1;
 /// it).
 pub const SCRATCH: &str = ".calibrate-scratch";
 
+/// The examples of `calibrate --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem calibrate -s hinged-linear-2d --seeds 20          20 seeds of one scene
+  langevin-fem calibrate --seeds 100 -o reports/calibration      every built-in scene (about 25 min)
+  langevin-fem calibrate -s my-scene.toml --seeds 50 --first-seed 1000 -j 2
+
+Progress goes to stderr: a bar on a terminal, else a line per seed; the tables go to stdout.";
+
 /// Command-line arguments of `langevin-fem calibrate`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct CalibrateArgs {
     /// Scene to calibrate: a built-in scene's name, a name in --scene-dir when given, or
     /// a path to a .toml file (repeatable; default: every built-in top-level scene, or
     /// every scene of --scene-dir).
-    #[arg(long = "scene", value_name = "NAME|PATH")]
+    #[arg(short = 's', long = "scene", value_name = "NAME|PATH")]
     scenes: Vec<String>,
     /// Seeds per scene, N (2 to 100000): seed k = --first-seed + k, k = 0 .. N-1.
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = count_in::<2, 100_000>)]
@@ -59,14 +69,14 @@ pub struct CalibrateArgs {
     #[arg(long, value_name = "S", default_value_t = DEFAULT_FIRST_SEED, allow_negative_numbers = true, value_parser = count_in::<0, { u64::MAX }>)]
     first_seed: u64,
     /// Statistics budget of every verification.
-    #[arg(long, value_enum, default_value = "quick")]
+    #[arg(short, long, value_enum, default_value = "quick")]
     budget: BudgetArg,
     /// Family-wise significance level per scene (Holm), as in `verify`.
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
     /// Output directory: calibration.json, p-values.csv, <scene>-p-values.svg,
     /// index.html and the journal manifest.json.
-    #[arg(long, default_value = "reports/calibration")]
+    #[arg(short, long, default_value = "reports/calibration")]
     pub(super) out: PathBuf,
     /// Directory of scene files: names resolve there instead of among the built-in
     /// scenes, and without --scene every scene there runs.
@@ -74,7 +84,7 @@ pub struct CalibrateArgs {
     scene_dir: Option<PathBuf>,
     /// Worker threads of the parallel ensembles (1 to 256; default: rayon's, the number
     /// of CPUs or RAYON_NUM_THREADS). Results are bit-identical whatever the count.
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 256>)]
+    #[arg(short = 'j', long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 256>)]
     threads: Option<usize>,
     #[command(flatten)]
     limits: super::LimitArgs,
@@ -105,7 +115,7 @@ struct SceneTally {
 
 /// Runs the calibration; exit code 0 if every scene is consistent with α and no check
 /// kind is rejected, 1 otherwise.
-pub fn run(args: CalibrateArgs) -> Result<i32> {
+pub fn run(args: CalibrateArgs, verbosity: Verbosity) -> Result<i32> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -136,16 +146,25 @@ pub fn run(args: CalibrateArgs) -> Result<i32> {
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     let scratch = args.out.join(SCRATCH);
     remove_scratch(&scratch)?;
-    eprintln!(
-        "calibrate: {} scene(s) x {n} seeds ({} .. {}; seed k = {} + k, each as `verify --seed`), budget {}, alpha {} per scene",
-        scenes.len(),
-        plan.seeds[0],
-        plan.seeds[plan.seeds.len() - 1],
-        plan.first,
-        budget.name(),
-        args.alpha
-    );
-    let (tallies, rows) = verify_seeds(&scenes, &plan, budget, args.alpha, limits, &scratch)?;
+    let progress = verbosity.progress();
+    if progress.mode != langevin_fem::progress::ProgressMode::Hidden {
+        eprintln!(
+            "calibrate: {} scene(s) x {n} seeds ({} .. {}; seed k = {} + k, each as `verify --seed`), budget {}, alpha {} per scene",
+            scenes.len(),
+            plan.seeds[0],
+            plan.seeds[plan.seeds.len() - 1],
+            plan.first,
+            budget.name(),
+            args.alpha
+        );
+    }
+    let (tallies, rows) = verify_seeds(
+        &scenes,
+        &plan,
+        (budget, args.alpha, limits),
+        &scratch,
+        progress,
+    )?;
     let per_check = p_values_per_check(&rows);
     let kinds = uniformity_by_kind(&per_check)?;
     let mut scene_results = Vec::with_capacity(scenes.len());
@@ -188,7 +207,7 @@ pub fn run(args: CalibrateArgs) -> Result<i32> {
     };
     write_calibration_report(report, &summary)?;
     print_summary(&summary);
-    eprintln!(
+    println!(
         "{}; report: {} (run {})",
         if passed { "PASSED" } else { "FAILED" },
         args.out.join("index.html").display(),
@@ -200,28 +219,33 @@ pub fn run(args: CalibrateArgs) -> Result<i32> {
 /// Verifies every scene at every seed of `plan` in `scratch` (removed after each), in
 /// turn: per scene its tally, and one p-value row per check per seed. A run failure at a
 /// seed is recorded, not returned; bad input at the first seed and I/O errors stop.
+/// Progress (`progress`) is weighted by each scene's projected work; on plain lines,
+/// one line at the start of every seed.
 ///
 /// # Errors
 /// Input errors at the first seed (exit 2), I/O errors.
 fn verify_seeds(
     scenes: &[Scene],
     plan: &SeedPlan,
-    budget: Budget,
-    alpha: f64,
-    limits: WorkLimits,
+    (budget, alpha, limits): (Budget, f64, WorkLimits),
     scratch: &Path,
+    progress: ProgressOptions,
 ) -> Result<(Vec<SceneTally>, Vec<PValueRow>)> {
     let n = plan.seeds.len() as u64;
-    let bar = progress_bar(
-        n * scenes.len() as u64,
-        "runs",
-        std::io::stderr().is_terminal(),
-    );
+    let work: Vec<f64> = scenes
+        .iter()
+        .map(|s| projected_work(std::slice::from_ref(s), budget).dof_steps())
+        .collect();
+    let bar = Progress::new(progress, n as f64 * work.iter().sum::<f64>(), "DOF-steps");
     let mut tallies: Vec<SceneTally> = scenes.iter().map(|_| SceneTally::default()).collect();
     let mut rows: Vec<PValueRow> = Vec::new();
     for (k, &seed) in plan.seeds.iter().enumerate() {
-        for (scene, tally) in scenes.iter().zip(&mut tallies) {
-            bar.set_message(format!("seed {} of {n} ({seed}): {}", k + 1, scene.name));
+        for ((scene, tally), &w) in scenes.iter().zip(&mut tallies).zip(&work) {
+            bar.begin_run(
+                &format!("seed {seed}"),
+                &format!("seed {} of {n} ({seed}): {}", k + 1, scene.name),
+                w,
+            );
             let mut one = scene.clone();
             one.seed = seed;
             let outcome = run_verification(&VerifyOptions {
@@ -229,7 +253,7 @@ fn verify_seeds(
                 budget,
                 out: scratch.to_path_buf(),
                 alpha,
-                progress: false,
+                progress: ProgressOptions::HIDDEN,
                 limits,
             });
             remove_scratch(scratch)?;
@@ -243,9 +267,10 @@ fn verify_seeds(
                 Err(err) if k == 0 && err.exit_code() == 2 => return Err(err),
                 Err(err) => {
                     let message = err.to_string();
-                    bar.suspend(|| {
-                        eprintln!("{} seed {seed}: run failed: {message}", scene.name);
-                    });
+                    bar.println(&format!(
+                        "{} seed {seed}: run failed: {message}",
+                        scene.name
+                    ));
                     tally.run_failures += 1;
                     tally.failed.push(FailedSeed {
                         seed,
@@ -254,10 +279,9 @@ fn verify_seeds(
                     });
                 }
             }
-            bar.inc(1);
         }
     }
-    bar.finish_and_clear();
+    bar.finish();
     Ok((tallies, rows))
 }
 
@@ -299,7 +323,7 @@ fn record_scene(
     seed: u64,
     tally: &mut SceneTally,
     rows: &mut Vec<PValueRow>,
-    bar: &indicatif::ProgressBar,
+    bar: &Progress,
 ) {
     tally.wall_seconds += s.wall_seconds;
     if !tally.checks_per_seed.contains(&s.checks.len()) {
@@ -321,7 +345,11 @@ fn record_scene(
             .filter(|c| !c.passed)
             .map(|c| c.name.clone())
             .collect();
-        bar.suspend(|| eprintln!("{} seed {seed}: failed: {}", s.name, failed.join(", ")));
+        bar.println(&format!(
+            "{} seed {seed}: failed: {}",
+            s.name,
+            failed.join(", ")
+        ));
         tally.failed.push(FailedSeed {
             seed,
             failed_checks: failed,

@@ -1,25 +1,41 @@
 //! `langevin-fem check`: a scene's statistical checks applied to trajectories written by
 //! any program in the trajectory data format ([`langevin_fem::data`]).
 
+use super::Verbosity;
+use super::terminal::{Totals, print_scenes};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::verify::check_data;
 use std::path::PathBuf;
+use std::time::Instant;
 
+/// The examples of `check --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem run -s hinged-linear-2d -o traj            trajectories in the data format
+  langevin-fem check -s hinged-linear-2d -d traj -o traj-report
+  langevin-fem check -s my-scene.toml -d my-simulator-output -q
+
+The last line of stdout is `N passed, N failed, N skipped in T s`; the exit code is 0 if
+every check passed, 1 if one failed, 2 on bad input (the message names the file and key),
+3 if an estimator found no answer in the data.";
+
+/// Command-line arguments of `langevin-fem check`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct CheckArgs {
     /// Scene whose checks are applied: a name from the scene directory or a path to a
     /// .toml file. Its check kinds, modes, profile and two-time points say what is
     /// checked; the data's sidecar says what was simulated.
-    #[arg(long, value_name = "NAME|PATH")]
+    #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// Data directory: data.json (the sidecar) and the trajectory files it lists, as
     /// `langevin-fem run` writes them (see the README, "Check your own simulator").
-    #[arg(long, value_name = "DIR")]
+    #[arg(short, long, value_name = "DIR")]
     data: PathBuf,
     /// Output directory for summary.json, index.html and per-run tables and figures.
-    #[arg(long, default_value = "check-report")]
+    #[arg(short, long, default_value = "check-report")]
     pub(super) out: PathBuf,
     /// Directory of scene files in which --scene NAME is looked up (default: the
     /// built-in scenes).
@@ -30,8 +46,10 @@ pub struct CheckArgs {
     alpha: f64,
 }
 
-/// Runs the checks; exit code 0 if every check passes, 1 otherwise.
-pub fn run(args: CheckArgs) -> Result<i32> {
+/// Runs the checks; exit code 0 if every check passes, 1 otherwise. Prints the scenes
+/// and the totals on stdout at `verbosity` ([`super::terminal`]).
+pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
+    let start = Instant::now();
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -45,30 +63,19 @@ pub fn run(args: CheckArgs) -> Result<i32> {
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha)?;
     write_report(report, &summary)?;
-    for s in &summary.scenes {
-        let failed: Vec<&str> = s
-            .checks
-            .iter()
-            .filter(|c| !c.passed)
-            .map(|c| c.name.as_str())
-            .collect();
+    print_scenes(&summary, verbosity, false);
+    if verbosity != Verbosity::Quiet {
         println!(
-            "{:<24} {}  {} checks, {} failed",
-            s.name,
-            if s.passed { "PASS" } else { "FAIL" },
-            s.checks.len(),
-            failed.len()
+            "{} (data {}, family-wise alpha {}, Holm); report: {}",
+            if summary.passed { "PASSED" } else { "FAILED" },
+            args.data.display(),
+            summary.alpha,
+            args.out.join("index.html").display()
         );
-        for f in failed {
-            println!("    failed: {f}");
-        }
     }
     println!(
-        "{} (data {}, family-wise alpha {}, Holm); report: {}",
-        if summary.passed { "PASSED" } else { "FAILED" },
-        args.data.display(),
-        summary.alpha,
-        args.out.join("index.html").display()
+        "{}",
+        Totals::of(&summary.scenes).line(start.elapsed().as_secs_f64())
     );
     Ok(if summary.passed { 0 } else { 1 })
 }

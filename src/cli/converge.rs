@@ -2,25 +2,36 @@
 //! compression) over the element count or the time step, with fitted orders against the
 //! expected ones.
 
-use super::{parse_list, usize_in};
+use super::verify::BudgetArg;
+use super::{Verbosity, parse_list, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_convergence_index;
-use langevin_fem::scene::Budget;
 use langevin_fem::scene::load_scene;
 use langevin_fem::studies::converge::{
     ConvergeOptions, ConvergeSummary, ObservableSummary, OrderFit, Over, run_convergence,
 };
 use std::path::{Path, PathBuf};
 
+/// The examples of `converge --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem converge -s hinged-linear-2d --over elements
+  langevin-fem converge -s hinged-linear-2d --over dt --run crank-nicolson -b standard
+  langevin-fem converge -s compression-2d --over elements --values 5,10,20 --strain-ratios 0 \\
+      --trajectories 16 --duration-tau1 200 -o reports/convergence
+
+The fitted orders go to stdout, progress to stderr; the exit code is 3 if every value failed.";
+
 /// Command-line arguments of `langevin-fem converge`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct ConvergeArgs {
     /// Scene: a built-in scene's name (finite-element scenes: hinged-linear-2d,
     /// hinged-linear-3d, compression-2d, compression-3d, ...; see `langevin-fem list`), a
     /// name in --scene-dir, or a path to a .toml file.
-    #[arg(long, value_name = "NAME|PATH")]
+    #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// What is refined: the element count or the time step dt/tau1.
     #[arg(long, value_enum)]
@@ -43,7 +54,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_name = "R1,R2,...", allow_hyphen_values = true)]
     strain_ratios: Option<String>,
     /// Ensemble budget of the run (trajectories and duration per value).
-    #[arg(long, value_enum, default_value = "quick")]
+    #[arg(short, long, value_enum, default_value = "quick")]
     budget: BudgetArg,
     /// Trajectories per value, instead of the budget's (1 to 100000).
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 100_000>)]
@@ -52,7 +63,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     duration_tau1: Option<f64>,
     /// Output directory.
-    #[arg(long, default_value = "reports/convergence")]
+    #[arg(short, long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
     /// Directory of scene files: --scene names resolve there instead of among the
     /// built-in scenes.
@@ -70,19 +81,12 @@ enum OverArg {
     Dt,
 }
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-enum BudgetArg {
-    Quick,
-    Standard,
-    Full,
-}
-
-/// Runs the study, prints a summary of the fitted orders on stderr and rebuilds the
-/// index page of the output directory; exit code 0, or 3 if every value failed (diverged
-/// or too short for its correlation time).
-pub fn run(args: ConvergeArgs) -> Result<i32> {
+/// Runs the study (progress on stderr unless quiet), prints a summary of the fitted
+/// orders on stdout and rebuilds the index page of the output directory; exit code 0,
+/// or 3 if every value failed (diverged or too short for its correlation time).
+pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
     let out = args.out.clone();
-    let s = run_convergence(&options(args)?)?;
+    let s = run_convergence(&options(args, verbosity)?)?;
     write_convergence_index(&out)?;
     print_summary(&s, &out);
     // Every value failed: nothing was measured (exit 3, as for a failed run).
@@ -95,16 +99,12 @@ pub fn run(args: ConvergeArgs) -> Result<i32> {
 
 /// The study's options from the command line (the scene resolved last, after the
 /// flags are parsed).
-fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
+fn options(args: ConvergeArgs, verbosity: Verbosity) -> Result<ConvergeOptions> {
     let over = match args.over {
         OverArg::Elements => Over::Elements,
         OverArg::Dt => Over::Dt,
     };
-    let budget = match args.budget {
-        BudgetArg::Quick => Budget::Quick,
-        BudgetArg::Standard => Budget::Standard,
-        BudgetArg::Full => Budget::Full,
-    };
+    let budget = args.budget.budget();
     let values = args
         .values
         .as_deref()
@@ -133,7 +133,7 @@ fn options(args: ConvergeArgs) -> Result<ConvergeOptions> {
         trajectories: args.trajectories,
         duration_tau1: args.duration_tau1,
         out: args.out,
-        progress: true,
+        progress: verbosity.shows_progress(),
         limits: args.limits.limits(),
     })
 }
@@ -166,14 +166,14 @@ fn fmt_fit(f: &Option<OrderFit>) -> String {
     }
 }
 
-/// One observable's fitted orders, expected order, note and reason on stderr.
+/// One observable's fitted orders, expected order, note and reason on stdout.
 fn print_observable(o: &ObservableSummary) {
     let expected = match (o.expected.order, o.expected.exact) {
         (Some(p), _) => format!("{p}"),
         (None, true) => "exact (zero error)".to_string(),
         (None, false) => "no single order".to_string(),
     };
-    eprintln!(
+    println!(
         "  {:<8} observed {}; exact-error order {}; expected {}; sampling floor at {:?}",
         o.observable,
         fmt_fit(&o.observed),
@@ -186,15 +186,16 @@ fn print_observable(o: &ObservableSummary) {
         o.floor_values
     );
     if !o.note.is_empty() {
-        eprintln!("           {}", o.note);
+        println!("           {}", o.note);
     }
-    eprintln!("           expected: {}", o.expected.why);
+    println!("           expected: {}", o.expected.why);
 }
 
-/// The study's summary on stderr: what was refined, the observables, the consistency
-/// with the exact discrete references, the failed values, notes, warnings and files.
+/// The study's summary on stdout (warnings on stderr): what was refined, the
+/// observables, the consistency with the exact discrete references, the failed values,
+/// notes and files.
 fn print_summary(s: &ConvergeSummary, out: &Path) {
-    eprintln!(
+    println!(
         "{} / {} ({} with {} noise, seed {}), over {} (h = {}), {}; errors against the {}",
         s.scene,
         s.run,
@@ -210,13 +211,13 @@ fn print_summary(s: &ConvergeSummary, out: &Path) {
         print_observable(o);
     }
     if let Some(c) = &s.discrete_consistency {
-        eprintln!(
+        println!(
             "  simulation vs exact discrete reference: largest |z| = {:.2} ({}) over {} rows, Bonferroni p = {:.3}; sum z^2 = {:.2}",
             c.max_abs_z, c.worst, c.rows, c.p_value, c.chi2
         );
     }
     for u in &s.failed {
-        eprintln!(
+        println!(
             "  FAILED ({}) at {}={}: {}",
             u.kind,
             s.over.name(),
@@ -225,12 +226,12 @@ fn print_summary(s: &ConvergeSummary, out: &Path) {
         );
     }
     for n in &s.notes {
-        eprintln!("  note: {n}");
+        println!("  note: {n}");
     }
     for w in &s.warnings {
-        eprintln!("  warning: {w}");
+        eprintln!("warning: {w}");
     }
-    eprintln!(
+    println!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),
         out.display(),

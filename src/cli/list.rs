@@ -9,6 +9,11 @@ use std::path::PathBuf;
 
 /// Command-line arguments of `langevin-fem list`.
 #[derive(Debug, Args)]
+#[command(after_help = "\
+Examples:
+  langevin-fem list
+  langevin-fem list --scene-dir my-scenes
+  langevin-fem list --json | python3 -m json.tool")]
 pub struct ListArgs {
     /// Also list the scene files (*.toml) of this directory, after the built-in scenes.
     #[arg(long, value_name = "DIR")]

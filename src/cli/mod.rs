@@ -9,13 +9,15 @@ mod power;
 mod run;
 mod scene;
 mod stability;
+mod terminal;
 mod theory;
 mod verify;
 mod work_precision;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
+use langevin_fem::progress::ProgressOptions;
 use langevin_fem::scene::Scene;
 use langevin_fem::work::WorkLimits;
 use std::path::Path;
@@ -23,11 +25,62 @@ use std::str::FromStr;
 
 /// Finite-element Langevin dynamics of thermally fluctuating filaments, with exact
 /// references and statistical verification.
+///
+/// Results and summaries go to stdout; progress, warnings and errors to stderr. Exit
+/// codes: 0 ok, 1 checks failed, 2 bad input (the message names the flag, or the file and
+/// key), 3 a run failed.
 #[derive(Debug, Parser)]
-#[command(name = "langevin-fem", version = langevin_fem::output::provenance::VERSION_LINE, about, long_about = None)]
+#[command(name = "langevin-fem", version = langevin_fem::output::provenance::VERSION_LINE, about, long_about = None, after_help = EXAMPLES)]
 struct Cli {
+    /// Print no progress and no per-scene lines: only failures, warnings, errors and the
+    /// closing totals line.
+    #[arg(
+        short,
+        long,
+        global = true,
+        conflicts_with = "verbose",
+        display_order = 1000
+    )]
+    quiet: bool,
+    /// Print more: every failed check with its statistic, p-values and estimate, every
+    /// skipped check with the reason, and the wall time of every run.
+    #[arg(short, long, global = true, display_order = 1000)]
+    verbose: bool,
     #[command(subcommand)]
     command: Command,
+}
+
+/// The examples of `langevin-fem --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem verify                          every built-in scene, quick budget, reports/
+  langevin-fem verify -s hinged-linear-2d -b full -o out
+  langevin-fem verify -q | tee verify.log      failures and the totals line only
+  langevin-fem list                            the built-in scenes
+  langevin-fem theory mode --n 1               exact rate and variance of mode 1
+  langevin-fem completions bash > ~/.local/share/bash-completion/completions/langevin-fem";
+
+/// How much a command prints (`--quiet`, `--verbose`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verbosity {
+    /// Failures, warnings and the totals line only; no progress.
+    Quiet,
+    /// Progress, per-scene lines, totals.
+    Normal,
+    /// Also every failed and skipped check in detail, and run times.
+    Verbose,
+}
+
+impl Verbosity {
+    /// The progress a command shows on stderr: none if quiet, run times if verbose.
+    pub fn progress(self) -> ProgressOptions {
+        ProgressOptions::stderr(self != Verbosity::Quiet, self == Verbosity::Verbose)
+    }
+
+    /// Whether progress lines are printed (not quiet).
+    pub fn shows_progress(self) -> bool {
+        self != Verbosity::Quiet
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -63,52 +116,90 @@ enum Command {
     /// intervals; writes power.csv, power.json and power.md.
     #[cfg(feature = "faults")]
     Power(power::PowerArgs),
+    /// Print a shell completion script on stdout (bash, zsh or fish).
+    #[command(after_help = "\
+Examples:
+  langevin-fem completions bash > ~/.local/share/bash-completion/completions/langevin-fem
+  langevin-fem completions zsh > ~/.zfunc/_langevin-fem     (with fpath+=~/.zfunc)
+  langevin-fem completions fish > ~/.config/fish/completions/langevin-fem.fish")]
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: Shell,
+    },
+}
+
+/// A shell of `completions`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum Shell {
+    Bash,
+    Zsh,
+    Fish,
 }
 
 /// Parses the command line and runs the command; returns the process exit code.
 pub fn run() -> Result<i32> {
     let cli = Cli::parse();
+    let v = match (cli.quiet, cli.verbose) {
+        (true, _) => Verbosity::Quiet,
+        (false, true) => Verbosity::Verbose,
+        (false, false) => Verbosity::Normal,
+    };
     match cli.command {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => {
             check_out_dir(&args.out)?;
             args.sim.start()?;
-            verify::run(args)
+            verify::run(args, v)
         }
         Command::Calibrate(args) => {
             check_out_dir(&args.out)?;
             args.start()?;
-            calibrate::run(args)
+            calibrate::run(args, v)
         }
         Command::Converge(args) => {
             check_out_dir(&args.out)?;
             args.sim.start()?;
-            converge::run(args)
+            converge::run(args, v)
         }
         Command::Stability(args) => {
             check_out_dir(&args.out)?;
             args.sim.start()?;
-            stability::run(args)
+            stability::run(args, v)
         }
         Command::WorkPrecision(args) => {
             check_out_dir(&args.out)?;
             args.sim.start()?;
-            work_precision::run(args)
+            work_precision::run(args, v)
         }
         Command::Run(args) => {
             check_out_dir(&args.out)?;
-            run::run(args)
+            run::run(args, v)
         }
         Command::Check(args) => {
             check_out_dir(&args.out)?;
-            check::run(args)
+            check::run(args, v)
         }
         Command::List(args) => list::run(args),
         Command::Scene(args) => scene::run(args),
         #[cfg(feature = "faults")]
         Command::Power(args) => {
             check_out_dir(&args.out)?;
-            power::run(args)
+            power::run(args, v)
+        }
+        Command::Completions { shell } => {
+            let shell = match shell {
+                Shell::Bash => clap_complete::Shell::Bash,
+                Shell::Zsh => clap_complete::Shell::Zsh,
+                Shell::Fish => clap_complete::Shell::Fish,
+            };
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "langevin-fem",
+                &mut std::io::stdout(),
+            );
+            Ok(0)
         }
     }
 }
@@ -262,7 +353,7 @@ pub struct SimArgs {
     seed: Option<u64>,
     /// Worker threads of the parallel ensembles (1 to 256; default: rayon's, the number
     /// of CPUs or RAYON_NUM_THREADS). Results are bit-identical whatever the count.
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 256>)]
+    #[arg(short = 'j', long, value_name = "N", allow_negative_numbers = true, value_parser = usize_in::<1, 256>)]
     threads: Option<usize>,
 }
 

@@ -2,12 +2,23 @@
 //! every catalogued simulator fault over seeds, per scene and size
 //! ([`langevin_fem::fault::run_power`]).
 
+use super::Verbosity;
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fault::{FaultKind, PowerOptions, run_power};
 use std::path::PathBuf;
 
+/// The examples of `power --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem power                                   every fault, 20 seeds (about 25 min)
+  langevin-fem power --fault noise-variance --seeds 5 -o out
+
+Progress and per-size rows go to stderr, the smallest detected sizes to stdout.";
+
+/// Command-line arguments of `langevin-fem power`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct PowerArgs {
     /// Fault to measure (repeatable; default: the whole catalogue): noise-variance,
     /// noise-time-scaling, integrator-stiffness, integrator-drag, correlated-noise,
@@ -19,19 +30,19 @@ pub struct PowerArgs {
     #[arg(long, default_value_t = 20, allow_negative_numbers = true, value_parser = super::count_in::<1, 100_000>)]
     seeds: u64,
     /// Statistics budget of every verification.
-    #[arg(long, value_enum, default_value = "quick")]
+    #[arg(short, long, value_enum, default_value = "quick")]
     budget: super::verify::BudgetArg,
     /// Family-wise significance level per scene (Holm), as `verify --alpha`.
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
     /// Output directory for power.csv, power.json and power.md.
-    #[arg(long, default_value = "reports/power")]
+    #[arg(short, long, default_value = "reports/power")]
     pub(super) out: PathBuf,
 }
 
 /// Runs the power study; exit code 0 once the tables are written (a measurement: the
 /// tables say which stated sizes were detected in at least 95 % of seeds).
-pub fn run(args: PowerArgs) -> Result<i32> {
+pub fn run(args: PowerArgs, verbosity: Verbosity) -> Result<i32> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -49,9 +60,10 @@ pub fn run(args: PowerArgs) -> Result<i32> {
         budget: args.budget.budget(),
         alpha: args.alpha,
         out: args.out.clone(),
+        progress: verbosity.shows_progress(),
     })?;
     for m in &report.smallest_detected {
-        eprintln!(
+        println!(
             "{:<24} {:<20} smallest detected size {:<18} stated {} {}",
             m.fault,
             m.scene,
@@ -64,7 +76,7 @@ pub fn run(args: PowerArgs) -> Result<i32> {
             }
         );
     }
-    eprintln!(
+    println!(
         "power: {:.0} s; tables: {}",
         report.wall_seconds,
         args.out.join("power.md").display()

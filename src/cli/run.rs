@@ -2,9 +2,8 @@
 //! series in the trajectory data format ([`langevin_fem::data`]), ready for NumPy, pandas
 //! or `langevin-fem check`.
 
-use super::usize_in;
+use super::{Verbosity, usize_in};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use langevin_fem::data::{
     COMPRESSION_COLUMNS, DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR,
     Start, TrajectoryFile, VERSION, trajectory_columns,
@@ -12,26 +11,38 @@ use langevin_fem::data::{
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::banded::LANES;
 use langevin_fem::output::{Provenance, ReportRun};
+use langevin_fem::progress::Progress;
 use langevin_fem::rng::derive_seed;
 use langevin_fem::scene::compression::CompressionRun;
 use langevin_fem::scene::linear::{LinearRun, RowPlan};
 use langevin_fem::scene::{Budget, ModelKind, Scene};
 use langevin_fem::work::{RunWork, WorkProjection};
 use std::f64::consts::PI;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
+/// The examples of `run --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem run -s hinged-linear-2d -o traj                 every run, quick budget, .npy
+  langevin-fem run -s hinged-linear-2d --run crank-nicolson --trajectories 8 \\
+      --duration-tau1 40 --every 10 --format csv -o traj
+  langevin-fem check -s hinged-linear-2d -d traj               then check them
+
+Progress goes to stderr, the closing line (what was written, where) to stdout.";
+
+/// Command-line arguments of `langevin-fem run`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct RunArgs {
     /// Scene: a name from the scene directory or a path to a .toml file (linear scenes:
     /// hinged-linear-2d, hinged-linear-3d, spectral-reference).
-    #[arg(long, value_name = "NAME|PATH")]
+    #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// Run of the scene to simulate (repeatable; default: every run).
     #[arg(long = "run", value_name = "NAME")]
     runs: Vec<String>,
     /// The ensemble: trajectories and duration of the scene's budget.
-    #[arg(long, value_enum, default_value = "quick")]
+    #[arg(short, long, value_enum, default_value = "quick")]
     budget: super::verify::BudgetArg,
     /// Trajectories per run (default: the budget's).
     #[arg(long, value_name = "N", value_parser = usize_in::<1, 100_000>)]
@@ -49,7 +60,7 @@ pub struct RunArgs {
     #[command(flatten)]
     sim: super::SimArgs,
     /// Output directory: data.json (the sidecar), manifest.json and <run>/trajectory-NNNN.<format>.
-    #[arg(long, default_value = "trajectories")]
+    #[arg(short, long, default_value = "trajectories")]
     pub(super) out: PathBuf,
     /// Directory of scene files in which --scene NAME is looked up (default: the
     /// built-in scenes).
@@ -69,6 +80,8 @@ enum FormatArg {
 /// ensembles.
 struct Job<'a> {
     args: &'a RunArgs,
+    /// What is printed on stderr while it runs.
+    verbosity: Verbosity,
     scene: Scene,
     seed_note: String,
     budget: Budget,
@@ -170,8 +183,8 @@ impl Job<'_> {
     }
 }
 
-/// Runs the command; exit code 0.
-pub fn run(args: RunArgs) -> Result<i32> {
+/// Runs the command (progress on stderr unless quiet); exit code 0.
+pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
@@ -200,6 +213,7 @@ pub fn run(args: RunArgs) -> Result<i32> {
     let job = Job {
         budget: args.budget.budget(),
         args: &args,
+        verbosity,
         scene,
         seed_note,
         chosen,
@@ -232,15 +246,18 @@ fn run_linear(job: &Job<'_>) -> Result<i32> {
             run.row_plan(scene, steps, args.every)
         })
         .collect::<Result<Vec<_>>>()?;
-    args.limits.limits().check(&projection(job, &plans))?;
+    let work = projection(job, &plans);
+    args.limits.limits().check(&work)?;
     let (provenance, report) = job.begin()?;
     let total: u64 = job.chosen.iter().map(|&k| job.ensemble(k).0 as u64).sum();
-    let bar = progress(total);
+    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
     let mut data_runs = Vec::new();
-    for ((&k, run), plan) in job.chosen.iter().zip(&runs).zip(&plans) {
+    for (((&k, run), plan), part) in job.chosen.iter().zip(&runs).zip(&plans).zip(&work.parts) {
+        let label = format!("{}/{}", scene.name, scene.runs[k].name);
+        bar.begin_run(&scene.name, &label, part.work.dof_steps);
         data_runs.push(write_linear_run(job, &report, k, run, plan, &bar)?);
     }
-    bar.finish_and_clear();
+    bar.finish();
     let what = format!(
         "{total} trajectories of {} ({} run(s))",
         scene.name,
@@ -256,12 +273,12 @@ fn write_linear_run(
     k: usize,
     run: &LinearRun,
     plan: &RowPlan,
-    bar: &ProgressBar,
+    bar: &Progress,
 ) -> Result<DataRun> {
     let (scene, out) = (&job.scene, &job.args.out);
     let spec = &scene.runs[k];
-    bar.set_message(format!("{} / {}", scene.name, spec.name));
     let count = job.ensemble(k).0 as u64;
+    let per_trajectory = bar.run_work() / count.max(1) as f64;
     let files: Vec<String> = (0..count)
         .map(|j| format!("{}/trajectory-{j:04}.{}", spec.name, job.ext()))
         .collect();
@@ -274,14 +291,14 @@ fn write_linear_run(
         count,
         plan,
         |j| out.join(&files[j as usize]),
-        |n| bar.inc(n),
+        |n| bar.advance(n as f64 * per_trajectory),
     )
     .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
-    if !std::io::stderr().is_terminal() {
-        eprintln!(
+    if job.verbosity == Verbosity::Verbose {
+        bar.println(&format!(
             "{} / {}: {count} trajectories x {} rows",
             scene.name, spec.name, plan.rows
-        );
+        ));
     }
     let dt = run.reference.dt;
     Ok(DataRun {
@@ -335,20 +352,6 @@ fn projection(job: &Job<'_>, plans: &[RowPlan]) -> WorkProjection {
     }
 }
 
-/// A progress bar over trajectories on stderr when it is a terminal, else hidden.
-fn progress(total: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} trajectories (eta {eta})  {msg}",
-    ) {
-        bar.set_style(style);
-    }
-    bar
-}
-
 /// `run` of a compression scene: per run and strain, every trajectory's F and stored
 /// length after the burn-in (the samples `verify` takes, same seeds), one data run per
 /// strain in the sidecar. A budget by target precision chooses durations by a pilot:
@@ -380,7 +383,8 @@ fn run_compression(job: &Job<'_>) -> Result<i32> {
                 .map_err(|e| scene.run_error(k, "integrator", e))
         })
         .collect::<Result<Vec<_>>>()?;
-    args.limits.limits().check(&compression_projection(job))?;
+    let work = compression_projection(job);
+    args.limits.limits().check(&work)?;
     let (provenance, report) = job.begin()?;
     let strains = comp.strain_ratios.len();
     let total: u64 = job
@@ -388,12 +392,14 @@ fn run_compression(job: &Job<'_>) -> Result<i32> {
         .iter()
         .map(|&k| (job.ensemble(k).0 * strains) as u64)
         .sum();
-    let bar = progress(total);
+    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
     let mut data_runs = Vec::new();
-    for (&k, run) in job.chosen.iter().zip(&runs) {
+    for ((&k, run), part) in job.chosen.iter().zip(&runs).zip(&work.parts) {
+        let label = format!("{}/{}", scene.name, scene.runs[k].name);
+        bar.begin_run(&scene.name, &label, part.work.dof_steps);
         data_runs.extend(write_compression_run(job, &report, k, run, &bar)?);
     }
-    bar.finish_and_clear();
+    bar.finish();
     let what = format!(
         "{total} trajectories of {} ({} run(s) x {strains} strains)",
         scene.name,
@@ -440,21 +446,21 @@ fn write_compression_run(
     report: &ReportRun,
     k: usize,
     run: &CompressionRun,
-    bar: &ProgressBar,
+    bar: &Progress,
 ) -> Result<Vec<DataRun>> {
     let scene = &job.scene;
     let (Some(comp), f) = (&scene.compression, scene.filament) else {
         return Ok(Vec::new());
     };
     let spec = &scene.runs[k];
-    bar.set_message(format!("{} / {}", scene.name, spec.name));
     let (n, duration) = job.ensemble(k);
+    let per_trajectory = bar.run_work() / (n * run.points()).max(1) as f64;
     let steps: Vec<u64> = (0..run.points())
         .map(|i| run.sampled_steps_at(i, duration * f.tau1()))
         .collect();
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", spec.name));
     let records = run
-        .simulate_ensemble_per_point(seed, n, &steps, || bar.inc(1))
+        .simulate_ensemble_per_point(seed, n, &steps, || bar.advance(per_trajectory))
         .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
     let columns: Vec<String> = COMPRESSION_COLUMNS.iter().map(|c| c.to_string()).collect();
     let euler_strain = PI.powi(2) * f.bending_rigidity / (f.stretch_rigidity * f.length.powi(2));

@@ -10,6 +10,11 @@ use std::path::PathBuf;
 
 /// Command-line arguments of `langevin-fem scene`.
 #[derive(Debug, Args)]
+#[command(after_help = "\
+Examples:
+  langevin-fem scene show hinged-linear-2d                 as it will run, every key documented
+  langevin-fem scene show hinged-linear-2d --as-written > my-scene.toml
+  langevin-fem scene show my-scene.toml")]
 pub struct SceneArgs {
     #[command(subcommand)]
     command: SceneCommand,

@@ -1,7 +1,7 @@
 //! `langevin-fem stability`: stability map (integrator × Δt·λ_max × element count) and
 //! the measured per-mode stationary bias against each integrator's exact formula.
 
-use super::{count_in, parse_list_or, usize_in};
+use super::{Verbosity, count_in, parse_list_or, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -12,12 +12,28 @@ use langevin_fem::studies::stability::{
 };
 use std::path::PathBuf;
 
+/// The examples of `stability --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem stability                                   the default map (4 integrators x 4 meshes x 7 steps)
+  langevin-fem stability --elements 10 --dt-lambda-max 0.1,1.9,2.1,1e3 --steps 20000
+  langevin-fem stability --integrators euler-maruyama,crank-nicolson -o out -j 2
+
+The map goes to stdout, progress to stderr; the exit code is 1 if an exact formula was
+rejected or a stability prediction failed.";
+
 /// Command-line arguments of `langevin-fem stability`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct StabilityArgs {
     /// Linear finite-element scene supplying the filament and the seed: a built-in
     /// scene's name, a name in --scene-dir, or a path to a .toml file.
-    #[arg(long, value_name = "NAME|PATH", default_value = "hinged-linear-2d")]
+    #[arg(
+        short,
+        long,
+        value_name = "NAME|PATH",
+        default_value = "hinged-linear-2d"
+    )]
     scene: String,
     /// Comma-separated integrators (default: euler-maruyama, backward-euler,
     /// crank-nicolson, exact-modal).
@@ -43,7 +59,7 @@ pub struct StabilityArgs {
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
     /// Output directory.
-    #[arg(long, default_value = "reports/convergence")]
+    #[arg(short, long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
     /// Directory of scene files: --scene names resolve there instead of among the
     /// built-in scenes.
@@ -55,9 +71,10 @@ pub struct StabilityArgs {
     pub(super) sim: super::SimArgs,
 }
 
-/// Runs the study and prints the map on stderr; exit code 0 if every formula comparison
-/// passed and every stability prediction held, 1 otherwise.
-pub fn run(args: StabilityArgs) -> Result<i32> {
+/// Runs the study (progress on stderr unless quiet) and prints the map on stdout; exit
+/// code 0 if every formula comparison passed and every stability prediction held, 1
+/// otherwise.
+pub fn run(args: StabilityArgs, verbosity: Verbosity) -> Result<i32> {
     let integrators = match &args.integrators {
         None => DEFAULT_INTEGRATORS.to_vec(),
         Some(t) => t
@@ -103,17 +120,17 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         burn_in_steps: args.burn_in,
         alpha: args.alpha,
         out: args.out.clone(),
-        progress: true,
+        progress: verbosity.shows_progress(),
         limits: args.limits.limits(),
     })?;
-    eprintln!(
+    println!(
         "stability map of {} (consistent noise; {} trajectories x {} steps after {} burn-in; seed {})",
         s.scene, s.trajectories, s.sampled_steps, s.burn_in_steps, s.seed
     );
     let mut last = String::new();
     for c in &s.cells {
         if c.integrator != last {
-            eprintln!("  {}:", c.integrator);
+            println!("  {}:", c.integrator);
             last.clone_from(&c.integrator);
         }
         let mark = match c.status {
@@ -121,12 +138,12 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
             Status::Biased => "BIASED  ",
             Status::Unstable => "UNSTABLE",
         };
-        eprintln!(
+        println!(
             "    {:>4} elements, dt*lambda_max {:>8.3e}: {mark} {}",
             c.elements, c.dt_lambda_max, c.detail
         );
     }
-    eprintln!(
+    println!(
         "exact stationary-variance formulas: {} of {} per-mode comparisons rejected (Holm, alpha = {}); stability predictions {}",
         s.formula_rejections,
         s.formula_tests,
@@ -138,7 +155,7 @@ pub fn run(args: StabilityArgs) -> Result<i32> {
         }
     );
     langevin_fem::report::write_convergence_index(&args.out)?;
-    eprintln!(
+    println!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),
         args.out.display(),

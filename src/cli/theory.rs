@@ -45,7 +45,19 @@ impl PhysicalArgs {
     }
 }
 
+/// The examples of `theory --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem theory variance --x 0.5
+  langevin-fem theory mode --n 3 --length 10 --bending-rigidity 17 --drag 1 --kt 4.1e-3
+  langevin-fem theory correlation --x 0.5 --y 0.5 --t 0.1 --eta 0.2
+  langevin-fem theory compression --dims 2 --strain-ratio 0,1,3,10 --elements 20
+
+Every result is one JSON object on stdout.";
+
+/// Command-line arguments of `langevin-fem theory`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct TheoryArgs {
     #[command(subcommand)]
     query: Query,
@@ -78,7 +90,7 @@ enum Query {
         #[arg(long, allow_negative_numbers = true)]
         eta: f64,
         /// Relative tolerance for the truncation bound of the mode sum.
-        #[arg(long, default_value_t = 1e-12, allow_negative_numbers = true)]
+        #[arg(long, default_value = "1e-12", allow_negative_numbers = true)]
         tolerance: f64,
         #[command(flatten)]
         phys: PhysicalArgs,
@@ -99,8 +111,8 @@ enum Query {
     /// tension at every strain and the exact mode sum grows as (S/P²)^(1/3).
     Compression {
         /// Spatial dimension: 2 (planar) or 3.
-        #[arg(long, allow_negative_numbers = true)]
-        dims: i64,
+        #[arg(long, value_enum)]
+        dims: DimsArg,
         /// Comma-separated strain ratios ε/ε_c0, each in [0, 100·√S/P] (10 at the smallest
         /// S/P², 10⁸ at the largest; the work grows with ε/ε_c0).
         #[arg(long, allow_hyphen_values = true)]
@@ -174,18 +186,29 @@ fn check_ratios(persistence_ratio: f64, stretch_ratio: f64) -> Result<()> {
     Ok(())
 }
 
+/// `theory compression --dims`: 2 or 3.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum DimsArg {
+    /// Planar.
+    #[value(name = "2")]
+    Two,
+    /// Three-dimensional.
+    #[value(name = "3")]
+    Three,
+}
+
 /// The compression query: validates the flags and evaluates the exact theory.
 fn compression(
-    dims: i64,
+    dims: DimsArg,
     strain_ratio: &str,
     elements: Option<i64>,
     persistence_ratio: f64,
     stretch_ratio: f64,
 ) -> Result<serde_json::Value> {
-    let dims = match dims {
-        2 | 3 => Dims::from_u32(dims as u32)?,
-        _ => return Err(Error::invalid("--dims", dims, "2 or 3")),
-    };
+    let dims = Dims::from_u32(match dims {
+        DimsArg::Two => 2,
+        DimsArg::Three => 3,
+    })?;
     check_ratios(persistence_ratio, stretch_ratio)?;
     let elements = match elements {
         None => None,

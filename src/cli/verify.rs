@@ -1,25 +1,41 @@
 //! `langevin-fem verify`: run verification scenes and write reports.
 
+use super::Verbosity;
+use super::terminal::{Totals, print_scenes};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::scene::{Budget, load_scenes};
 use langevin_fem::verify::{VerifyOptions, run_verification};
-use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::time::Instant;
 
+/// The examples of `verify --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem verify                                  every built-in scene, quick budget, into reports/
+  langevin-fem verify -s hinged-linear-2d -s compression-2d -b standard -o out
+  langevin-fem verify -s my-scene.toml --seed 7 -j 2   a scene file of yours, another seed, 2 threads
+  langevin-fem verify --scene-dir scenes/ -q           every scene in scenes/; failures and totals only
+  langevin-fem verify -v | cat                         failed and skipped checks in detail, run times
+
+The last line of stdout is `N passed, N failed, N skipped in T s`; the exit code is 0 if
+every check passed, 1 if one failed, 2 on bad input, 3 if a run failed.";
+
+/// Command-line arguments of `langevin-fem verify`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct VerifyArgs {
     /// Scene to run: a built-in scene's name (see `langevin-fem list`), a name in
     /// --scene-dir when given, or a path to a .toml file (repeatable; default: every
     /// built-in top-level scene, or every scene of --scene-dir).
-    #[arg(long = "scene", value_name = "NAME|PATH")]
+    #[arg(short = 's', long = "scene", value_name = "NAME|PATH")]
     scenes: Vec<String>,
     /// Statistics budget.
-    #[arg(long, value_enum, default_value = "quick")]
+    #[arg(short, long, value_enum, default_value = "quick")]
     budget: BudgetArg,
     /// Output directory for summary.json, index.html and per-scene figures and tables.
-    #[arg(long, default_value = "reports")]
+    #[arg(short, long, default_value = "reports")]
     pub(super) out: PathBuf,
     /// Directory of scene files: names resolve there instead of among the built-in
     /// scenes, and without --scene every scene there runs.
@@ -53,8 +69,11 @@ impl BudgetArg {
     }
 }
 
-/// Runs the verification; exit code 0 if every check passes, 1 otherwise.
-pub fn run(args: VerifyArgs) -> Result<i32> {
+/// Runs the verification; exit code 0 if every check passes, 1 otherwise. Prints the
+/// scenes and the totals on stdout at `verbosity` ([`super::terminal`]), progress on
+/// stderr.
+pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
+    let start = Instant::now();
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -77,45 +96,27 @@ pub fn run(args: VerifyArgs) -> Result<i32> {
         budget,
         out: args.out.clone(),
         alpha: args.alpha,
-        progress: std::io::stderr().is_terminal(),
+        progress: verbosity.progress(),
         limits: args.limits.limits(),
     })?;
     for (scene, note) in summary.scenes.iter_mut().zip(seed_notes) {
         scene.notes.push(note);
     }
     write_report(report, &summary)?;
-    for scene in &summary.scenes {
-        let failed: Vec<&str> = scene
-            .checks
-            .iter()
-            .filter(|c| !c.passed)
-            .map(|c| c.name.as_str())
-            .collect();
-        eprintln!(
-            "{:<24} {}  {} checks, {} failed, {:.1} s",
-            scene.name,
-            if scene.passed { "PASS" } else { "FAIL" },
-            scene.checks.len(),
-            failed.len(),
-            scene.wall_seconds
+    print_scenes(&summary, verbosity, true);
+    if verbosity != Verbosity::Quiet {
+        println!(
+            "{} (budget {}, family-wise alpha {} per scene, Holm); report: {} (run {})",
+            if summary.passed { "PASSED" } else { "FAILED" },
+            summary.budget,
+            summary.alpha,
+            args.out.join("index.html").display(),
+            summary.run_id
         );
-        for f in failed {
-            eprintln!("    failed: {f}");
-        }
-        for w in &scene.warnings {
-            eprintln!("    warning: {w}");
-        }
-        if let Some(seed) = scene.notes.last() {
-            eprintln!("    {seed}");
-        }
     }
-    eprintln!(
-        "{} (budget {}, family-wise alpha {} per scene, Holm); report: {} (run {})",
-        if summary.passed { "PASSED" } else { "FAILED" },
-        summary.budget,
-        summary.alpha,
-        args.out.join("index.html").display(),
-        summary.run_id
+    println!(
+        "{}",
+        Totals::of(&summary.scenes).line(start.elapsed().as_secs_f64())
     );
     Ok(if summary.passed { 0 } else { 1 })
 }

@@ -1,7 +1,7 @@
 //! `langevin-fem work-precision`: error in ⟨w²(L/2)⟩ against wall time for every
 //! integrator and noise model, with the projected cost of reaching a tolerance.
 
-use super::{parse_list_or, usize_in};
+use super::{Verbosity, parse_list_or, usize_in};
 use clap::Args;
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
@@ -13,12 +13,28 @@ use langevin_fem::studies::work_precision::{
 };
 use std::path::PathBuf;
 
+/// The examples of `work-precision --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem work-precision                              every method, default steps
+  langevin-fem work-precision --methods crank-nicolson/consistent,exact-modal/consistent \\
+      --dt-tau1 1e-2,1e-3 --duration-tau1 100 -o out
+  langevin-fem work-precision --tolerance 0.001 -j 2
+
+The cost table goes to stdout, progress to stderr.";
+
 /// Command-line arguments of `langevin-fem work-precision`.
 #[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
 pub struct WorkPrecisionArgs {
     /// Linear finite-element scene (a built-in scene's name, a name in --scene-dir, or a
     /// .toml path): filament, mesh, seed, burn-in.
-    #[arg(long, value_name = "NAME|PATH", default_value = "hinged-linear-2d")]
+    #[arg(
+        short,
+        long,
+        value_name = "NAME|PATH",
+        default_value = "hinged-linear-2d"
+    )]
     scene: String,
     /// Comma-separated methods INTEGRATOR/NOISE (default: euler-maruyama/element-uniform,
     /// euler-maruyama/consistent, backward-euler/consistent,
@@ -37,17 +53,29 @@ pub struct WorkPrecisionArgs {
     #[arg(long, default_value_t = 8, allow_negative_numbers = true, value_parser = usize_in::<2, 1024>)]
     trajectories: usize,
     /// Sampled duration per trajectory, in units of tau1 (stable integrators).
-    #[arg(long, default_value_t = 400.0, allow_negative_numbers = true)]
-    duration: f64,
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = 400.0,
+        allow_negative_numbers = true,
+        alias = "duration"
+    )]
+    duration_tau1: f64,
     /// Sampled duration per trajectory of euler-maruyama, in units of tau1 (its step is
     /// bounded by the stability limit, about 1e5 steps per tau1 at 10 elements).
-    #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
-    em_duration: f64,
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = 8.0,
+        allow_negative_numbers = true,
+        alias = "em-duration"
+    )]
+    em_duration_tau1: f64,
     /// Relative error whose projected cost is tabulated.
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     tolerance: f64,
     /// Output directory.
-    #[arg(long, default_value = "reports/convergence")]
+    #[arg(short, long, default_value = "reports/convergence")]
     pub(super) out: PathBuf,
     /// Directory of scene files: --scene names resolve there instead of among the
     /// built-in scenes.
@@ -80,8 +108,9 @@ fn parse_method(text: &str) -> Result<(IntegratorKind, NoiseModel)> {
     Ok((kind, noise))
 }
 
-/// Runs the study and prints the cost table on stderr; exit code 0.
-pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
+/// Runs the study (progress on stderr unless quiet) and prints the cost table on
+/// stdout; exit code 0.
+pub fn run(args: WorkPrecisionArgs, verbosity: Verbosity) -> Result<i32> {
     let methods = match &args.methods {
         None => DEFAULT_METHODS.to_vec(),
         Some(t) => t.split(',').map(parse_method).collect::<Result<_>>()?,
@@ -106,14 +135,14 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         dt_tau1,
         em_fractions,
         trajectories: args.trajectories,
-        duration_tau1: args.duration,
-        em_duration_tau1: args.em_duration,
+        duration_tau1: args.duration_tau1,
+        em_duration_tau1: args.em_duration_tau1,
         tolerance: args.tolerance,
         out: args.out.clone(),
-        progress: true,
+        progress: verbosity.shows_progress(),
         limits: args.limits.limits(),
     })?;
-    eprintln!(
+    println!(
         "{} ({} elements, seed {}): <w2(L/2)> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",
         s.scene,
         s.elements,
@@ -125,17 +154,17 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         s.threads,
         s.sampling_floor
     );
-    eprintln!(
+    println!(
         "projected wall time to a relative error of {} (95 %, bias + 2 s.e.):",
         s.tolerance
     );
     for m in &s.methods {
         match (m.seconds_to_tolerance, m.best_dt_tau1, m.relative_cost) {
-            (Some(t), Some(dt), Some(r)) => eprintln!(
+            (Some(t), Some(dt), Some(r)) => println!(
                 "  {:<16} {:<16} {t:>10.3e} s at dt/tau1 = {dt:.3e} ({r:.1}x the fastest)",
                 m.integrator, m.noise
             ),
-            _ => eprintln!("  {:<16} {:<16} {}", m.integrator, m.noise, m.note),
+            _ => println!("  {:<16} {:<16} {}", m.integrator, m.noise, m.note),
         }
     }
     if s.inconsistent_points > 0 {
@@ -145,7 +174,7 @@ pub fn run(args: WorkPrecisionArgs) -> Result<i32> {
         );
     }
     langevin_fem::report::write_convergence_index(&args.out)?;
-    eprintln!(
+    println!(
         "wrote {} in {} ({:.1} s)",
         s.files.join(", "),
         args.out.display(),

@@ -93,6 +93,9 @@ pub struct PowerOptions {
     /// Output directory (`power.csv`, `power.json`, `power.md`; a scratch directory for
     /// the verifications, removed at the end).
     pub out: PathBuf,
+    /// Print progress on stderr: a line per row, and within a row at most one every
+    /// [`crate::progress::LINE_INTERVAL`] (off with `--quiet`).
+    pub progress: bool,
 }
 
 /// One fault, scene and size over the seeds.
@@ -236,7 +239,7 @@ fn verify_once(scene: Scene, opts: &PowerOptions, scratch: &std::path::Path) -> 
         budget: opts.budget,
         out: scratch.to_path_buf(),
         alpha: opts.alpha,
-        progress: false,
+        progress: crate::progress::ProgressOptions::HIDDEN,
         limits: WorkLimits::default(),
     });
     match result {
@@ -266,7 +269,20 @@ fn measure(
     let (mut failed, mut crashed, mut refused) = (0u64, 0u64, 0u64);
     let mut names: BTreeMap<String, u64> = BTreeMap::new();
     let mut first_error = None;
-    for &seed in seeds {
+    let mut last_line = Instant::now();
+    for (k, &seed) in seeds.iter().enumerate() {
+        if opts.progress && last_line.elapsed() >= crate::progress::LINE_INTERVAL {
+            last_line = Instant::now();
+            eprintln!(
+                "progress: {} s = {} in {}: seed {} of {}, elapsed {}",
+                fault.kind.name(),
+                fault.size,
+                target.scene,
+                k + 1,
+                seeds.len(),
+                crate::progress::fmt_seconds(start.elapsed().as_secs_f64())
+            );
+        }
         match verify_once(faulty_scene(target, fault, seed)?, opts, scratch) {
             Outcome::Passed => {}
             Outcome::FailedChecks(checks) => {
@@ -349,7 +365,7 @@ fn smallest_detected(rows: &[PowerRow]) -> Vec<Smallest> {
     out
 }
 
-/// Runs the power study (progress on stderr) and writes `power.csv`, `power.json` and
+/// Runs the power study (progress on stderr if `opts.progress`) and writes `power.csv`, `power.json` and
 /// `power.md` to `opts.out`.
 ///
 /// # Errors
@@ -362,14 +378,20 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
     let seeds = seeds(opts.seeds);
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let scratch = opts.out.join(".verify-scratch");
-    eprintln!(
+    // Progress lines on stderr, unless quiet.
+    let say = |line: String| {
+        if opts.progress {
+            eprintln!("{line}");
+        }
+    };
+    say(format!(
         "power: budget {}, alpha {}, seeds {}..={} ({} per size)",
         opts.budget.name(),
         opts.alpha,
         seeds[0],
         seeds[seeds.len() - 1],
         seeds.len()
-    );
+    ));
     let mut rows = Vec::new();
     for &kind in &opts.faults {
         for target in targets(kind) {
@@ -379,17 +401,17 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
                 if rows.last().is_some_and(|r: &PowerRow| {
                     r.fault == kind.name() && r.scene == target.scene && r.detection_rate == 1.0
                 }) {
-                    eprintln!(
+                    say(format!(
                         "{:<24} {:<20} s = {:<8} not run: a smaller size was detected in every seed",
                         kind.name(),
                         target.scene,
                         size
-                    );
+                    ));
                     continue;
                 }
                 let fault = Fault::new(kind, size)?;
                 let row = measure(&target, fault, &seeds, opts, &scratch)?;
-                eprintln!(
+                say(format!(
                     "{:<24} {:<20} s = {:<8} detected {:>3}/{} (checks {}, run failures {}, input errors {}) [{:.2}, {:.2}]  {:.1} s/seed",
                     kind.name(),
                     target.scene,
@@ -402,7 +424,7 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
                     row.interval[0],
                     row.interval[1],
                     row.mean_seconds
-                );
+                ));
                 rows.push(row);
             }
         }

@@ -95,9 +95,9 @@ pub fn projected_work(opts: &WorkPrecisionOptions) -> Result<WorkProjection> {
     for &method in &opts.methods {
         let em = method.0 == IntegratorKind::EulerMaruyama;
         let flags = if em {
-            "--methods, --em-fractions, --trajectories, --em-duration"
+            "--methods, --em-fractions, --trajectories, --em-duration-tau1"
         } else {
-            "--methods, --dt-tau1, --trajectories, --duration"
+            "--methods, --dt-tau1, --trajectories, --duration-tau1"
         };
         for dt in method_dts(opts, method)? {
             let s = point_scene(opts, method, dt);
@@ -108,7 +108,11 @@ pub fn projected_work(opts: &WorkPrecisionOptions) -> Result<WorkProjection> {
                     "{} (--trajectories {} x {} = {} tau1 at dt/tau1 = {}, {} elements)",
                     flags,
                     opts.trajectories,
-                    if em { "--em-duration" } else { "--duration" },
+                    if em {
+                        "--em-duration-tau1"
+                    } else {
+                        "--duration-tau1"
+                    },
                     Num(e.duration_tau1),
                     Num(dt),
                     s.mesh.elements
@@ -294,8 +298,8 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
             "an integer in [2, 1024]",
         ));
     }
-    crate::error::require_in_range("--duration", opts.duration_tau1, 1.0, 1e6)?;
-    crate::error::require_in_range("--em-duration", opts.em_duration_tau1, 1.0, 1e6)?;
+    crate::error::require_in_range("--duration-tau1", opts.duration_tau1, 1.0, 1e6)?;
+    crate::error::require_in_range("--em-duration-tau1", opts.em_duration_tau1, 1.0, 1e6)?;
     crate::error::require_in_range("--tolerance", opts.tolerance, 1e-6, 1.0)?;
     // At most 1e10 sampled steps per trajectory (--dt-tau1 1e-12 would ask for 1e18).
     let shortest = opts.duration_tau1 / MAX_STEPS_PER_TRAJECTORY;
@@ -303,7 +307,7 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
         return Err(Error::invalid(
             "--dt-tau1",
             d,
-            format!(">= --duration/1e10 = {shortest:.3e} (at most 1e10 steps per trajectory)"),
+            format!(">= --duration-tau1/1e10 = {shortest:.3e} (at most 1e10 steps per trajectory)"),
         ));
     }
     Ok(())

@@ -36,6 +36,7 @@ use crate::error::{Error, Result};
 use crate::fem::noise::{NoiseModel, element_uniform_variance_ratios};
 use crate::output::{Figure, Provenance, ReportRun, Series, SeriesStyle};
 use crate::params::physical::units_note;
+use crate::progress::{Progress, ProgressOptions};
 use crate::rng::derive_seed;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
@@ -49,7 +50,6 @@ use crate::verify::compression::{compression_checks, halving_check};
 use crate::verify::oracle::{Oracle, compression_oracle, linear_oracle};
 use crate::verify::summary::{CheckResult, SceneSummary, SkippedCheck, Summary};
 use crate::work::{WorkLimits, WorkProjection};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -64,8 +64,9 @@ pub struct VerifyOptions {
     pub out: PathBuf,
     /// Family-wise significance level per scene (Holm).
     pub alpha: f64,
-    /// Show a progress bar (only drawn on a terminal).
-    pub progress: bool,
+    /// Progress on stderr, over the projected work of the runs, naming the scene and the
+    /// run ([`crate::progress`]).
+    pub progress: ProgressOptions,
     /// The caps on the projected work and memory of all the scenes
     /// ([`projected_work`]), checked before anything runs.
     pub limits: WorkLimits,
@@ -108,7 +109,8 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes = &opts.scenes;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
-    opts.limits.check(&projected_work(scenes, opts.budget))?;
+    let work = projected_work(scenes, opts.budget);
+    opts.limits.check(&work)?;
     // Prepare every run first so that bad input is reported before any long work.
     let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
     for (scene, work) in scenes.iter().zip(&prepared) {
@@ -124,15 +126,10 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     }
     let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
-    let bar = progress_bar(
-        trajectory_count(scenes, opts.budget),
-        "trajectories",
-        opts.progress,
-    );
+    let bar = Progress::new(opts.progress, work.dof_steps(), "DOF-steps");
     let mut summaries = Vec::new();
     let mut curves = Vec::new();
     for (scene, work) in scenes.iter().zip(&prepared) {
-        bar.set_message(scene.name.clone());
         summaries.push(match work {
             Prepared::Linear(runs, oracles) => {
                 run_scene(scene, runs, oracles, opts, &report, &bar)?
@@ -148,7 +145,7 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
             )?,
         });
     }
-    bar.finish_and_clear();
+    bar.finish();
     let summary = Summary {
         run_id: report.run_id(),
         budget: opts.budget.name().to_string(),
@@ -319,44 +316,15 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
     Ok(Prepared::Compression(theory, oracle, runs))
 }
 
-/// Trajectories of all scenes at `budget` (per strain for compression scenes), for the
-/// progress bar.
-fn trajectory_count(scenes: &[Scene], budget: Budget) -> u64 {
-    scenes
-        .iter()
-        .map(|s| {
-            let points = s.compression.as_ref().map_or(1, |c| c.strain_ratios.len());
-            s.runs
-                .iter()
-                .map(|r| {
-                    let e = r.ensemble(budget);
-                    if s.compression.is_some() {
-                        // A budget by target precision runs a pilot and a main stage.
-                        let stages = if e.precision_target().is_some() { 2 } else { 1 };
-                        (stages * e.trajectories * points) as u64
-                    } else {
-                        (e.trajectories + e.two_time_trajectories) as u64
-                    }
-                })
-                .sum::<u64>()
-        })
-        .sum()
-}
-
-/// A progress bar over `total` things (`unit`: `trajectories`, `runs`) on stderr, or a
-/// hidden one.
-pub fn progress_bar(total: u64, unit: &str, show: bool) -> ProgressBar {
-    let bar = if show {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    if let Ok(style) = ProgressStyle::with_template(&format!(
-        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {unit}  {{msg}}"
-    )) {
-        bar.set_style(style);
-    }
-    bar
+/// Starts run `k` of `scene` on `bar`: labelled `scene/run`, of its projected work at
+/// `budget` ([`Scene::projected_work`]).
+fn begin_run(bar: &Progress, scene: &Scene, k: usize, budget: Budget) {
+    let work = scene
+        .projected_work(budget)
+        .get(k)
+        .map_or(0.0, |p| p.work.dof_steps);
+    let run = scene.runs.get(k).map_or("?", |r| r.name.as_str());
+    bar.begin_run(&scene.name, &format!("{}/{run}", scene.name), work);
 }
 
 /// What a scene produces, each list in the order of `summary.json`, and the report run
@@ -438,7 +406,7 @@ fn run_compression_scene(
     runs: &[CompressionRun],
     opts: &VerifyOptions,
     report: &ReportRun,
-    bar: &ProgressBar,
+    bar: &Progress,
     curves: &mut Vec<Curve>,
 ) -> Result<SceneSummary> {
     let start = Instant::now();
@@ -457,6 +425,7 @@ fn run_compression_scene(
     // at half the first run's steps.
     let mut chosen: Vec<Option<Vec<f64>>> = Vec::new();
     for (k, run) in runs.iter().enumerate() {
+        begin_run(bar, scene, k, opts.budget);
         let inherited = halved_steps(scene, runs, &chosen, k);
         let halved;
         let run = match inherited {
@@ -513,11 +482,28 @@ fn run_compression_scene(
     outputs.figures.push(write_fig2(report, &opts.out, curves)?);
     let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((what, slope)) = largest_slope {
-        summary
-            .warnings
-            .extend(small_slope_warning(&what, slope, &scene.filament));
+        add_slope_status(scene, &mut summary, &what, slope);
     }
     Ok(summary)
+}
+
+/// The small-slope status of `scene` when its largest RMS slope exceeds the model's limit
+/// ([`small_slope_warning`]): a warning for a user's scene file, which may be meant as a
+/// physical filament; for a built-in scene, floppy on purpose to exercise the model, one
+/// note in the report instead (a warning on every default run would teach users to
+/// ignore warnings).
+fn add_slope_status(scene: &Scene, summary: &mut SceneSummary, what: &str, slope: (f64, f64)) {
+    let Some(text) = small_slope_warning(what, slope, &scene.filament) else {
+        return;
+    };
+    let builtin = crate::scene::builtin::find(&scene.name).is_some_and(|b| scene.path == b.label());
+    if builtin {
+        summary.notes.push(format!(
+            "small-slope status (a built-in scene, floppy on purpose): {text}"
+        ));
+    } else {
+        summary.warnings.push(text);
+    }
 }
 
 /// The steps of run `k` if it is the second run of the scene's Δt-halving pair and the
@@ -549,10 +535,11 @@ fn run_compression(
     k: usize,
     run: &CompressionRun,
     opts: &VerifyOptions,
-    bar: &ProgressBar,
+    bar: &Progress,
     outputs: &mut SceneOutputs<'_>,
 ) -> Result<(ForceEstimates, Option<RmsSlope>, Option<Vec<f64>>)> {
     let e = run.spec.ensemble(opts.budget);
+    let tick = tick_work(bar, run, &e);
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
     let searched;
     let (records, plan, run) = match e.precision_target() {
@@ -561,7 +548,7 @@ fn run_compression(
                 .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
                 .collect();
             let records = run
-                .simulate_ensemble_per_point(seed, e.trajectories, &steps, || bar.inc(1))
+                .simulate_ensemble_per_point(seed, e.trajectories, &steps, || bar.advance(tick))
                 .map_err(|e| simulation_error(scene, k, e))?;
             (records, None, run)
         }
@@ -570,7 +557,9 @@ fn run_compression(
             searched = adapted;
             let run = searched.as_ref().unwrap_or(run);
             let records = run
-                .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || bar.inc(1))
+                .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || {
+                    bar.advance(tick)
+                })
                 .map_err(|e| simulation_error(scene, k, e))?;
             (records, Some(plan), run)
         }
@@ -597,6 +586,14 @@ fn run_compression(
         .and_then(|p| p.search)
         .map(|s| s.iter().map(|c| c.dt_tau1).collect());
     Ok((est, slope, steps))
+}
+
+/// The work of one trajectory at one strain of compression run `run` at ensemble `e`, for
+/// the progress: the run's projected work shared equally among its trajectories (times
+/// two stages, pilot and main, for a budget by target precision).
+fn tick_work(bar: &Progress, run: &CompressionRun, e: &Ensemble) -> f64 {
+    let stages = if e.precision_target().is_some() { 2 } else { 1 };
+    bar.run_work() / (stages * run.points() * e.trajectories.max(1)) as f64
 }
 
 /// The pilot of a budget by target precision and the main-stage durations it chose.
@@ -627,10 +624,11 @@ fn targeted_plan(
     e: &Ensemble,
     target: PrecisionTarget,
     budget: Budget,
-    bar: &ProgressBar,
+    bar: &Progress,
 ) -> Result<(TargetedPlan, Option<CompressionRun>)> {
     let tau1 = scene.filament.tau1();
     let name = &run.spec.name;
+    let tick = tick_work(bar, run, e);
     let (search, adapted) = match target.step_search {
         None => (None, None),
         Some(search) => {
@@ -653,7 +651,7 @@ fn targeted_plan(
             |i| derive_seed(scene.seed, &format!("{name}/pilot/{i}")),
             e.trajectories,
             &pilot_steps,
-            || bar.inc(1),
+            || bar.advance(tick),
         )
         .map_err(|e| simulation_error(scene, k, e))?;
     let pilot_key = format!("{}.pilot_tau1", budget.name());
@@ -931,7 +929,7 @@ fn run_scene(
     oracles: &[Oracle],
     opts: &VerifyOptions,
     report: &ReportRun,
-    bar: &ProgressBar,
+    bar: &Progress,
 ) -> Result<SceneSummary> {
     let start = Instant::now();
     let dir = opts.out.join(&scene.name);
@@ -946,6 +944,7 @@ fn run_scene(
         ModelKind::Spectral | ModelKind::Compression => None,
     };
     for (k, (run, oracle)) in runs.iter().zip(oracles).enumerate() {
+        begin_run(bar, scene, k, opts.budget);
         outputs.checks.extend(oracle.checks.iter().cloned());
         outputs.notes.extend(oracle.notes.iter().cloned());
         if !oracle.passed() {
@@ -974,11 +973,8 @@ fn run_scene(
     }
     let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((run, slope)) = largest_slope {
-        summary.warnings.extend(small_slope_warning(
-            &format!("run {run} (largest of the runs)"),
-            slope,
-            &scene.filament,
-        ));
+        let what = format!("run {run} (largest of the runs)");
+        add_slope_status(scene, &mut summary, &what, slope);
     }
     Ok(summary)
 }
@@ -1169,17 +1165,27 @@ fn simulate_linear(
     k: usize,
     run: &LinearRun,
     e: &Ensemble,
-    bar: &ProgressBar,
+    bar: &Progress,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let seed = derive_seed(scene.seed, &run.spec.name);
     let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
     let full = e.trajectories as u64;
+    // The work of one full trajectory and of one extra two-time trajectory (much
+    // shorter), from the run's projection.
+    let only_full = Ensemble {
+        two_time_trajectories: 0,
+        ..*e
+    };
+    let full_work = scene.run_work(k, &only_full, None).dof_steps;
+    let extra_work = scene.run_work(k, e, None).dof_steps - full_work;
+    let per_full = full_work / e.trajectories.max(1) as f64;
+    let per_extra = extra_work / e.two_time_trajectories.max(1) as f64;
     let records = run
-        .simulate_ensemble(seed, 0, full, steps, |k| bar.inc(k))
+        .simulate_ensemble(seed, 0, full, steps, |n| bar.advance(n as f64 * per_full))
         .map_err(|e| simulation_error(scene, k, e))?;
     let extra: Vec<Vec<f64>> = run
-        .simulate_ensemble(seed, full, e.two_time_trajectories as u64, 0, |k| {
-            bar.inc(k)
+        .simulate_ensemble(seed, full, e.two_time_trajectories as u64, 0, |n| {
+            bar.advance(n as f64 * per_extra)
         })
         .map_err(|e| simulation_error(scene, k, e))?
         .into_iter()

@@ -1,0 +1,200 @@
+//! What `verify` and `check` print: per-scene lines and the closing totals line on
+//! stdout, warnings on stderr, at the chosen [`Verbosity`].
+//!
+//! - quiet: every failed check (`SCENE  failed: NAME`), then the totals line;
+//! - normal: a line per scene (verdict, checks passed, failed and skipped, wall time),
+//!   its failed checks, the verdict with the report's path, then the totals line;
+//! - verbose: also, per failed check, its test, statistic, p-values and estimate
+//!   against the reference, per skipped check the reason, and the seed of each scene.
+//!
+//! The last line of stdout is always `N passed, N failed, N skipped in T s` (checks
+//! summed over the scenes; T the command's wall time), for a person and for a script.
+
+use super::Verbosity;
+use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
+
+/// Checks passed, failed and skipped (not evaluated) in a set of scenes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Totals {
+    /// Checks that passed.
+    pub passed: usize,
+    /// Checks that failed.
+    pub failed: usize,
+    /// Checks not evaluated ([`SceneSummary::skipped`]).
+    pub skipped: usize,
+}
+
+impl Totals {
+    /// The totals of `scenes`.
+    pub fn of<'a>(scenes: impl IntoIterator<Item = &'a SceneSummary>) -> Self {
+        scenes.into_iter().fold(Totals::default(), |t, s| {
+            let failed = s.checks.iter().filter(|c| !c.passed).count();
+            Totals {
+                passed: t.passed + s.checks.len() - failed,
+                failed: t.failed + failed,
+                skipped: t.skipped + s.skipped.len(),
+            }
+        })
+    }
+
+    /// The closing line: `N passed, N failed, N skipped in T s`.
+    pub fn line(&self, seconds: f64) -> String {
+        format!(
+            "{} passed, {} failed, {} skipped in {seconds:.1} s",
+            self.passed, self.failed, self.skipped
+        )
+    }
+}
+
+/// A number for the terminal: 4 significant digits.
+fn num(v: Option<f64>) -> String {
+    v.map_or("-".to_string(), |x| format!("{x:.4e}"))
+}
+
+/// The detail of a failed check for `--verbose`: test, statistic, p-values, estimate ±
+/// s.e. against the reference.
+fn failure_detail(c: &CheckResult) -> String {
+    let mut parts = vec![c.kind.clone()];
+    if let Some(stat) = c.statistic {
+        let dof = c.dof.map_or(String::new(), |d| format!(" (dof {d})"));
+        parts.push(format!("statistic {stat:.4}{dof}"));
+    }
+    if c.p_value.is_some() {
+        parts.push(format!(
+            "p = {}, adjusted p = {}",
+            num(c.p_value),
+            num(c.p_adjusted)
+        ));
+    }
+    if c.estimate.is_some() || c.reference.is_some() {
+        let unit = if c.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", c.unit)
+        };
+        parts.push(format!(
+            "estimate {} +- {} against reference {}{unit}",
+            num(c.estimate),
+            num(c.std_error),
+            num(c.reference)
+        ));
+    }
+    parts.join("; ")
+}
+
+/// Prints the scenes of `summary` at `verbosity`: failures and per-scene lines on
+/// stdout, warnings on stderr (`wall`: print each scene's wall time).
+pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
+    for s in &summary.scenes {
+        let t = Totals::of([s]);
+        if verbosity != Verbosity::Quiet {
+            let time = if wall {
+                format!(", {:.1} s", s.wall_seconds)
+            } else {
+                String::new()
+            };
+            println!(
+                "{:<24} {}  {} checks: {} passed, {} failed, {} skipped{time}",
+                s.name,
+                if s.passed { "PASS" } else { "FAIL" },
+                s.checks.len(),
+                t.passed,
+                t.failed,
+                t.skipped
+            );
+        }
+        for c in s.checks.iter().filter(|c| !c.passed) {
+            match verbosity {
+                Verbosity::Quiet => println!("{}  failed: {}", s.name, c.name),
+                Verbosity::Normal => println!("    failed: {}", c.name),
+                Verbosity::Verbose => {
+                    println!("    failed: {}: {}", c.name, failure_detail(c));
+                }
+            }
+        }
+        if verbosity == Verbosity::Verbose {
+            for k in &s.skipped {
+                println!("    skipped: {}: {}", k.name, k.reason);
+            }
+            if let Some(seed) = s.notes.iter().rev().find(|n| n.starts_with("seed ")) {
+                println!("    {seed}");
+            }
+        }
+        for w in &s.warnings {
+            eprintln!("warning: {}: {w}", s.name);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(name: &str, passed: bool) -> CheckResult {
+        CheckResult {
+            name: name.to_string(),
+            run: String::new(),
+            check: String::new(),
+            parameter: String::new(),
+            kind: "z-test".to_string(),
+            statistic: Some(3.5),
+            dof: None,
+            passed,
+            p_value: Some(4.6e-4),
+            p_adjusted: Some(2.1e-3),
+            estimate: Some(1.1),
+            reference: Some(1.0),
+            std_error: Some(0.03),
+            continuum: None,
+            reference_kind: "discrete".to_string(),
+            unit: "[L]^2".to_string(),
+            detail: String::new(),
+        }
+    }
+
+    fn scene(checks: Vec<CheckResult>, skipped: usize) -> SceneSummary {
+        SceneSummary {
+            name: "s".to_string(),
+            passed: checks.iter().all(|c| c.passed),
+            wall_seconds: 1.0,
+            figures: vec![],
+            captions: vec![],
+            tables: vec![],
+            notes: vec![],
+            warnings: vec![],
+            skipped: (0..skipped)
+                .map(|k| langevin_fem::verify::summary::SkippedCheck {
+                    name: format!("r/decay-rate/n={k}"),
+                    reason: "too short".to_string(),
+                })
+                .collect(),
+            checks,
+        }
+    }
+
+    /// Totals sum over scenes; skipped checks count apart; the line reads as documented.
+    #[test]
+    fn totals_count_passed_failed_and_skipped_checks() {
+        let a = scene(vec![check("a", true), check("b", false)], 2);
+        let b = scene(vec![check("c", true)], 1);
+        let t = Totals::of([&a, &b]);
+        assert_eq!(
+            t,
+            Totals {
+                passed: 2,
+                failed: 1,
+                skipped: 3
+            }
+        );
+        assert_eq!(t.line(12.345), "2 passed, 1 failed, 3 skipped in 12.3 s");
+    }
+
+    #[test]
+    fn failure_detail_names_the_test_the_p_values_and_the_estimate() {
+        let d = failure_detail(&check("a", false));
+        assert_eq!(
+            d,
+            "z-test; statistic 3.5000; p = 4.6000e-4, adjusted p = 2.1000e-3; estimate 1.1000e0 +- 3.0000e-2 against reference 1.0000e0 [L]^2"
+        );
+    }
+}
