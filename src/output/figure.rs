@@ -1,10 +1,22 @@
 //! Line and scatter figures rendered to SVG with `plotters`.
 //!
-//! A [`Figure`] is plain data (title, axis labels, log flags, [`Series`], horizontal
-//! reference lines) and renders deterministically: the same figure always produces the
-//! same SVG bytes. Text is emitted as SVG `<text>` elements and laid out by the viewer, so
-//! no font files are needed (plotters only estimates text extents, from the character
-//! count, to place the legend box).
+//! A [`Figure`] is plain data (title, axis labels with units, log or category axes,
+//! [`Series`], horizontal reference lines, a caption) and renders deterministically: the
+//! same figure always produces the same SVG bytes. Text is emitted as SVG `<text>`
+//! elements and laid out by the viewer, so no font files are needed and Unicode labels
+//! (`⟨F⟩`, `λᵢ`, `τ₁`) render as they are; text extents are estimated from the character
+//! count to place the legend box.
+//!
+//! Reading aids:
+//! - colours: a series takes the palette colour of its index unless it names one
+//!   ([`Series::palette`], [`Series::rgb`]); the series of one quantity share a colour,
+//!   the reference curve in a [light](Series::light) tint beneath the data, and a legend
+//!   entry can [join](Series::joined_with_next) the two ("mode 1: simulated / exact");
+//! - the legend goes in a corner of the plot that no point, line, marker or error bar
+//!   touches, else beside the plot (the canvas widens): it never hides data;
+//! - the SVG carries the caption as its `<title>` and the axis labels as its `<desc>`
+//!   (`horizontal axis: …` and `vertical axis: …`, one a line), for screen readers and
+//!   tests; [`AxisUnits`] spells the units of the column dictionary in the labels.
 //!
 //! Robustness rules, so that a figure never hides a failed run behind a rendering error:
 //! - points with a non-finite coordinate are skipped, and so are points with a
