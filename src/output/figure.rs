@@ -1,10 +1,22 @@
 //! Line and scatter figures rendered to SVG with `plotters`.
 //!
-//! A [`Figure`] is plain data (title, axis labels, log flags, [`Series`], horizontal
-//! reference lines) and renders deterministically: the same figure always produces the
-//! same SVG bytes. Text is emitted as SVG `<text>` elements and laid out by the viewer, so
-//! no font files are needed (plotters only estimates text extents, from the character
-//! count, to place the legend box).
+//! A [`Figure`] is plain data (title, axis labels with units, log or category axes,
+//! [`Series`], horizontal reference lines, a caption) and renders deterministically: the
+//! same figure always produces the same SVG bytes. Text is emitted as SVG `<text>`
+//! elements and laid out by the viewer, so no font files are needed and Unicode labels
+//! (`⟨F⟩`, `λᵢ`, `τ₁`) render as they are; text extents are estimated from the character
+//! count to place the legend box.
+//!
+//! Reading aids:
+//! - colours: a series takes the palette colour of its index unless it names one
+//!   ([`Series::palette`], [`Series::rgb`]); the series of one quantity share a colour,
+//!   the reference curve in a [light](Series::light) tint beneath the data, and a legend
+//!   entry can [join](Series::joined_with_next) the two ("mode 1: simulated / exact");
+//! - the legend goes in a corner of the plot that no point, line, marker or error bar
+//!   touches, else beside the plot (the canvas widens): it never hides data;
+//! - the SVG carries the caption as its `<title>` and the axis labels as its `<desc>`
+//!   (`horizontal axis: …` and `vertical axis: …`, one a line), for screen readers and
+//!   tests; [`AxisUnits`] spells the units of the column dictionary in the labels.
 //!
 //! Robustness rules, so that a figure never hides a failed run behind a rendering error:
 //! - points with a non-finite coordinate are skipped, and so are points with a
@@ -19,7 +31,6 @@ use std::path::Path;
 
 use std::ops::Range;
 
-use plotters::chart::SeriesAnno;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -35,9 +46,23 @@ const HEIGHT: u32 = 520;
 const FONT: &str = "sans-serif";
 /// Half width of an error-bar cap in pixels.
 const CAP: i32 = 4;
-const MARKER_RADIUS: i32 = 3;
-/// Legend font size (plotters units; the SVG font size is this / 1.24).
-const LEGEND_FONT: f64 = 15.0;
+/// Default marker radius in pixels.
+const MARKER_RADIUS: u32 = 4;
+/// Legend font size (plotters units; the SVG font size is this / 1.24, 12.5 px).
+const LEGEND_FONT: f64 = 15.5;
+/// Estimated width of a legend character in pixels (about 0.53 em of the 12.5-px font,
+/// a little above the average of DejaVu Sans and Liberation Sans text).
+const LEGEND_CHAR_WIDTH: f64 = 6.6;
+/// Height of a legend line in pixels.
+const LEGEND_LINE: i32 = 19;
+/// Inner margin of the legend box in pixels.
+const LEGEND_PAD: i32 = 8;
+/// Width of a legend glyph in pixels.
+const GLYPH_WIDTH: i32 = 24;
+/// Left edge of a legend placed beside the plot (just right of the plot area).
+const OUTSIDE_X: i32 = WIDTH as i32 - 10;
+/// Lowest top edge of a legend placed beside the plot.
+const OUTSIDE_TOP: i32 = 40;
 /// Relative margin added on each side of the data range.
 const MARGIN: f64 = 0.05;
 
@@ -63,6 +88,57 @@ const HLINE_COLORS: [RGBColor; 3] = [
     RGBColor(150, 60, 0),
 ];
 
+/// Units for axis labels: the column dictionary's base dimensions made readable
+/// (`[L]`, `[L²]`, `[1/T]`, `[L²·T]`; see [`super::columns`]), or the concrete units of a
+/// scene given in physical units (`[µm]`, `[µm²]`, `[1/s]`, `[µm²·s]`; see
+/// [`super::provenance::SceneProvenance::units`]). Multiples of τ₁, F_c0 and ε_c0 are
+/// written as ratios in the labels themselves (`t / τ₁`, `⟨F⟩ / F_c0`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AxisUnits {
+    /// The length unit (`L` or `µm`).
+    pub length: &'static str,
+    /// The time unit (`T` or `s`).
+    pub time: &'static str,
+}
+
+impl AxisUnits {
+    /// The units of a scene in its own consistent units (`physical` false: `[L]`, `[T]`)
+    /// or given in physical units (`physical` true: µm, s).
+    pub fn new(physical: bool) -> Self {
+        if physical {
+            AxisUnits {
+                length: "µm",
+                time: "s",
+            }
+        } else {
+            AxisUnits {
+                length: "L",
+                time: "T",
+            }
+        }
+    }
+
+    /// A length, e.g. `[L]`.
+    pub fn length(&self) -> String {
+        format!("[{}]", self.length)
+    }
+
+    /// A squared length, e.g. `[L²]`.
+    pub fn area(&self) -> String {
+        format!("[{}²]", self.length)
+    }
+
+    /// A frequency, e.g. `[1/T]`.
+    pub fn frequency(&self) -> String {
+        format!("[1/{}]", self.time)
+    }
+
+    /// A power spectral density of a length, e.g. `[L²·T]`.
+    pub fn psd(&self) -> String {
+        format!("[{}²·{}]", self.length, self.time)
+    }
+}
+
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SeriesStyle {
@@ -74,6 +150,17 @@ pub enum SeriesStyle {
     Markers,
     /// A solid line with markers at the points.
     LineMarkers,
+}
+
+/// The colour of a series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesColor {
+    /// Entry `i` of the figure palette (the "Tableau 10" colours, then hues spread around
+    /// the colour circle).
+    Palette(usize),
+    /// An explicit colour (red, green, blue), e.g. for a status with a conventional
+    /// colour.
+    Rgb(u8, u8, u8),
 }
 
 /// One data series of a [`Figure`].
@@ -88,27 +175,41 @@ pub struct Series {
     pub y_err: Option<Vec<f64>>,
     /// How the series is drawn.
     pub style: SeriesStyle,
+    /// Its colour; `None`: the palette colour of the series' index in the figure.
+    pub color: Option<SeriesColor>,
+    /// Drawn in a light tint of its colour, under the other series (e.g. the exact curve
+    /// of a mode beneath the simulated markers of the same colour).
+    pub light: bool,
+    /// Marker radius in pixels.
+    pub marker_radius: u32,
+    /// The legend entry of this series also shows the glyph of the next series: one entry
+    /// for a pair such as "mode 1: simulated / exact" (the next series then needs no
+    /// label of its own).
+    pub legend_joins_next: bool,
 }
 
 impl Series {
-    /// A series drawn as a solid line.
-    pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+    fn with(label: impl Into<String>, points: Vec<(f64, f64)>, style: SeriesStyle) -> Self {
         Series {
             label: label.into(),
             points,
             y_err: None,
-            style: SeriesStyle::Line,
+            style,
+            color: None,
+            light: false,
+            marker_radius: MARKER_RADIUS,
+            legend_joins_next: false,
         }
+    }
+
+    /// A series drawn as a solid line.
+    pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Series::with(label, points, SeriesStyle::Line)
     }
 
     /// A series drawn as markers.
     pub fn markers(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
-        Series {
-            label: label.into(),
-            points,
-            y_err: None,
-            style: SeriesStyle::Markers,
-        }
+        Series::with(label, points, SeriesStyle::Markers)
     }
 
     /// Adds vertical error bars (half-widths, one per point, e.g. standard errors).
@@ -131,10 +232,46 @@ impl Series {
         self.style = style;
         self
     }
+
+    /// Draws the series in palette colour `i` (series of one quantity share a colour).
+    #[must_use]
+    pub fn palette(mut self, i: usize) -> Self {
+        self.color = Some(SeriesColor::Palette(i));
+        self
+    }
+
+    /// Draws the series in the colour `(r, g, b)`.
+    #[must_use]
+    pub fn rgb(mut self, r: u8, g: u8, b: u8) -> Self {
+        self.color = Some(SeriesColor::Rgb(r, g, b));
+        self
+    }
+
+    /// Draws the series in a light tint of its colour, beneath the other series.
+    #[must_use]
+    pub fn light(mut self) -> Self {
+        self.light = true;
+        self
+    }
+
+    /// Sets the marker radius in pixels (default 4).
+    #[must_use]
+    pub fn marker_radius(mut self, px: u32) -> Self {
+        self.marker_radius = px;
+        self
+    }
+
+    /// Makes this series' legend entry also show the next series' glyph (see
+    /// [`Series::legend_joins_next`]).
+    #[must_use]
+    pub fn joined_with_next(mut self) -> Self {
+        self.legend_joins_next = true;
+        self
+    }
 }
 
-/// A 2-D figure: series, optional error bars, horizontal reference lines, linear or
-/// logarithmic axes.
+/// A 2-D figure: series, optional error bars, horizontal reference lines, linear,
+/// logarithmic or category axes, and a caption.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
     /// Title above the plot.
@@ -147,10 +284,18 @@ pub struct Figure {
     pub x_log: bool,
     /// Logarithmic vertical axis (base 10).
     pub y_log: bool,
-    /// The data series, drawn in order (later series on top).
+    /// Category labels of the horizontal axis: if not empty, x = k is drawn at the `k`-th
+    /// label (k = 0, 1, …) and `x_log` is ignored.
+    pub x_categories: Vec<String>,
+    /// Category labels of the vertical axis (as [`Figure::x_categories`]).
+    pub y_categories: Vec<String>,
+    /// The data series, drawn in order (later series on top; light series first).
     pub series: Vec<Series>,
     /// Horizontal reference lines `(y, legend label)`, drawn dashed across the plot.
     pub hlines: Vec<(f64, String)>,
+    /// What the figure shows and what a reader should see in it; written into the SVG as
+    /// its `<title>` (empty: none).
+    pub caption: String,
 }
 
 impl Figure {
@@ -166,8 +311,11 @@ impl Figure {
             y_label: y_label.into(),
             x_log: false,
             y_log: false,
+            x_categories: Vec::new(),
+            y_categories: Vec::new(),
             series: Vec::new(),
             hlines: Vec::new(),
+            caption: String::new(),
         }
     }
 
@@ -185,6 +333,20 @@ impl Figure {
         self
     }
 
+    /// Makes the horizontal axis a category axis (see [`Figure::x_categories`]).
+    #[must_use]
+    pub fn x_categories(mut self, labels: Vec<String>) -> Self {
+        self.x_categories = labels;
+        self
+    }
+
+    /// Makes the vertical axis a category axis (see [`Figure::y_categories`]).
+    #[must_use]
+    pub fn y_categories(mut self, labels: Vec<String>) -> Self {
+        self.y_categories = labels;
+        self
+    }
+
     /// Adds a series.
     #[must_use]
     pub fn series(mut self, s: Series) -> Self {
@@ -199,7 +361,15 @@ impl Figure {
         self
     }
 
-    /// Renders the figure as an SVG document (800 × 520 pixels).
+    /// Sets the caption (see [`Figure::caption`]).
+    #[must_use]
+    pub fn caption(mut self, text: impl Into<String>) -> Self {
+        self.caption = text.into();
+        self
+    }
+
+    /// Renders the figure as an SVG document: 800 × 520 pixels, wider (and taller, for
+    /// a long legend) when the legend has to go beside the plot.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] if a series has error bars whose count differs from its
@@ -207,14 +377,31 @@ impl Figure {
     /// the SVG backend).
     pub fn render_svg(&self) -> Result<String> {
         let prepared = self.prepare()?;
+        let legend = self.legend_entries(&prepared);
+        let size = legend_size(&legend);
+        let corner = if legend.is_empty() {
+            None
+        } else {
+            self.free_corner(&prepared, size)
+                .map_err(|e| self.render_error(e))?
+        };
+        let (width, height, place) = match corner {
+            _ if legend.is_empty() => (WIDTH, HEIGHT, LegendPlace::None),
+            Some(at) => (WIDTH, HEIGHT, LegendPlace::Inside(at)),
+            None => (
+                (OUTSIDE_X + size.0 + 12) as u32,
+                HEIGHT.max((OUTSIDE_TOP + size.1 + 12) as u32),
+                LegendPlace::Outside,
+            ),
+        };
         let mut buf = String::new();
         {
-            let root = SVGBackend::with_string(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
-            self.draw(&root, &prepared)
+            let root = SVGBackend::with_string(&mut buf, (width, height)).into_drawing_area();
+            self.draw(&root, &prepared, &legend, place)
                 .map_err(|e| self.render_error(e))?;
             root.present().map_err(|e| self.render_error(e))?;
         }
-        Ok(buf)
+        Ok(self.with_accessible_text(buf))
     }
 
     /// Renders the figure (see [`Figure::render_svg`]) and writes it to `path` atomically.
@@ -233,14 +420,34 @@ impl Figure {
         }
     }
 
+    /// `svg` with the caption as `<title>` and the axis labels as `<desc>` (one a line:
+    /// `horizontal axis: …`, `vertical axis: …`) right after the opening `<svg>` tag, for
+    /// screen readers, browsers' tooltips and tests.
+    fn with_accessible_text(&self, mut svg: String) -> String {
+        let Some(end) = svg.find('>') else {
+            return svg;
+        };
+        let mut text = String::new();
+        if !self.caption.is_empty() {
+            text.push_str(&format!("\n<title>{}</title>", xml_escape(&self.caption)));
+        }
+        text.push_str(&format!(
+            "\n<desc>horizontal axis: {}\nvertical axis: {}</desc>",
+            xml_escape(&self.x_label),
+            xml_escape(&self.y_label)
+        ));
+        svg.insert_str(end + 1, &text);
+        svg
+    }
+
     /// Maps a data coordinate to plot space (`log10` on a log axis); `None` if the value
     /// cannot be drawn on that axis.
     fn tx(&self, x: f64) -> Option<f64> {
-        to_axis(x, self.x_log)
+        to_axis(x, self.x_log && self.x_categories.is_empty())
     }
 
     fn ty(&self, y: f64) -> Option<f64> {
-        to_axis(y, self.y_log)
+        to_axis(y, self.y_log && self.y_categories.is_empty())
     }
 
     /// Filters and transforms the data and computes the axes.
@@ -309,31 +516,56 @@ impl Figure {
             }
         }
 
+        let axis = |extent: Extent, log: bool, categories: &[String]| {
+            if categories.is_empty() {
+                Axis::new(extent, log)
+            } else {
+                Axis::categories(extent, categories)
+            }
+        };
         Ok(Prepared {
             series,
             hlines,
             skipped,
             skipped_hlines,
             has_data,
-            x: Axis::new(xs, self.x_log),
-            y: Axis::new(ys, self.y_log),
+            x: axis(xs, self.x_log, &self.x_categories),
+            y: axis(ys, self.y_log, &self.y_categories),
         })
     }
 
-    fn draw(&self, root: &Root<'_>, prep: &Prepared) -> DrawResult<()> {
+    fn draw(
+        &self,
+        root: &Root<'_>,
+        prep: &Prepared,
+        legend: &[LegendEntry],
+        place: LegendPlace,
+    ) -> DrawResult<()> {
         root.fill(&WHITE)?;
-        let mut chart = self.chart_with_mesh(root, prep)?;
-        // Reference lines first, so that data are drawn over them.
+        let plot_root = root.clone().shrink((0, 0), (WIDTH, HEIGHT));
+        let mut chart = self.chart_with_mesh(&plot_root, prep)?;
+        // Reference lines first, then light series (references), so that data are drawn
+        // over them.
         draw_hlines(&mut chart, prep)?;
-        for (i, (s, p)) in self.series.iter().zip(&prep.series).enumerate() {
-            draw_data_series(&mut chart, prep, s, p, series_color(i))?;
+        let order = self
+            .series
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.light)
+            .chain(self.series.iter().enumerate().filter(|(_, s)| !s.light));
+        for (i, s) in order {
+            draw_data_series(&mut chart, prep, s, &prep.series[i], self.color(i))?;
         }
-        let n_legend = self.legend_entries(&mut chart, prep)?;
         if !prep.has_data {
             draw_no_data_note(root, &chart)?;
         }
-        if n_legend > 0 {
-            self.draw_legend(&mut chart, prep)?;
+        match place {
+            LegendPlace::None => {}
+            LegendPlace::Inside(at) => draw_legend(root, legend, at)?,
+            LegendPlace::Outside => {
+                let (_, yr) = chart.plotting_area().get_pixel_range();
+                draw_legend(root, legend, (OUTSIDE_X, yr.start.max(OUTSIDE_TOP)))?;
+            }
         }
         if let Some(note) = prep.skipped_note(self.x_log || self.y_log) {
             root.draw(&Text::new(
@@ -346,6 +578,17 @@ impl Figure {
             ))?;
         }
         Ok(())
+    }
+
+    /// The colour of series `i`: its own, or the palette colour of its index.
+    fn color(&self, i: usize) -> RGBColor {
+        let s = &self.series[i];
+        let c = match s.color {
+            None => series_color(i),
+            Some(SeriesColor::Palette(k)) => series_color(k),
+            Some(SeriesColor::Rgb(r, g, b)) => RGBColor(r, g, b),
+        };
+        if s.light { tint(c) } else { c }
     }
 
     /// The chart (caption, label areas, axes in plot space) with its grid, ticks and axis
@@ -362,7 +605,11 @@ impl Figure {
             .x_label_area_size(52)
             .y_label_area_size(92);
         if !self.title.is_empty() {
-            builder.caption(&self.title, (FONT, 24));
+            // Smaller type for a long title, so that it fits the width (about 0.55 em a
+            // character; the SVG font size is the plotters size / 1.24).
+            let chars = self.title.chars().count().max(1) as f64;
+            let fit = f64::from(WIDTH - 40) / (0.55 * chars) * 1.24;
+            builder.caption(&self.title, (FONT, fit.clamp(14.0, 22.0)));
         }
         let mut chart =
             builder.build_cartesian_2d(TickedRange::new(&prep.x), TickedRange::new(&prep.y))?;
@@ -384,60 +631,68 @@ impl Figure {
         Ok(chart)
     }
 
-    /// Legend entries: empty series that only carry a label and a glyph, for every
-    /// labelled series and then every labelled reference line; returns their number.
-    fn legend_entries<'a, 'b: 'a>(
-        &self,
-        chart: &mut Chart<'a, 'b>,
-        prep: &Prepared,
-    ) -> DrawResult<usize> {
-        let mut n_legend = 0usize;
+    /// The legend entries: every labelled series (with the glyph of the next series too
+    /// if it [joins](Series::legend_joins_next) it), then every labelled reference line.
+    fn legend_entries(&self, prep: &Prepared) -> Vec<LegendEntry> {
+        let mut entries = Vec::new();
         for (i, s) in self.series.iter().enumerate() {
             if s.label.is_empty() {
                 continue;
             }
-            n_legend += 1;
-            let anno = chart.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
-            Glyph::new(series_color(i), s.style, s.y_err.is_some()).attach(anno, &s.label);
+            let mut glyph = Glyph::of(s, self.color(i));
+            if s.legend_joins_next
+                && let Some(next) = self.series.get(i + 1)
+            {
+                glyph.join(Glyph::of(next, self.color(i + 1)));
+            }
+            entries.push(LegendEntry {
+                label: s.label.clone(),
+                glyph,
+            });
         }
         for (k, _, label) in &prep.hlines {
             if label.is_empty() {
                 continue;
             }
-            n_legend += 1;
-            let anno = chart.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
-            Glyph::new(
-                HLINE_COLORS[k % HLINE_COLORS.len()],
-                SeriesStyle::Dashed,
-                false,
-            )
-            .attach(anno, label);
+            let color = HLINE_COLORS[k % HLINE_COLORS.len()];
+            let line = Series::line("", Vec::new()).dashed();
+            entries.push(LegendEntry {
+                label: label.clone(),
+                glyph: Glyph::of(&line, color),
+            });
         }
-        Ok(n_legend)
+        entries
     }
 
-    /// The legend box, in the corner chosen by [`legend_position`].
-    fn draw_legend<'a, 'b: 'a>(
-        &self,
-        chart: &mut Chart<'a, 'b>,
-        prep: &Prepared,
-    ) -> DrawResult<()> {
-        let labels: Vec<&str> = self
+    /// The top-left pixel of a legend box of `size` in a corner of the plot that no
+    /// drawn point, line, marker or error bar touches (tried in the order upper right,
+    /// upper left, lower right, lower left); `None` if every corner has data. Lays the
+    /// chart out on a scratch canvas of the final plot size to find where data go.
+    fn free_corner(&self, prep: &Prepared, size: (i32, i32)) -> DrawResult<Option<(i32, i32)>> {
+        let mut scratch = String::new();
+        let root = SVGBackend::with_string(&mut scratch, (WIDTH, HEIGHT)).into_drawing_area();
+        let chart = self.chart_with_mesh(&root, prep)?;
+        let samples = data_pixels(&chart, prep);
+        let pad = self
             .series
             .iter()
-            .map(|s| s.label.as_str())
-            .chain(prep.hlines.iter().map(|(_, _, l)| l.as_str()))
-            .filter(|l| !l.is_empty())
-            .collect();
-        let position = legend_position(chart, prep, &labels);
-        chart
-            .configure_series_labels()
-            .position(position)
-            .label_font((FONT, LEGEND_FONT))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(150, 150, 150))
-            .draw()?;
-        Ok(())
+            .map(|s| s.marker_radius as i32)
+            .max()
+            .unwrap_or(0)
+            + 3;
+        let (w, h) = size;
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        let (left, right) = (xr.start + 6, xr.end - 6 - w);
+        let (top, bottom) = (yr.start + 6, yr.end - 6 - h);
+        let free = |(x0, y0): (i32, i32)| {
+            !samples.iter().any(|&(x, y)| {
+                x >= x0 - pad && x <= x0 + w + pad && y >= y0 - pad && y <= y0 + h + pad
+            })
+        };
+        Ok([(right, top), (left, top), (right, bottom), (left, bottom)]
+            .into_iter()
+            .filter(|&(x0, y0)| x0 >= xr.start && y0 >= yr.start)
+            .find(|&c| free(c)))
     }
 }
 
@@ -445,6 +700,129 @@ impl Figure {
 type Root<'b> = DrawingArea<SVGBackend<'b>, plotters::coord::Shift>;
 /// The result of a plotters drawing call on the SVG backend.
 type DrawResult<T> = std::result::Result<T, DrawingAreaErrorKind<std::io::Error>>;
+
+/// Where the legend goes.
+#[derive(Debug, Clone, Copy)]
+enum LegendPlace {
+    /// No legend (no labelled series or reference line).
+    None,
+    /// Inside the plot, with its box's top-left corner at this pixel.
+    Inside((i32, i32)),
+    /// To the right of the plot (the canvas is widened).
+    Outside,
+}
+
+/// One legend line: a glyph and its label.
+struct LegendEntry {
+    label: String,
+    glyph: Glyph,
+}
+
+/// The legend box size in pixels for `entries` (text width estimated from the number of
+/// characters: plotters has no font metrics without fonts).
+fn legend_size(entries: &[LegendEntry]) -> (i32, i32) {
+    let chars = entries
+        .iter()
+        .map(|e| e.label.chars().count())
+        .max()
+        .unwrap_or(0) as f64;
+    let w = 2 * LEGEND_PAD + GLYPH_WIDTH + 8 + (LEGEND_CHAR_WIDTH * chars).ceil() as i32;
+    let h = 2 * LEGEND_PAD + LEGEND_LINE * entries.len() as i32;
+    (w, h)
+}
+
+/// Draws the legend box with its top-left corner at `at` (pixels of `root`).
+fn draw_legend(root: &Root<'_>, entries: &[LegendEntry], at: (i32, i32)) -> DrawResult<()> {
+    let (w, h) = legend_size(entries);
+    root.draw(&Rectangle::new(
+        [at, (at.0 + w, at.1 + h)],
+        WHITE.mix(0.9).filled(),
+    ))?;
+    root.draw(&Rectangle::new(
+        [at, (at.0 + w, at.1 + h)],
+        RGBColor(150, 150, 150).stroke_width(1),
+    ))?;
+    for (k, e) in entries.iter().enumerate() {
+        let y = at.1 + LEGEND_PAD + LEGEND_LINE * k as i32 + LEGEND_LINE / 2;
+        let x = at.0 + LEGEND_PAD;
+        e.glyph.draw(root, (x, y))?;
+        root.draw(&Text::new(
+            e.label.clone(),
+            (x + GLYPH_WIDTH + 8, y),
+            (FONT, LEGEND_FONT)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+    }
+    Ok(())
+}
+
+/// The pixels that data cover: lines and error bars sampled every 6 pixels, markers,
+/// reference lines.
+fn data_pixels(chart: &Chart<'_, '_>, prep: &Prepared) -> Vec<(i32, i32)> {
+    let mut samples: Vec<(i32, i32)> = Vec::new();
+    let mut add_segment = |a: (i32, i32), b: (i32, i32)| {
+        let len = (b.0 - a.0).abs().max((b.1 - a.1).abs());
+        let n = (len / 6).max(1);
+        for k in 0..=n {
+            let t = f64::from(k) / f64::from(n);
+            samples.push((
+                (f64::from(a.0) + t * f64::from(b.0 - a.0)).round() as i32,
+                (f64::from(a.1) + t * f64::from(b.1 - a.1)).round() as i32,
+            ));
+        }
+    };
+    for s in &prep.series {
+        for run in &s.runs {
+            for pair in run.windows(2) {
+                add_segment(chart.backend_coord(&pair[0]), chart.backend_coord(&pair[1]));
+            }
+        }
+        for p in &s.points {
+            let c = chart.backend_coord(p);
+            add_segment(c, c);
+        }
+        for bar in &s.bars {
+            let hi = bar.hi.unwrap_or(prep.y.hi);
+            let lo = bar.lo.unwrap_or(prep.y.lo);
+            add_segment(
+                chart.backend_coord(&(bar.x, lo)),
+                chart.backend_coord(&(bar.x, hi)),
+            );
+        }
+    }
+    for (_, y, _) in &prep.hlines {
+        add_segment(
+            chart.backend_coord(&(prep.x.lo, *y)),
+            chart.backend_coord(&(prep.x.hi, *y)),
+        );
+    }
+    samples
+}
+
+/// Escapes `&`, `<`, `>`, `"` and `'` for XML text.
+fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// A light tint of `c` (halfway to white and a bit more), for reference curves drawn
+/// beneath data of the same colour.
+fn tint(c: RGBColor) -> RGBColor {
+    let t = |v: u8| (f64::from(v) + 0.55 * (255.0 - f64::from(v))).round() as u8;
+    RGBColor(t(c.0), t(c.1), t(c.2))
+}
 
 /// The horizontal reference lines, dashed across the whole x range.
 fn draw_hlines<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, prep: &Prepared) -> DrawResult<()> {
@@ -494,7 +872,7 @@ fn draw_data_series<'a, 'b: 'a>(
     chart.draw_series(
         marker_points
             .iter()
-            .map(|&pt| Circle::new(pt, MARKER_RADIUS, color.filled())),
+            .map(|&pt| Circle::new(pt, s.marker_radius, color.filled())),
     )?;
     Ok(())
 }
@@ -559,71 +937,62 @@ fn series_color(i: usize) -> RGBColor {
     }
 }
 
-/// The legend glyph of a series: up to three line pieces (solid or dashed), an error bar
-/// with caps and a marker, in pixel offsets from the legend entry's anchor. Parts that a
-/// style does not use are transparent, which the SVG backend skips, so that every glyph
-/// has the same element type.
+/// A legend glyph: line pieces (solid or dashed), an error bar with caps and markers, in
+/// pixel offsets from the entry's anchor (left end, vertical centre).
 #[derive(Clone)]
 struct Glyph {
-    paths: [(Vec<(i32, i32)>, ShapeStyle); 6],
-    marker: ShapeStyle,
+    paths: Vec<(Vec<(i32, i32)>, ShapeStyle)>,
+    /// Marker radii and styles, drawn at the glyph's centre over the paths.
+    markers: Vec<(u32, ShapeStyle)>,
 }
 
 impl Glyph {
-    fn new(color: RGBColor, style: SeriesStyle, with_bar: bool) -> Self {
+    /// The glyph of series `s` drawn in `color`.
+    fn of(s: &Series, color: RGBColor) -> Self {
         let line = color.stroke_width(2);
-        let none = TRANSPARENT.stroke_width(1);
-        let thin = if with_bar {
-            color.stroke_width(1)
-        } else {
-            none
-        };
-        let solid = matches!(style, SeriesStyle::Line | SeriesStyle::LineMarkers);
-        let dashed = style == SeriesStyle::Dashed;
-        let markers = matches!(style, SeriesStyle::Markers | SeriesStyle::LineMarkers);
-        let (first, second, third) = if dashed {
-            (
-                (vec![(0, 0), (7, 0)], line),
-                (vec![(10, 0), (14, 0)], line),
-                (vec![(17, 0), (24, 0)], line),
-            )
-        } else {
-            (
-                (vec![(0, 0), (24, 0)], if solid { line } else { none }),
-                (vec![], none),
-                (vec![], none),
-            )
-        };
-        Glyph {
-            paths: [
-                (vec![(12, -6), (12, 6)], thin),
-                (vec![(12 - CAP, -6), (12 + CAP, -6)], thin),
-                (vec![(12 - CAP, 6), (12 + CAP, 6)], thin),
-                first,
-                second,
-                third,
-            ],
-            marker: if markers {
-                color.filled()
-            } else {
-                TRANSPARENT.filled()
-            },
+        let mid = GLYPH_WIDTH / 2;
+        let mut paths = Vec::new();
+        if s.y_err.is_some() {
+            let thin = color.stroke_width(1);
+            paths.push((vec![(mid, -6), (mid, 6)], thin));
+            paths.push((vec![(mid - CAP, -6), (mid + CAP, -6)], thin));
+            paths.push((vec![(mid - CAP, 6), (mid + CAP, 6)], thin));
         }
+        match s.style {
+            SeriesStyle::Dashed => {
+                paths.push((vec![(0, 0), (7, 0)], line));
+                paths.push((vec![(10, 0), (14, 0)], line));
+                paths.push((vec![(17, 0), (GLYPH_WIDTH, 0)], line));
+            }
+            SeriesStyle::Line | SeriesStyle::LineMarkers => {
+                paths.push((vec![(0, 0), (GLYPH_WIDTH, 0)], line));
+            }
+            SeriesStyle::Markers => {}
+        }
+        let markers = if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
+            vec![(s.marker_radius.min(6), color.filled())]
+        } else {
+            Vec::new()
+        };
+        Glyph { paths, markers }
     }
 
-    /// Attaches `label` and this glyph to a (data-less) series annotation.
-    fn attach<'a, DB: DrawingBackend + 'a>(self, anno: &mut SeriesAnno<'a, DB>, label: &str) {
-        anno.label(label).legend(move |origin| {
-            let [a, b, c, d, e, f] = self.paths.clone();
-            EmptyElement::at(origin)
-                + PathElement::new(a.0, a.1)
-                + PathElement::new(b.0, b.1)
-                + PathElement::new(c.0, c.1)
-                + PathElement::new(d.0, d.1)
-                + PathElement::new(e.0, e.1)
-                + PathElement::new(f.0, f.1)
-                + Circle::new((12, 0), MARKER_RADIUS, self.marker)
-        });
+    /// Adds `other`'s parts (its paths under this glyph's markers).
+    fn join(&mut self, other: Glyph) {
+        self.paths.extend(other.paths);
+        self.markers.extend(other.markers);
+    }
+
+    /// Draws the glyph with its anchor at `(x, y)` (pixels of `root`).
+    fn draw(&self, root: &Root<'_>, (x, y): (i32, i32)) -> DrawResult<()> {
+        for (points, style) in &self.paths {
+            let shifted: Vec<(i32, i32)> = points.iter().map(|&(a, b)| (x + a, y + b)).collect();
+            root.draw(&PathElement::new(shifted, *style))?;
+        }
+        for &(r, style) in &self.markers {
+            root.draw(&Circle::new((x + GLYPH_WIDTH / 2, y), r, style))?;
+        }
+        Ok(())
     }
 }
 
@@ -682,83 +1051,6 @@ impl Ranged for TickedRange {
     fn range(&self) -> Range<f64> {
         self.lo..self.hi
     }
-}
-
-/// Picks the plot corner where the legend box covers the fewest drawn points (sampled
-/// along lines and error bars); ties prefer upper right, upper left, lower right, lower
-/// left, in that order.
-fn legend_position(chart: &Chart<'_, '_>, prep: &Prepared, labels: &[&str]) -> SeriesLabelPosition {
-    // Mirrors plotters' legend layout without font metrics:
-    // character width 0.7 em, line height 1.25 of the font height, 30 px glyph area,
-    // 10 px margins, 5 px from the plot border.
-    let em = LEGEND_FONT / 1.24 / 1.24;
-    let max_chars = labels.iter().map(|l| l.len()).max().unwrap_or(0) as f64;
-    let w = (em * 0.7 * max_chars + 30.0 + 20.0).round() as i32 + 4;
-    let h = (labels.len() as f64 * em * 1.24 * 1.25 + 20.0).round() as i32 + 4;
-
-    let (xr, yr) = chart.plotting_area().get_pixel_range();
-    let left = xr.start + 5;
-    let right = xr.end - 5 - w;
-    let top = yr.start + 5;
-    let bottom = yr.end - 5 - h;
-
-    let mut samples: Vec<(i32, i32)> = Vec::new();
-    let mut add_segment = |a: (i32, i32), b: (i32, i32)| {
-        let len = (b.0 - a.0).abs().max((b.1 - a.1).abs());
-        let n = (len / 6).max(1);
-        for k in 0..=n {
-            let t = f64::from(k) / f64::from(n);
-            samples.push((
-                (f64::from(a.0) + t * f64::from(b.0 - a.0)).round() as i32,
-                (f64::from(a.1) + t * f64::from(b.1 - a.1)).round() as i32,
-            ));
-        }
-    };
-    for s in &prep.series {
-        for run in &s.runs {
-            for pair in run.windows(2) {
-                add_segment(chart.backend_coord(&pair[0]), chart.backend_coord(&pair[1]));
-            }
-            if let [single] = run.as_slice() {
-                let c = chart.backend_coord(single);
-                add_segment(c, c);
-            }
-        }
-        for bar in &s.bars {
-            let hi = bar.hi.unwrap_or(prep.y.hi);
-            let lo = bar.lo.unwrap_or(prep.y.lo);
-            add_segment(
-                chart.backend_coord(&(bar.x, lo)),
-                chart.backend_coord(&(bar.x, hi)),
-            );
-        }
-    }
-    for (_, y, _) in &prep.hlines {
-        add_segment(
-            chart.backend_coord(&(prep.x.lo, *y)),
-            chart.backend_coord(&(prep.x.hi, *y)),
-        );
-    }
-
-    let candidates = [
-        (SeriesLabelPosition::UpperRight, right, top),
-        (SeriesLabelPosition::UpperLeft, left, top),
-        (SeriesLabelPosition::LowerRight, right, bottom),
-        (SeriesLabelPosition::LowerLeft, left, bottom),
-    ];
-    let mut best = SeriesLabelPosition::UpperRight;
-    let mut best_count = usize::MAX;
-    for (pos, x0, y0) in candidates {
-        let count = samples
-            .iter()
-            .filter(|&&(x, y)| x >= x0 && x <= x0 + w && y >= y0 && y <= y0 + h)
-            .count();
-        if count < best_count {
-            best_count = count;
-            best = pos;
-        }
-    }
-    best
 }
 
 /// Data of one series in plot space.
@@ -848,6 +1140,8 @@ enum TickFormat {
     /// 1, 2 and 5 times powers of ten (log axes spanning about two decades): plain
     /// numbers such as `0.02` if `plain`, else e.g. `2×10⁻⁵`.
     LogMixed { plain: bool },
+    /// The category labels of a category axis (value k: the k-th label).
+    Category,
 }
 
 /// An axis in plot space (`log10` of the data on a log axis) with its ticks.
@@ -860,6 +1154,8 @@ struct Axis {
     /// Minor ticks (light grid lines).
     light: Vec<f64>,
     format: TickFormat,
+    /// The labels of a category axis (empty otherwise).
+    categories: Vec<String>,
 }
 
 impl Axis {
@@ -872,6 +1168,7 @@ impl Axis {
             bold: Vec::new(),
             light: Vec::new(),
             format: TickFormat::Fixed(0),
+            categories: Vec::new(),
         };
         if log {
             axis.log_ticks();
@@ -882,6 +1179,25 @@ impl Axis {
             axis.format = format;
         }
         axis
+    }
+
+    /// A category axis: a labelled tick at k = 0, 1, … for every label, from −½ to
+    /// n − ½ (widened to data outside that range).
+    fn categories(extent: Extent, labels: &[String]) -> Axis {
+        let n = labels.len() as f64;
+        let (lo, hi) = match extent.range {
+            Some((a, b)) => ((a - 0.5).min(-0.5), (b + 0.5).max(n - 0.5)),
+            None => (-0.5, n - 0.5),
+        };
+        Axis {
+            lo,
+            hi,
+            log: false,
+            bold: (0..labels.len()).map(|k| k as f64).collect(),
+            light: Vec::new(),
+            format: TickFormat::Category,
+            categories: labels.to_vec(),
+        }
     }
 
     fn log_ticks(&mut self) {
@@ -943,6 +1259,14 @@ impl Axis {
     /// The tick label of a plot-space value.
     fn format(&self, v: f64) -> String {
         match self.format {
+            TickFormat::Category => {
+                let k = v.round();
+                if k >= 0.0 && (k as usize) < self.categories.len() {
+                    self.categories[k as usize].clone()
+                } else {
+                    String::new()
+                }
+            }
             TickFormat::Decades => format!("10{}", superscript(v.round() as i32)),
             TickFormat::LogMixed { plain } => {
                 // v = log10(m · 10^k) with m in {1, 2, 5}.

@@ -29,7 +29,7 @@ pub mod io;
 pub mod manifest;
 pub mod provenance;
 
-pub use figure::{Figure, Series, SeriesStyle};
+pub use figure::{AxisUnits, Figure, Series, SeriesColor, SeriesStyle};
 pub use io::{AtomicFile, remove_stale_temporaries, write_atomic, write_csv, write_json};
 pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};
 pub use provenance::{DescribeScene, Provenance, ProvenanceRef, SceneProvenance};

@@ -42,7 +42,7 @@ use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::output::{Figure, Provenance, Series, SeriesStyle};
+use crate::output::{AxisUnits, Figure, Provenance, Series};
 use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
 use crate::scene::validate::Num;
@@ -1226,7 +1226,7 @@ fn finish(
     report.write(&format!("{stem}.csv"), rows_csv(&study.rows).as_bytes())?;
     report.write_svg(
         &format!("{stem}.svg"),
-        &figure(scene, label, spec, over, &study.names, &study.rows),
+        &figure(scene, label, spec, over, &observables, &study.rows),
     )?;
     let summary = ConvergeSummary {
         run_id: report.run_id(),
@@ -1426,50 +1426,86 @@ fn rows_csv(rows: &[Row]) -> String {
     text
 }
 
+/// The study's figure: per observable (one colour each), |error| of the resolved
+/// estimates (markers, ±1 s.e.), the sampling-floor points (light markers at 3 s.e.), the
+/// exact discretization error (light line) and the least-squares fit of the observed
+/// order (dashed, its order in the legend).
 fn figure(
     scene: &Scene,
     label: &str,
     spec: &RunSpec,
     over: Over,
-    names: &[String],
+    observables: &[ObservableSummary],
     rows: &[Row],
 ) -> Figure {
-    let x_label = format!("h = {}", over.h_label());
+    let units = AxisUnits::new(scene.physical.is_some());
+    let x_label = match over {
+        Over::Elements => format!("element length h = L/N {}", units.length()),
+        Over::Dt => "time step h = Δt / τ₁".to_string(),
+    };
+    let y_label = match scene.model {
+        ModelKind::Compression => "|error of ⟨F⟩| / F_c0".to_string(),
+        ModelKind::Fem | ModelKind::Spectral => format!("|error| {}", units.area()),
+    };
     let mut fig = Figure::new(
         format!(
-            "{} {label} ({} noise): |error| vs {}",
+            "{} {label} ({} noise): error against {}",
             scene.name,
             spec.noise.name(),
             over.name()
         ),
         x_label,
-        "|estimate - limit| (markers), |discrete - limit| (lines)",
+        y_label,
     )
     .log_x()
-    .log_y();
-    for name in names {
+    .log_y()
+    .caption(format!(
+        "Error of each observable against the {} as the {} is refined (log–log), one \
+         colour per observable: |estimate − limit| (markers, ±1 s.e.), estimates within \
+         3 standard errors of the limit (light markers, drawn at 3 s.e.: the sampling \
+         floor), the exact error of the discretization (light line) and the \
+         least-squares fit of the observed order (dashed). The markers should follow the \
+         light line, and the fitted order should match the expected one.",
+        if over == Over::Elements {
+            "continuum"
+        } else {
+            "Δt → 0 limit"
+        },
+        if over == Over::Elements {
+            "mesh"
+        } else {
+            "time step"
+        }
+    ));
+    for (hue, o) in observables.iter().enumerate() {
+        let name = &o.observable;
         let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
         let res: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
         let floor: Vec<&&Row> = rs.iter().filter(|r| r.sampling_floor).collect();
         if !res.is_empty() {
             fig = fig.series(
                 Series::markers(
-                    name.clone(),
+                    format!("{name}: simulated"),
                     res.iter().map(|r| (r.h, r.total_error)).collect(),
                 )
-                .with_errors(res.iter().map(|r| r.total_error_se).collect()),
+                .with_errors(res.iter().map(|r| r.total_error_se).collect())
+                .palette(hue),
             );
         }
         if !floor.is_empty() {
             // At the floor the error is not resolved: drawn at 3 standard errors (an
             // upper bound), without error bars.
-            fig = fig.series(Series::markers(
-                format!("{name} sampling floor (3 s.e.)"),
-                floor
-                    .iter()
-                    .map(|r| (r.h, FLOOR_SIGMAS * r.total_error_se))
-                    .collect(),
-            ));
+            fig = fig.series(
+                Series::markers(
+                    format!("{name}: sampling floor (3 s.e.)"),
+                    floor
+                        .iter()
+                        .map(|r| (r.h, FLOOR_SIGMAS * r.total_error_se))
+                        .collect(),
+                )
+                .palette(hue)
+                .light(),
+            );
         }
         let exact: Vec<(f64, f64)> = rs
             .iter()
@@ -1478,8 +1514,29 @@ fn figure(
             .collect();
         if !exact.is_empty() {
             fig = fig.series(
-                Series::line(format!("{name} exact"), exact).with_style(SeriesStyle::LineMarkers),
+                Series::line(format!("{name}: exact error"), exact)
+                    .palette(hue)
+                    .light(),
             );
+        }
+        if let Some(f) = o
+            .observed
+            .filter(|f| f.order.is_finite() && f.prefactor > 0.0)
+        {
+            let (lo, hi) = res.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+                (lo.min(r.h), hi.max(r.h))
+            });
+            if lo < hi {
+                let line = [lo, hi]
+                    .iter()
+                    .map(|&h| (h, f.prefactor * h.powf(f.order)))
+                    .collect();
+                fig = fig.series(
+                    Series::line(format!("{name}: fit, order {:.2}", f.order), line)
+                        .dashed()
+                        .palette(hue),
+                );
+            }
         }
     }
     fig

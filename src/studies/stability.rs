@@ -171,6 +171,16 @@ impl Status {
             Status::Unstable => "unstable",
         }
     }
+
+    /// The status colour of the figures, (red, green, blue): stable green, biased amber,
+    /// unstable red, as in the HTML table of the map.
+    pub fn rgb(self) -> (u8, u8, u8) {
+        match self {
+            Status::Stable => (26, 127, 55),
+            Status::Biased => (230, 145, 0),
+            Status::Unstable => (207, 34, 46),
+        }
+    }
 }
 
 /// The measured stationary variance of one mode against the exact formula.
@@ -867,36 +877,88 @@ fn modes_csv(cells: &[Cell]) -> String {
     csv
 }
 
+/// A category label for a normalized step: `0.1`, `1.9`, `1000`, `1e5`.
+fn step_label(a: f64) -> String {
+    if a.abs() >= 1e4 {
+        format!("{a:e}")
+    } else {
+        format!("{a}")
+    }
+}
+
+/// The stability map of integrator `kind`: one disc per cell, coloured by its status
+/// ([`Status::rgb`]), one column per normalized step Δt·λ_max and one row per element
+/// count, as in the HTML table.
 fn map_figure(scene: &str, kind: IntegratorKind, cells: &[Cell]) -> Figure {
+    let mut steps: Vec<f64> = cells.iter().map(|c| c.dt_lambda_max).collect();
+    steps.sort_by(f64::total_cmp);
+    steps.dedup();
+    let mut elements: Vec<usize> = cells.iter().map(|c| c.elements).collect();
+    elements.sort_unstable();
+    elements.dedup();
     let mut fig = Figure::new(
-        format!("{scene}: stability map of {kind} (consistent noise)"),
-        "dt * lambda_max",
-        "elements",
+        format!("{scene}: stability map of {kind}"),
+        "time step Δt·λ_max (dimensionless; one column per value, explicit limit 2)",
+        "number of elements (dimensionless)",
     )
-    .log_x()
-    .log_y();
+    .x_categories(steps.iter().map(|&a| step_label(a)).collect())
+    .y_categories(elements.iter().map(ToString::to_string).collect())
+    .caption(format!(
+        "Stability map of {kind} with consistent noise: one disc per cell of time step \
+         Δt·λ_max (λ_max the fastest rate of the mesh) and element count, coloured by \
+         the cell's status: stable (green, no stationary bias resolved), biased (amber, \
+         the stationary variance of a mode differs from kT/λ beyond its error) or \
+         unstable (red, |m| ≥ 1: refused before running, diverging when forced). An \
+         explicit scheme should turn red above Δt·λ_max = 2; implicit ones stay green or \
+         amber."
+    ));
+    let index = |v: &[f64], x: f64| {
+        v.iter()
+            .position(|&y| y == x)
+            .map_or(f64::NAN, |i| i as f64)
+    };
+    let elements_f: Vec<f64> = elements.iter().map(|&e| e as f64).collect();
     for status in [Status::Stable, Status::Biased, Status::Unstable] {
         let pts: Vec<(f64, f64)> = cells
             .iter()
             .filter(|c| c.integrator == kind.name() && c.status == status)
-            .map(|c| (c.dt_lambda_max, c.elements as f64))
+            .map(|c| {
+                (
+                    index(&steps, c.dt_lambda_max),
+                    index(&elements_f, c.elements as f64),
+                )
+            })
             .collect();
-        // Every status gets a series, even an empty one, so colours mean the same in
-        // every map.
-        fig = fig.series(Series::markers(status.name(), pts));
+        let (r, g, b) = status.rgb();
+        // Every status gets a series, even an empty one, so that every map has the same
+        // legend.
+        fig = fig.series(
+            Series::markers(status.name(), pts)
+                .rgb(r, g, b)
+                .marker_radius(11),
+        );
     }
     fig
 }
 
+/// The measured stationary variance ratio of every checked mode against each
+/// integrator's exact formula, one colour per integrator.
 fn bias_figure(scene: &str, kinds: &[IntegratorKind], cells: &[Cell]) -> Figure {
     let mut fig = Figure::new(
-        format!("{scene}: stationary variance per mode / (kT/lambda)"),
-        "lambda * dt",
-        "variance ratio: measured (markers), exact formula (lines)",
+        format!("{scene}: stationary variance per mode"),
+        "λ·Δt of the mode (dimensionless)",
+        "⟨aᵢ²⟩ / (kT/λᵢ) (dimensionless)",
     )
     .log_x()
-    .log_y();
-    for &k in kinds {
+    .log_y()
+    .caption(
+        "Stationary variance of every checked mode of every cell relative to kT/λ, \
+         measured (markers, ±1 s.e.) against the integrator's exact discrete-time formula \
+         (light line of the same colour), against the mode's λ·Δt. The markers should lie \
+         on the line of their integrator; the line's distance from 1 is the integrator's \
+         exact stationary bias.",
+    );
+    for (hue, &k) in kinds.iter().enumerate() {
         let modes: Vec<&ModeBias> = cells
             .iter()
             .filter(|c| c.integrator == k.name())
@@ -915,15 +977,22 @@ fn bias_figure(scene: &str, kinds: &[IntegratorKind], cells: &[Cell]) -> Figure 
         fig = fig
             .series(
                 Series::markers(
-                    format!("{k} measured"),
+                    format!("{k}: measured / formula"),
                     modes
                         .iter()
                         .map(|m| (m.lambda_dt, m.measured_ratio))
                         .collect(),
                 )
-                .with_errors(modes.iter().map(|m| m.std_error).collect()),
+                .with_errors(modes.iter().map(|m| m.std_error).collect())
+                .palette(hue)
+                .joined_with_next(),
             )
-            .series(Series::line(format!("{k} formula"), curve).with_style(SeriesStyle::Line));
+            .series(
+                Series::line("", curve)
+                    .with_style(SeriesStyle::Line)
+                    .palette(hue)
+                    .light(),
+            );
     }
     fig
 }

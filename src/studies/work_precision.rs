@@ -584,14 +584,21 @@ fn label((k, n): (IntegratorKind, NoiseModel)) -> String {
 fn measured_figure(opts: &WorkPrecisionOptions, points: &[WpPoint], floor: f64) -> Figure {
     let mut fig = Figure::new(
         format!(
-            "{}: error in <w2(L/2)> vs wall time ({} x {} tau1 per point, EM {} tau1)",
+            "{}: error in ⟨w²(L/2)⟩ against wall time ({} × {} τ₁ per point, EM {} τ₁)",
             opts.scene.name, opts.trajectories, opts.duration_tau1, opts.em_duration_tau1
         ),
-        "wall time of the ensemble (s)",
-        "|estimate - continuum| / continuum",
+        "wall time of the ensemble [s]",
+        "|estimate − continuum| / continuum (dimensionless)",
     )
     .log_x()
-    .log_y();
+    .log_y()
+    .caption(
+        "Relative error of ⟨w²(L/2)⟩ against the continuum for each method and time step \
+         (markers, ±1 s.e., joined in order of the step) against the wall time of its \
+         ensemble (log–log); the dashed lines are the sampling floor and the tolerance. A \
+         better method should reach the tolerance in less wall time; points near the floor \
+         are limited by sampling, not by the method.",
+    );
     for &m in &opts.methods {
         let ps = method_points(points, m);
         fig = fig.series(
@@ -610,14 +617,21 @@ fn measured_figure(opts: &WorkPrecisionOptions, points: &[WpPoint], floor: f64) 
 fn projected_figure(opts: &WorkPrecisionOptions, points: &[WpPoint]) -> Figure {
     let mut fig = Figure::new(
         format!(
-            "{}: projected wall time to reach a relative error in <w2(L/2)> (95 %)",
+            "{}: projected wall time to reach a relative error in ⟨w²(L/2)⟩ (95 %)",
             opts.scene.name
         ),
-        "projected wall time (s)",
-        "relative error reached",
+        "projected wall time [s]",
+        "relative error reached (dimensionless)",
     )
     .log_x()
-    .log_y();
+    .log_y()
+    .caption(
+        "Projected wall time for each method to reach a relative error in ⟨w²(L/2)⟩ with \
+         95 % confidence (bias + 2 s.e.), from its measured cost and standard error, at \
+         its best time step (log–log); the dashed line is the tolerance. The leftmost curve \
+         at a given error should be the cheapest method there; a curve that stops never \
+         reaches smaller errors (its bias is larger).",
+    );
     for &m in &opts.methods {
         let ps = method_points(points, m);
         let curve: Vec<(f64, f64)> = (0..CURVE_TOLERANCES)

@@ -404,8 +404,14 @@ pub fn p_value_figure(scene: &str, seeds: u64, kinds: &[(String, Vec<f64>)]) -> 
     let width = 1.0 / bins as f64;
     let mut fig = Figure::new(
         format!("{scene}: raw p-values of the checks over {seeds} seeds, per kind ({bins} bins)"),
-        "raw p-value",
-        "density (uniform: 1)",
+        "raw p-value (dimensionless)",
+        "density (dimensionless; uniform: 1)",
+    )
+    .caption(
+        "Histogram of the raw p-values of each check kind over every seed, as a density. \
+         For checks whose p-values are calibrated it should be flat at 1 (dashed line); a \
+         peak near 0 means the kind rejects too often, a dip near 0 that it is \
+         conservative.",
     );
     for (kind, p) in kinds {
         let n = p.iter().filter(|x| x.is_finite()).count();
