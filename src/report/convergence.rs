@@ -55,20 +55,41 @@ fn fit(f: Option<&OrderFit>) -> String {
     }
 }
 
-fn figure(h: &mut String, file: &str) {
+/// The caption of figure `file` in `dir`: the `<title>` every figure of the project
+/// carries ([`crate::output::figure`]), empty if it has none.
+fn svg_caption(dir: &Path, file: &str) -> String {
+    let text = std::fs::read_to_string(dir.join(file)).unwrap_or_default();
+    text.split_once("<title>")
+        .and_then(|(_, rest)| rest.split_once("</title>"))
+        .map(|(t, _)| {
+            t.replace("&lt;", "<")
+                .replace("&gt;", ">")
+                .replace("&quot;", "\"")
+                .replace("&apos;", "'")
+                .replace("&amp;", "&")
+        })
+        .unwrap_or_default()
+}
+
+/// A figure with its caption (what is plotted, what to see) and its file name.
+fn figure(h: &mut String, dir: &Path, file: &str) {
+    let caption = svg_caption(dir, file);
+    let alt = if caption.is_empty() { file } else { &caption };
     let _ = writeln!(
         h,
-        "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a><figcaption>{1}</figcaption></figure>",
+        "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a><figcaption>{2} <code>{3}</code></figcaption></figure>",
         url_path(file),
+        esc(alt),
+        esc(&caption),
         esc(file)
     );
 }
 
 /// The figures (SVG) of a summary, then links to its data files.
-fn files(h: &mut String, list: &[String]) {
+fn files(h: &mut String, dir: &Path, list: &[String]) {
     h.push_str("<div class=\"figures\">\n");
     for f in list.iter().filter(|f| f.ends_with(".svg")) {
-        figure(h, f);
+        figure(h, dir, f);
     }
     h.push_str("</div>\n<p class=\"meta\">Data: ");
     for f in list.iter().filter(|f| !f.ends_with(".svg")) {
@@ -78,7 +99,7 @@ fn files(h: &mut String, list: &[String]) {
 }
 
 /// The heading, the table of observables and the consistency line of one study.
-fn convergence_section(h: &mut String, journal: &str, v: &ConvergeSummary) {
+fn convergence_section(h: &mut String, dir: &Path, journal: &str, v: &ConvergeSummary) {
     let _ = writeln!(
         h,
         "<h3>{} / {} ({} noise, {}) over {}</h3>\n<p class=\"meta\">h = {}; {}; errors against the {}; budget {}: {} trajectories x {} tau1 per value; {:.1} s.</p>",
@@ -155,11 +176,11 @@ fn convergence_section(h: &mut String, journal: &str, v: &ConvergeSummary) {
     list(h, &failed, "fail", "no rows: ");
     list(h, &v.warnings, "warn", "warning: ");
     list(h, &v.notes, "meta", "");
-    files(h, &v.files);
+    files(h, dir, &v.files);
 }
 
 /// The work–precision heading and its table of methods.
-fn work_precision_section(h: &mut String, journal: &str, v: &WorkPrecisionSummary) {
+fn work_precision_section(h: &mut String, dir: &Path, journal: &str, v: &WorkPrecisionSummary) {
     let _ = writeln!(
         h,
         "<h2>Work–precision ({})</h2>\n<p class=\"meta\">Error in &lt;w²(L/2)&gt; against the continuum, {} elements, {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {}. Projected wall time to reach a relative error of {} with 95 % confidence (bias + 2 s.e.), from the measured cost and standard error (s.e. ∝ T<sup>-1/2</sup>); {} points disagree with their exact discrete value by more than 3 s.e.</p>",
@@ -189,7 +210,7 @@ fn work_precision_section(h: &mut String, journal: &str, v: &WorkPrecisionSummar
         );
     }
     h.push_str("</table>\n");
-    files(h, &v.files);
+    files(h, dir, &v.files);
 }
 
 /// The run id of a listed study, with a link to its journal.
@@ -232,7 +253,7 @@ fn stability_cell(h: &mut String, c: Option<&Cell>) {
 
 /// The stability heading and the map: one row per integrator and element count, one
 /// column per dt·λ_max.
-fn stability_section(h: &mut String, journal: &str, v: &StabilitySummary) {
+fn stability_section(h: &mut String, dir: &Path, journal: &str, v: &StabilitySummary) {
     let _ = writeln!(
         h,
         "<h2>Stability map ({})</h2>\n<p class=\"meta\">Consistent noise, {} trajectories x {} steps after {} burn-in steps per cell. <b>unstable</b>: |m| ≥ 1, refused before running and, forced, overflowing; <b>biased</b>: the stationary variance of a checked mode differs from kT/λ beyond its error (Holm over the map, α = {}); <b>stable</b>: no bias resolved. Exact per-mode formulas: {} of {} comparisons rejected; stability predictions {}.</p>",
@@ -277,7 +298,7 @@ fn stability_section(h: &mut String, journal: &str, v: &StabilitySummary) {
         }
     }
     h.push_str("</table>\n<p class=\"meta\">Hover a cell for its detail (measured variance ratio, z, unresolved modes); all of it is in stability-cells.csv and stationary-bias.csv.</p>\n");
-    files(h, &v.files);
+    files(h, dir, &v.files);
 }
 
 /// The summary `name` in `dir`, if it exists and reads as a `T`.
@@ -384,14 +405,14 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
     let mut converge_heading = false;
     for (journal, study) in &listed {
         match study {
-            Study::Stability(v) => stability_section(&mut h, journal, v),
-            Study::WorkPrecision(v) => work_precision_section(&mut h, journal, v),
+            Study::Stability(v) => stability_section(&mut h, dir, journal, v),
+            Study::WorkPrecision(v) => work_precision_section(&mut h, dir, journal, v),
             Study::Converge(v) => {
                 if !converge_heading {
                     h.push_str("<h2>Convergence over element count and time step</h2>\n");
                     converge_heading = true;
                 }
-                convergence_section(&mut h, journal, v);
+                convergence_section(&mut h, dir, journal, v);
             }
         }
     }
@@ -423,7 +444,7 @@ mod tests {
         assert!(v.continuum.is_nan() && v.methods[0].min_rel_bias.is_nan());
         assert_eq!(serde_json::to_value(&v).unwrap(), text);
         let mut h = String::new();
-        work_precision_section(&mut h, "work-precision.manifest.json", &v);
+        work_precision_section(&mut h, Path::new("."), "work-precision.manifest.json", &v);
         assert!(h.contains("sampling floor (median relative s.e.) –."));
         assert!(h.contains("<td class=\"num\">–</td><td class=\"detail\">n</td>"));
         let f: OrderFit = serde_json::from_value(
