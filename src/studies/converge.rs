@@ -1478,65 +1478,72 @@ fn figure(
         }
     ));
     for (hue, o) in observables.iter().enumerate() {
-        let name = &o.observable;
-        let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
-        let res: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
-        let floor: Vec<&&Row> = rs.iter().filter(|r| r.sampling_floor).collect();
-        if !res.is_empty() {
-            fig = fig.series(
-                Series::markers(
-                    format!("{name}: simulated"),
-                    res.iter().map(|r| (r.h, r.total_error)).collect(),
-                )
-                .with_errors(res.iter().map(|r| r.total_error_se).collect())
-                .palette(hue),
-            );
-        }
-        if !floor.is_empty() {
-            // At the floor the error is not resolved: drawn at 3 standard errors (an
-            // upper bound), without error bars.
-            fig = fig.series(
-                Series::markers(
-                    format!("{name}: sampling floor (3 s.e.)"),
-                    floor
-                        .iter()
-                        .map(|r| (r.h, FLOOR_SIGMAS * r.total_error_se))
-                        .collect(),
-                )
+        fig = observable_series(fig, hue, o, rows);
+    }
+    fig
+}
+
+/// The series of observable `o` in the convergence figure, in colour `hue`: the resolved
+/// errors with their error bars, the sampling floor, the exact error and the fitted order.
+fn observable_series(mut fig: Figure, hue: usize, o: &ObservableSummary, rows: &[Row]) -> Figure {
+    let name = &o.observable;
+    let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
+    let res: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+    let floor: Vec<&&Row> = rs.iter().filter(|r| r.sampling_floor).collect();
+    if !res.is_empty() {
+        fig = fig.series(
+            Series::markers(
+                format!("{name}: simulated"),
+                res.iter().map(|r| (r.h, r.total_error)).collect(),
+            )
+            .with_errors(res.iter().map(|r| r.total_error_se).collect())
+            .palette(hue),
+        );
+    }
+    if !floor.is_empty() {
+        // At the floor the error is not resolved: drawn at 3 standard errors (an
+        // upper bound), without error bars.
+        fig = fig.series(
+            Series::markers(
+                format!("{name}: sampling floor (3 s.e.)"),
+                floor
+                    .iter()
+                    .map(|r| (r.h, FLOOR_SIGMAS * r.total_error_se))
+                    .collect(),
+            )
+            .palette(hue)
+            .light(),
+        );
+    }
+    let exact: Vec<(f64, f64)> = rs
+        .iter()
+        .filter(|r| !r.exact_at_rounding)
+        .filter_map(|r| r.exact_error.map(|e| (r.h, e)))
+        .collect();
+    if !exact.is_empty() {
+        fig = fig.series(
+            Series::line(format!("{name}: exact error"), exact)
                 .palette(hue)
                 .light(),
-            );
-        }
-        let exact: Vec<(f64, f64)> = rs
-            .iter()
-            .filter(|r| !r.exact_at_rounding)
-            .filter_map(|r| r.exact_error.map(|e| (r.h, e)))
-            .collect();
-        if !exact.is_empty() {
+        );
+    }
+    if let Some(f) = o
+        .observed
+        .filter(|f| f.order.is_finite() && f.prefactor > 0.0)
+    {
+        let (lo, hi) = res.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+            (lo.min(r.h), hi.max(r.h))
+        });
+        if lo < hi {
+            let line = [lo, hi]
+                .iter()
+                .map(|&h| (h, f.prefactor * h.powf(f.order)))
+                .collect();
             fig = fig.series(
-                Series::line(format!("{name}: exact error"), exact)
-                    .palette(hue)
-                    .light(),
+                Series::line(format!("{name}: fit, order {:.2}", f.order), line)
+                    .dashed()
+                    .palette(hue),
             );
-        }
-        if let Some(f) = o
-            .observed
-            .filter(|f| f.order.is_finite() && f.prefactor > 0.0)
-        {
-            let (lo, hi) = res.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
-                (lo.min(r.h), hi.max(r.h))
-            });
-            if lo < hi {
-                let line = [lo, hi]
-                    .iter()
-                    .map(|&h| (h, f.prefactor * h.powf(f.order)))
-                    .collect();
-                fig = fig.series(
-                    Series::line(format!("{name}: fit, order {:.2}", f.order), line)
-                        .dashed()
-                        .palette(hue),
-                );
-            }
         }
     }
     fig

@@ -734,23 +734,44 @@ fn compression_data_check(
             ));
         }
     }
-    let euler_load = run.euler_load;
+    let records = read_force_records(dir, &sidecar_path, &by_strain, run.euler_load)?;
+    Ok(CompressionDataCheck {
+        run,
+        theory,
+        records,
+        notes,
+    })
+}
+
+/// F/F_c0 of every trajectory file of the data runs `by_strain` (index in the sidecar,
+/// run), from the first row at or after each run's burn-in.
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar key of a listed file that is not a file; the
+/// table reader's errors.
+fn read_force_records(
+    dir: &Path,
+    sidecar_path: &Path,
+    by_strain: &[(usize, &DataRun)],
+    euler_load: f64,
+) -> Result<Vec<Vec<ForceRecord>>> {
     let cols: Vec<String> = crate::data::COMPRESSION_COLUMNS
         .iter()
         .map(|c| c.to_string())
         .collect();
     let mut records = Vec::new();
-    for &(k, data) in &by_strain {
+    for &(k, data) in by_strain {
         let mut at_strain = Vec::new();
         for (j, path) in data.paths(dir).iter().enumerate() {
             if !path.is_file() {
-                return Err(bad(
-                    format!("runs[{k}].files[{j}]"),
-                    format!(
+                return Err(Error::Scene {
+                    file: sidecar_path.to_path_buf(),
+                    key: format!("runs[{k}].files[{j}]"),
+                    message: format!(
                         "must name a trajectory file; {} is not a file",
                         path.display()
                     ),
-                ));
+                });
             }
             let table = read_table(path, &cols)?;
             let t0 = if table.rows > 0 { table.get(0, 0) } else { 0.0 };
@@ -766,10 +787,5 @@ fn compression_data_check(
         }
         records.push(at_strain);
     }
-    Ok(CompressionDataCheck {
-        run,
-        theory,
-        records,
-        notes,
-    })
+    Ok(records)
 }
