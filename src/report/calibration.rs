@@ -96,7 +96,8 @@ pub fn render_calibration_index(summary: &CalibrationSummary) -> String {
         let _ = writeln!(
             h,
             "<figure><a href=\"{href}\"><img src=\"{href}\" alt=\"{0}\"></a>\
-             <figcaption>{0}</figcaption></figure>",
+             <figcaption>{0} <code>{1}</code></figcaption></figure>",
+            esc(crate::verify::calibrate::P_VALUE_CAPTION),
             esc(&s.figure)
         );
     }

@@ -395,6 +395,13 @@ pub fn histogram(p: &[f64], bins: usize) -> Vec<u64> {
     counts
 }
 
+/// The caption of every p-value histogram ([`p_value_figure`]), in the SVG and the
+/// calibration page.
+pub const P_VALUE_CAPTION: &str = "Histogram of the raw p-values of each check kind over every \
+     seed, as a density. For checks whose p-values are calibrated it should be flat at 1 \
+     (dashed line); a peak near 0 means the kind rejects too often, a dip near 0 that it is \
+     conservative.";
+
 /// The figure `<scene>-p-values.svg`: per kind, the histogram of the scene's raw
 /// p-values (every check of the kind, every seed) in [`HISTOGRAM_BINS`] bins, drawn as a
 /// step outline of the density (count / (n · bin width)), against the uniform density 1.
@@ -407,12 +414,7 @@ pub fn p_value_figure(scene: &str, seeds: u64, kinds: &[(String, Vec<f64>)]) -> 
         "raw p-value (dimensionless)",
         "density (dimensionless; uniform: 1)",
     )
-    .caption(
-        "Histogram of the raw p-values of each check kind over every seed, as a density. \
-         For checks whose p-values are calibrated it should be flat at 1 (dashed line); a \
-         peak near 0 means the kind rejects too often, a dip near 0 that it is \
-         conservative.",
-    );
+    .caption(P_VALUE_CAPTION);
     for (kind, p) in kinds {
         let n = p.iter().filter(|x| x.is_finite()).count();
         if n == 0 {
