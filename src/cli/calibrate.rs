@@ -185,7 +185,10 @@ pub fn run(args: CalibrateArgs, verbosity: Verbosity) -> Result<i32> {
     }
     let report = ReportRun::begin(&args.out, "calibrate", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
-    report.write(&args.out.join(P_VALUES_CSV), p_values_csv(&rows).as_bytes())?;
+    report.write(
+        &args.out.join(P_VALUES_CSV),
+        p_values_csv(&rows)?.as_bytes(),
+    )?;
     for s in &scene_results {
         let fig = p_value_figure(&s.name, n, &kind_p_values(&rows, &s.name));
         report.write_svg(&args.out.join(&s.figure), &fig)?;

@@ -4,8 +4,7 @@
 use super::npy::{NpyWriter, read_npy};
 use crate::error::{Error, Result};
 use crate::output::AtomicFile;
-use crate::output::io::{push_csv_field, push_csv_number};
-use std::io::Write;
+use crate::output::io::CsvWriter;
 use std::path::{Path, PathBuf};
 
 /// A trajectory file being written row by row; the format follows the extension
@@ -19,7 +18,7 @@ pub struct TrajectoryFile {
 
 #[derive(Debug)]
 enum Writer {
-    Csv(AtomicFile, String),
+    Csv(Box<CsvWriter<AtomicFile>>),
     Npy(NpyWriter<AtomicFile>),
 }
 
@@ -30,19 +29,11 @@ impl TrajectoryFile {
     /// [`Error::InvalidParameter`] for another extension; [`Error::Io`] naming the path.
     pub fn create(path: &Path, columns: &[String], rows: u64) -> Result<TrajectoryFile> {
         let io_err = |e: std::io::Error| Error::io(path, e);
-        let mut file = AtomicFile::create(path)?;
+        let file = AtomicFile::create(path)?;
         let out = match path.extension().and_then(|e| e.to_str()) {
             Some("csv") => {
-                let mut header = String::new();
-                for (j, c) in columns.iter().enumerate() {
-                    if j > 0 {
-                        header.push(',');
-                    }
-                    push_csv_field(&mut header, c);
-                }
-                header.push('\n');
-                file.write_all(header.as_bytes()).map_err(io_err)?;
-                Writer::Csv(file, String::with_capacity(24 * columns.len()))
+                let header: Vec<&str> = columns.iter().map(String::as_str).collect();
+                Writer::Csv(Box::new(CsvWriter::new(file, path, &header)?))
             }
             Some("npy") => Writer::Npy(NpyWriter::new(file, rows, columns.len()).map_err(io_err)?),
             _ => {
@@ -67,23 +58,11 @@ impl TrajectoryFile {
     pub fn push_row(&mut self, row: &[f64]) -> Result<()> {
         let io_err = |e: std::io::Error| Error::io(&self.path, e);
         match &mut self.out {
-            Writer::Csv(file, line) => {
-                if row.len() != self.columns {
-                    return Err(io_err(std::io::Error::new(
-                        std::io::ErrorKind::InvalidInput,
-                        format!("row of {} values for {} columns", row.len(), self.columns),
-                    )));
-                }
-                line.clear();
-                for (j, &v) in row.iter().enumerate() {
-                    if j > 0 {
-                        line.push(',');
-                    }
-                    push_csv_number(line, v);
-                }
-                line.push('\n');
-                file.write_all(line.as_bytes()).map_err(io_err)
-            }
+            Writer::Csv(_) if row.len() != self.columns => Err(io_err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("row of {} values for {} columns", row.len(), self.columns),
+            ))),
+            Writer::Csv(table) => table.numbers(row),
             Writer::Npy(w) => w.push_row(row).map_err(io_err),
         }
     }
@@ -94,7 +73,7 @@ impl TrajectoryFile {
     /// [`Error::Io`] naming the path (for `.npy`, rows missing included).
     pub fn commit(self) -> Result<()> {
         let file = match self.out {
-            Writer::Csv(file, _) => file,
+            Writer::Csv(table) => table.into_inner()?,
             Writer::Npy(w) => w.finish().map_err(|e| Error::io(&self.path, e))?,
         };
         file.commit()
@@ -126,8 +105,10 @@ impl Table {
 }
 
 /// Reads trajectory file `path` and returns its `columns`, in that order. A CSV file
-/// maps its header names to `columns` (any order; other columns ignored); a `.npy` file
-/// must have exactly these columns, in this order.
+/// maps its header names to `columns` (any order; other columns ignored); it is read as
+/// RFC 4180 text with the `csv` crate (quoted fields, `\r\n` line ends and a UTF-8
+/// byte-order mark accepted, fields trimmed, blank lines skipped). A `.npy` file must
+/// have exactly these columns, in this order.
 ///
 /// # Errors
 /// [`Error::Io`] if unreadable; [`Error::InvalidParameter`] naming the file and the
@@ -145,14 +126,19 @@ pub fn read_table(path: &Path, columns: &[String]) -> Result<Table> {
         }
         (rows, values)
     } else {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header: Vec<&str> = lines
-            .next()
-            .ok_or_else(|| bad("a header line".into()))?
-            .split(',')
-            .map(|h| h.trim().trim_matches('"'))
-            .collect();
+        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .from_reader(std::io::BufReader::new(file));
+        let unreadable = |e: csv::Error| match e.into_kind() {
+            csv::ErrorKind::Io(e) => Error::io(path, e),
+            other => bad(format!("CSV text ({other:?})")),
+        };
+        let header = reader.headers().map_err(unreadable)?.clone();
+        if header.iter().all(str::is_empty) {
+            return Err(bad("a header line".into()));
+        }
         let index = columns
             .iter()
             .map(|c| {
@@ -166,23 +152,25 @@ pub fn read_table(path: &Path, columns: &[String]) -> Result<Table> {
             .collect::<Result<Vec<_>>>()?;
         let mut values = Vec::new();
         let mut rows = 0;
-        for (r, line) in lines.enumerate() {
-            let fields: Vec<&str> = line.split(',').collect();
-            if fields.len() != header.len() {
+        let mut record = csv::StringRecord::new();
+        while reader.read_record(&mut record).map_err(unreadable)? {
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            let r = rows + 1;
+            if record.len() != header.len() {
                 return Err(bad(format!(
-                    "{} fields in data row {} (as many as header columns), got {}",
+                    "{} fields in data row {r} (as many as header columns), got {}",
                     header.len(),
-                    r + 1,
-                    fields.len()
+                    record.len()
                 )));
             }
             for &i in &index {
-                let f = fields[i].trim();
+                let f = &record[i];
                 values.push(f.parse::<f64>().map_err(|_| {
                     bad(format!(
-                        "numbers in column {:?}; data row {} holds {f:?}",
-                        header[i],
-                        r + 1
+                        "numbers in column {:?}; data row {r} holds {f:?}",
+                        &header[i]
                     ))
                 })?);
             }
@@ -232,6 +220,15 @@ mod tests {
         std::fs::write(&path, "aw_1,extra,t,w_0\n0.5,9,1,2\n").unwrap();
         let t = read_table(&path, &cols).unwrap();
         assert_eq!(t.values, vec![1.0, 2.0, 0.5]);
+        // As other programs write it: a byte-order mark, quoted names (one holding a
+        // comma and a doubled quote), CRLF line ends, a blank line.
+        std::fs::write(
+            &path,
+            "\u{feff}\"aw_1\",\"a \"\"b\"\", c\",\"t\", w_0\r\n0.5,x,1,2\r\n\r\n",
+        )
+        .unwrap();
+        let t = read_table(&path, &cols).unwrap();
+        assert_eq!((t.rows, t.values.clone()), (1, vec![1.0, 2.0, 0.5]));
         std::fs::write(&path, "t,w_0\n1,2\n").unwrap();
         let e = read_table(&path, &cols).unwrap_err().to_string();
         assert!(e.contains("aw_1") && e.contains("other.csv"), "{e}");

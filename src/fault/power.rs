@@ -15,7 +15,7 @@
 
 use super::{Fault, FaultKind};
 use crate::error::{Error, Result};
-use crate::output::io::{write_atomic, write_json};
+use crate::output::io::{CsvWriter, write_atomic, write_json};
 use crate::scene::builtin::find as find_builtin;
 use crate::scene::{Budget, Scene};
 use crate::verify::{VerifyOptions, run_verification};
@@ -23,7 +23,7 @@ use crate::work::WorkLimits;
 use serde::Serialize;
 use statrs::distribution::{Beta, ContinuousCDF};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The first seed of a power study; seed `j` (0-based) is `FIRST_SEED + j`.
@@ -443,40 +443,55 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
     };
     write_json(&opts.out.join("power.json"), &report)?;
     let csv = opts.out.join("power.csv");
-    write_atomic(&csv, csv_text(&report).as_bytes())?;
+    write_atomic(&csv, csv_text(&report)?.as_bytes())?;
     let md = opts.out.join("power.md");
     write_atomic(&md, markdown(&report).as_bytes())?;
     Ok(report)
 }
 
 /// `power.csv`: one line per row.
-fn csv_text(report: &PowerReport) -> String {
-    let mut s = String::from(
-        "fault,scene,runs,size,stated,seeds,failed_checks,run_failures,input_errors,detection_rate,ci_low,ci_high,mean_seconds\n",
-    );
+fn csv_text(report: &PowerReport) -> Result<String> {
+    let mut table = CsvWriter::new(
+        Vec::new(),
+        Path::new("power.csv"),
+        &[
+            "fault",
+            "scene",
+            "runs",
+            "size",
+            "stated",
+            "seeds",
+            "failed_checks",
+            "run_failures",
+            "input_errors",
+            "detection_rate",
+            "ci_low",
+            "ci_high",
+            "mean_seconds",
+        ],
+    )?;
     for r in &report.rows {
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{:.3}\n",
-            r.fault,
-            r.scene,
+        table.record([
+            r.fault.to_string(),
+            r.scene.to_string(),
             if r.runs.is_empty() {
                 "all".to_string()
             } else {
                 r.runs.join(" ")
             },
-            r.size,
-            r.stated,
-            r.seeds,
-            r.failed_checks,
-            r.run_failures,
-            r.input_errors,
-            r.detection_rate,
-            r.interval[0],
-            r.interval[1],
-            r.mean_seconds
-        ));
+            r.size.to_string(),
+            r.stated.to_string(),
+            r.seeds.to_string(),
+            r.failed_checks.to_string(),
+            r.run_failures.to_string(),
+            r.input_errors.to_string(),
+            r.detection_rate.to_string(),
+            r.interval[0].to_string(),
+            r.interval[1].to_string(),
+            format!("{:.3}", r.mean_seconds),
+        ])?;
     }
-    s
+    table.into_string()
 }
 
 /// `power.md`: the rows as a markdown table, then the smallest detected sizes.

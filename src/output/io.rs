@@ -212,53 +212,160 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<()> 
 /// # Errors
 /// As [`write_csv`], apart from writing.
 pub(crate) fn csv_text(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<String> {
-    if header.is_empty() {
-        return Err(Error::invalid(
-            format!("CSV header of {}", path.display()),
-            "an empty list",
-            "at least one column",
-        ));
-    }
-    if let Some((i, row)) = rows
-        .iter()
-        .enumerate()
-        .find(|(_, row)| row.len() != header.len())
-    {
-        return Err(Error::invalid(
-            format!("length of row {i} of CSV table {}", path.display()),
-            row.len(),
-            format!("{} (the number of header columns)", header.len()),
-        ));
-    }
-
-    let mut out = String::with_capacity(16 * header.len() * (rows.len() + 1));
-    for (j, name) in header.iter().enumerate() {
-        if j > 0 {
-            out.push(',');
-        }
-        push_csv_field(&mut out, name);
-    }
-    out.push('\n');
+    let mut table = CsvWriter::new(Vec::new(), path, header)?;
     for row in rows {
-        for (j, &v) in row.iter().enumerate() {
-            if j > 0 {
-                out.push(',');
-            }
-            push_csv_number(&mut out, v);
-        }
-        out.push('\n');
+        table.numbers(row)?;
     }
-    Ok(out)
+    table.into_string()
 }
 
-pub(crate) fn push_csv_field(out: &mut String, field: &str) {
-    if field.contains([',', '"', '\n', '\r']) {
-        out.push('"');
-        out.push_str(&field.replace('"', "\"\""));
-        out.push('"');
-    } else {
-        out.push_str(field);
+/// A CSV table written record by record with the `csv` crate, the one CSV writer of
+/// every table this program writes: fields holding a comma, quote or line break are
+/// quoted and their quotes doubled (RFC 4180), other fields are written as they are;
+/// lines end in `\n`; every record has as many fields as the header. Numbers are written
+/// as [`write_csv`] describes ([`CsvWriter::numbers`], [`csv_number`]).
+pub struct CsvWriter<W: io::Write> {
+    inner: csv::Writer<W>,
+    path: PathBuf,
+    columns: usize,
+    rows: usize,
+    field: String,
+}
+
+impl<W: io::Write> std::fmt::Debug for CsvWriter<W> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CsvWriter")
+            .field("path", &self.path)
+            .finish_non_exhaustive()
     }
+}
+
+impl<W: io::Write> CsvWriter<W> {
+    /// Starts the table of file `path` (named in errors) on `out` with its `header`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if the header is empty; [`Error::Io`] naming `path` if
+    /// writing fails.
+    pub fn new(out: W, path: &Path, header: &[&str]) -> Result<Self> {
+        if header.is_empty() {
+            return Err(Error::invalid(
+                format!("CSV header of {}", path.display()),
+                "an empty list",
+                "at least one column",
+            ));
+        }
+        let mut table = CsvWriter {
+            inner: csv::WriterBuilder::new()
+                .terminator(csv::Terminator::Any(b'\n'))
+                .from_writer(out),
+            path: path.to_path_buf(),
+            columns: header.len(),
+            rows: 0,
+            field: String::new(),
+        };
+        let written = table.inner.write_record(header);
+        written.map_err(|e| table.error(e))?;
+        Ok(table)
+    }
+
+    /// Appends one record of text fields, as many as the header's.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the row (counted from 0 after the header) for a
+    /// record of another length, nothing of which is written then; [`Error::Io`] naming
+    /// the path if writing fails.
+    pub fn record<I, T>(&mut self, fields: I) -> Result<()>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<str>,
+    {
+        let fields: Vec<T> = fields.into_iter().collect();
+        self.check_length(fields.len())?;
+        let written = self
+            .inner
+            .write_record(fields.iter().map(|f| f.as_ref().as_bytes()));
+        written.map_err(|e| self.error(e))
+    }
+
+    /// Appends one record of numbers, as many as the header's, each with round-trip
+    /// precision (see [`write_csv`]).
+    ///
+    /// # Errors
+    /// As [`Self::record`].
+    pub fn numbers(&mut self, row: &[f64]) -> Result<()> {
+        self.check_length(row.len())?;
+        let mut written = Ok(());
+        for &v in row {
+            self.field.clear();
+            push_csv_number(&mut self.field, v);
+            written = self.inner.write_field(&self.field);
+            if written.is_err() {
+                break;
+            }
+        }
+        if written.is_ok() {
+            written = self.inner.write_record(None::<&[u8]>);
+        }
+        written.map_err(|e| self.error(e))
+    }
+
+    fn check_length(&mut self, len: usize) -> Result<()> {
+        if len != self.columns {
+            return Err(Error::invalid(
+                format!(
+                    "length of row {} of CSV table {}",
+                    self.rows,
+                    self.path.display()
+                ),
+                len,
+                format!("{} (the number of header columns)", self.columns),
+            ));
+        }
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Flushes the table and returns the writer it was written to.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the path if flushing fails.
+    pub fn into_inner(self) -> Result<W> {
+        let path = self.path;
+        self.inner.into_inner().map_err(|e| {
+            Error::io(
+                path,
+                io::Error::new(e.error().kind(), e.error().to_string()),
+            )
+        })
+    }
+
+    fn error(&self, e: csv::Error) -> Error {
+        let source = match e.into_kind() {
+            csv::ErrorKind::Io(e) => e,
+            other => io::Error::other(format!("{other:?}")),
+        };
+        Error::io(&self.path, source)
+    }
+}
+
+impl CsvWriter<Vec<u8>> {
+    /// The finished table as text.
+    ///
+    /// # Errors
+    /// As [`Self::into_inner`]; [`Error::Io`] naming the path if a field was not UTF-8.
+    pub fn into_string(self) -> Result<String> {
+        let path = self.path.clone();
+        String::from_utf8(self.into_inner()?).map_err(|e| Error::io(path, io::Error::other(e)))
+    }
+}
+
+/// `v` with round-trip precision, as [`write_csv`] writes it; `None` as an empty field.
+pub fn csv_number(v: impl Into<Option<f64>>) -> String {
+    let mut out = String::new();
+    if let Some(v) = v.into() {
+        push_csv_number(&mut out, v);
+    }
+    out
 }
 
 /// Appends `v` with round-trip precision (see [`write_csv`]).
@@ -297,6 +404,26 @@ pub(crate) fn json_text<T: serde::Serialize>(path: &Path, value: &T) -> Result<S
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The one CSV writer: text quoted only where RFC 4180 needs it (a comma, a quote,
+    /// a line break), quotes doubled, numbers as `write_csv` documents, `\n` line ends,
+    /// and a record of the wrong length refused without writing any of it.
+    #[test]
+    fn csv_writer_quotes_only_where_needed() {
+        let path = Path::new("t.csv");
+        let mut t = CsvWriter::new(Vec::new(), path, &["name", "a,b", "x"]).unwrap();
+        t.record(["plain", "say \"hi\"", "two\nlines"]).unwrap();
+        t.numbers(&[1e-7, 0.5, f64::NEG_INFINITY]).unwrap();
+        let e = t.record(["one", "two"]).unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("t.csv"), "{e}");
+        assert!(t.numbers(&[1.0]).is_err());
+        t.record(["", &csv_number(None), &csv_number(2.0)]).unwrap();
+        assert_eq!(
+            t.into_string().unwrap(),
+            "name,\"a,b\",x\nplain,\"say \"\"hi\"\"\",\"two\nlines\"\n1e-7,0.5,-inf\n,,2\n"
+        );
+        assert!(CsvWriter::new(Vec::new(), path, &[]).is_err());
+    }
 
     /// Stale temporaries of a dead process are removed, down to two directory levels;
     /// this process's, other names and deeper files are kept.

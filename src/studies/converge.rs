@@ -42,6 +42,7 @@ use crate::fem::modal::{
     continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
 };
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::output::io::CsvWriter;
 use crate::output::{AxisUnits, Figure, Provenance, Series};
 use crate::rng::derive_seed;
 use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
@@ -51,7 +52,7 @@ use crate::stats;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Deserializer, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub mod compression;
@@ -1223,7 +1224,8 @@ fn finish(
     let observables = summarize(&study.names, &study.rows, &study.expected);
     let stem = format!("{}-{label}-{}", scene.name, over.name());
     let report = StudyReport::begin(&opts.out, "converge", &stem, provenance)?;
-    report.write(&format!("{stem}.csv"), rows_csv(&study.rows).as_bytes())?;
+    let csv = format!("{stem}.csv");
+    report.write(&csv, rows_csv(Path::new(&csv), &study.rows)?.as_bytes())?;
     report.write_svg(
         &format!("{stem}.svg"),
         &figure(scene, label, spec, over, &observables, &study.rows),
@@ -1398,32 +1400,47 @@ fn opt_cell(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| x.to_string())
 }
 
-/// The study's table `<stem>.csv`: one line per value and observable.
-fn rows_csv(rows: &[Row]) -> String {
-    let mut text = String::from(
-        "value,h,observable,estimate,std_error,discrete,limit,total_error,total_error_se,exact_error,status\n",
-    );
+/// The study's table `<stem>.csv` (`path` names it in errors): one line per value and
+/// observable.
+fn rows_csv(path: &Path, rows: &[Row]) -> Result<String> {
+    let mut table = CsvWriter::new(
+        Vec::new(),
+        path,
+        &[
+            "value",
+            "h",
+            "observable",
+            "estimate",
+            "std_error",
+            "discrete",
+            "limit",
+            "total_error",
+            "total_error_se",
+            "exact_error",
+            "status",
+        ],
+    )?;
     for r in rows {
-        text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.value,
-            r.h,
-            r.observable,
-            r.estimate,
-            r.std_error,
+        table.record([
+            r.value.to_string(),
+            r.h.to_string(),
+            r.observable.to_string(),
+            r.estimate.to_string(),
+            r.std_error.to_string(),
             opt_cell(r.discrete),
-            r.limit,
-            r.total_error,
-            r.total_error_se,
+            r.limit.to_string(),
+            r.total_error.to_string(),
+            r.total_error_se.to_string(),
             opt_cell(r.exact_error),
             if r.sampling_floor {
                 "sampling floor"
             } else {
                 "resolved"
             }
-        ));
+            .to_string(),
+        ])?;
     }
-    text
+    table.into_string()
 }
 
 /// The study's figure: per observable (one colour each), |error| of the resolved

@@ -42,6 +42,7 @@ use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::modal::generalized_modes;
 use crate::fem::noise::NoiseModel;
+use crate::output::io::CsvWriter;
 use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::{ModelKind, Scene};
@@ -50,7 +51,7 @@ use crate::studies::converge::nan_if_null;
 use crate::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Default element counts of the map.
@@ -812,8 +813,8 @@ fn judge_formulas(cells: &mut [Cell], alpha: f64) -> (usize, usize) {
 
 /// Writes the CSV tables and the figures of the output set through `report`.
 fn write_outputs(report: &StudyReport, opts: &StabilityOptions, cells: &[Cell]) -> Result<()> {
-    report.write("stability-cells.csv", cells_csv(cells).as_bytes())?;
-    report.write("stationary-bias.csv", modes_csv(cells).as_bytes())?;
+    report.write("stability-cells.csv", cells_csv(cells)?.as_bytes())?;
+    report.write("stationary-bias.csv", modes_csv(cells)?.as_bytes())?;
     for &k in &opts.integrators {
         let name = format!("stability-map-{}.svg", k.name());
         report.write_svg(&name, &map_figure(&opts.scene.name, k, cells))?;
@@ -825,56 +826,85 @@ fn write_outputs(report: &StudyReport, opts: &StabilityOptions, cells: &[Cell]) 
 }
 
 /// `stability-cells.csv`: one line per cell.
-fn cells_csv(cells: &[Cell]) -> String {
-    let mut csv = String::from(
-        "integrator,elements,dt_lambda_max,dt_tau1,max_multiplier,status,checked_modes,unresolved_modes,predicted_max_bias,diverged_at,detail\n",
-    );
+fn cells_csv(cells: &[Cell]) -> Result<String> {
+    let mut table = CsvWriter::new(
+        Vec::new(),
+        Path::new("stability-cells.csv"),
+        &[
+            "integrator",
+            "elements",
+            "dt_lambda_max",
+            "dt_tau1",
+            "max_multiplier",
+            "status",
+            "checked_modes",
+            "unresolved_modes",
+            "predicted_max_bias",
+            "diverged_at",
+            "detail",
+        ],
+    )?;
     for c in cells {
-        csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
-            c.integrator,
-            c.elements,
-            c.dt_lambda_max,
-            c.dt_tau1,
-            c.max_multiplier,
-            c.status.name(),
-            c.modes.len(),
-            c.unresolved_modes,
-            c.predicted_max_bias,
+        table.record([
+            c.integrator.to_string(),
+            c.elements.to_string(),
+            c.dt_lambda_max.to_string(),
+            c.dt_tau1.to_string(),
+            c.max_multiplier.to_string(),
+            c.status.name().to_string(),
+            c.modes.len().to_string(),
+            c.unresolved_modes.to_string(),
+            c.predicted_max_bias.to_string(),
             c.diverged_at.map(|s| s.to_string()).unwrap_or_default(),
-            c.detail.replace('"', "'")
-        ));
+            c.detail.clone(),
+        ])?;
     }
-    csv
+    table.into_string()
 }
 
 /// `stationary-bias.csv`: one line per checked mode of every cell.
-fn modes_csv(cells: &[Cell]) -> String {
-    let mut csv = String::from(
-        "integrator,elements,dt_lambda_max,mode,lambda_dt,multiplier,measured_ratio,std_error,formula_ratio,z_formula,p_formula,formula_rejected,z_bias,p_bias\n",
-    );
+fn modes_csv(cells: &[Cell]) -> Result<String> {
+    let mut table = CsvWriter::new(
+        Vec::new(),
+        Path::new("stationary-bias.csv"),
+        &[
+            "integrator",
+            "elements",
+            "dt_lambda_max",
+            "mode",
+            "lambda_dt",
+            "multiplier",
+            "measured_ratio",
+            "std_error",
+            "formula_ratio",
+            "z_formula",
+            "p_formula",
+            "formula_rejected",
+            "z_bias",
+            "p_bias",
+        ],
+    )?;
     for c in cells {
         for m in &c.modes {
-            csv.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-                c.integrator,
-                c.elements,
-                c.dt_lambda_max,
-                m.mode,
-                m.lambda_dt,
-                m.multiplier,
-                m.measured_ratio,
-                m.std_error,
-                m.formula_ratio,
-                m.z_formula,
-                m.p_formula,
-                m.formula_rejected,
-                m.z_bias,
-                m.p_bias
-            ));
+            table.record([
+                c.integrator.to_string(),
+                c.elements.to_string(),
+                c.dt_lambda_max.to_string(),
+                m.mode.to_string(),
+                m.lambda_dt.to_string(),
+                m.multiplier.to_string(),
+                m.measured_ratio.to_string(),
+                m.std_error.to_string(),
+                m.formula_ratio.to_string(),
+                m.z_formula.to_string(),
+                m.p_formula.to_string(),
+                m.formula_rejected.to_string(),
+                m.z_bias.to_string(),
+                m.p_bias.to_string(),
+            ])?;
         }
     }
-    csv
+    table.into_string()
 }
 
 /// A category label for a normalized step: `0.1`, `1.9`, `1000`, `1e5`.

@@ -27,6 +27,7 @@ use super::output::StudyReport;
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
+use crate::output::io::CsvWriter;
 use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::LinearRun;
@@ -35,7 +36,7 @@ use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Default methods: the paper's explicit scheme with both noise models, backward Euler,
@@ -386,7 +387,7 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
     let sampling_floor = ses.get(ses.len() / 2).copied().unwrap_or(f64::NAN);
 
     let report = StudyReport::begin(&opts.out, "work-precision", STEM, provenance)?;
-    report.write("work-precision.csv", points_csv(&points).as_bytes())?;
+    report.write("work-precision.csv", points_csv(&points)?.as_bytes())?;
     report.write_svg(
         "work-precision.svg",
         &measured_figure(opts, &points, sampling_floor),
@@ -496,34 +497,52 @@ fn run_point(opts: &WorkPrecisionOptions, (method, dt, s, lr): &PreparedPoint) -
 }
 
 /// The points as CSV (one line per point).
-fn points_csv(points: &[WpPoint]) -> String {
-    let mut csv = String::from(
-        "integrator,noise,dt_tau1,trajectories,duration_tau1,steps_per_trajectory,wall_seconds,estimate,std_error,discrete,continuum,rel_error,rel_std_error,rel_bias,z_discrete,seconds_to_tolerance\n",
-    );
+fn points_csv(points: &[WpPoint]) -> Result<String> {
+    let mut table = CsvWriter::new(
+        Vec::new(),
+        Path::new("work-precision.csv"),
+        &[
+            "integrator",
+            "noise",
+            "dt_tau1",
+            "trajectories",
+            "duration_tau1",
+            "steps_per_trajectory",
+            "wall_seconds",
+            "estimate",
+            "std_error",
+            "discrete",
+            "continuum",
+            "rel_error",
+            "rel_std_error",
+            "rel_bias",
+            "z_discrete",
+            "seconds_to_tolerance",
+        ],
+    )?;
     for p in points {
-        csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.integrator,
-            p.noise,
-            p.dt_tau1,
-            p.trajectories,
-            p.duration_tau1,
-            p.steps_per_trajectory,
-            p.wall_seconds,
-            p.estimate,
-            p.std_error,
-            p.discrete,
-            p.continuum,
-            p.rel_error,
-            p.rel_std_error,
-            p.rel_bias,
-            p.z_discrete,
+        table.record([
+            p.integrator.to_string(),
+            p.noise.to_string(),
+            p.dt_tau1.to_string(),
+            p.trajectories.to_string(),
+            p.duration_tau1.to_string(),
+            p.steps_per_trajectory.to_string(),
+            p.wall_seconds.to_string(),
+            p.estimate.to_string(),
+            p.std_error.to_string(),
+            p.discrete.to_string(),
+            p.continuum.to_string(),
+            p.rel_error.to_string(),
+            p.rel_std_error.to_string(),
+            p.rel_bias.to_string(),
+            p.z_discrete.to_string(),
             p.seconds_to_tolerance
                 .map(|t| t.to_string())
-                .unwrap_or_default()
-        ));
+                .unwrap_or_default(),
+        ])?;
     }
-    csv
+    table.into_string()
 }
 
 fn method_points(points: &[WpPoint], (k, n): (IntegratorKind, NoiseModel)) -> Vec<&WpPoint> {

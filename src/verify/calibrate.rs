@@ -43,13 +43,13 @@
 //!   correct simulator fails it: the model for reporting the verifier's own error rates.
 
 use crate::error::{Error, Result};
-use crate::output::io::{push_csv_field, push_csv_number};
+use crate::output::io::{CsvWriter, csv_number};
 use crate::output::{Figure, Series};
 use crate::stats;
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{Beta, Binomial, ContinuousCDF, DiscreteCDF};
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
+use std::path::Path;
 
 /// File name of the journal of a calibration report ([`crate::output::manifest`]).
 pub const MANIFEST: &str = "manifest.json";
@@ -465,24 +465,24 @@ pub const P_VALUES_HEADER: [&str; 7] = [
 /// The text of `p-values.csv`: [`P_VALUES_HEADER`], then one line per row; numbers with
 /// round-trip precision, an empty field for a missing p-value, `passed` as `true` or
 /// `false`, text fields quoted where they need it.
-pub fn p_values_csv(rows: &[PValueRow]) -> String {
-    let mut out = P_VALUES_HEADER.join(",");
-    out.push('\n');
+///
+/// # Errors
+/// [`Error::Io`] naming `p-values.csv` if the table cannot be
+/// written (it is written to memory; this does not happen).
+pub fn p_values_csv(rows: &[PValueRow]) -> Result<String> {
+    let mut table = CsvWriter::new(Vec::new(), Path::new(P_VALUES_CSV), &P_VALUES_HEADER)?;
     for r in rows {
-        push_csv_field(&mut out, &r.scene);
-        let _ = write!(out, ",{},", r.seed);
-        push_csv_field(&mut out, &r.check);
-        out.push(',');
-        push_csv_field(&mut out, &r.kind);
-        for v in [r.p_value, r.p_adjusted] {
-            out.push(',');
-            if let Some(v) = v {
-                push_csv_number(&mut out, v);
-            }
-        }
-        out.push_str(if r.passed { ",true\n" } else { ",false\n" });
+        table.record([
+            r.scene.clone(),
+            r.seed.to_string(),
+            r.check.clone(),
+            r.kind.clone(),
+            csv_number(r.p_value),
+            csv_number(r.p_adjusted),
+            r.passed.to_string(),
+        ])?;
     }
-    out
+    table.into_string()
 }
 
 /// The p-values of each check in `rows`, grouped by (scene, check) in order of first
@@ -852,7 +852,7 @@ mod tests {
             },
         ];
         assert_eq!(
-            p_values_csv(&rows),
+            p_values_csv(&rows).unwrap(),
             "scene,seed,check,kind,p_value,p_adjusted,passed\n\
              a,18446744073709551615,mode-variance/n=1,z-test,0.25,1e-7,true\n\
              a,2,\"odd, name\",deterministic,,,false\n"
