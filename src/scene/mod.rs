@@ -13,6 +13,8 @@
 //!   references and sampling plan, and the simulation of one trajectory.
 //! - [`compression`]: a prepared run of a compression scene
 //!   ([`compression::CompressionRun`]), its exact theory table and force estimates.
+//! - [`records`]: the per-trajectory records of a run as bytes, bit for bit (what a shard
+//!   of an ensemble will hand to the merge, issue #15).
 //!
 //! Both [`crate::verify`] (pass/fail checks) and [`crate::studies`] (parametric studies)
 //! are built on the runs prepared here.
@@ -21,6 +23,7 @@ pub mod builtin;
 pub mod compression;
 pub mod keys;
 pub mod linear;
+pub mod records;
 pub mod spec;
 pub mod validate;
 
