@@ -167,22 +167,7 @@ pub fn run(args: CalibrateArgs, verbosity: Verbosity) -> Result<i32> {
     )?;
     let per_check = p_values_per_check(&rows);
     let kinds = uniformity_by_kind(&per_check)?;
-    let mut scene_results = Vec::with_capacity(scenes.len());
-    for (scene, tally) in scenes.iter().zip(tallies) {
-        scene_results.push(SceneCalibration {
-            name: scene.name.clone(),
-            false_alarms: false_alarms(
-                tally.failed.len() as u64,
-                tally.run_failures,
-                n,
-                args.alpha,
-            )?,
-            checks_per_seed: tally.checks_per_seed,
-            failed_seeds: tally.failed,
-            figure: figure_name(&scene.name),
-            wall_seconds: tally.wall_seconds,
-        });
-    }
+    let scene_results = scene_calibrations(&scenes, tallies, n, args.alpha)?;
     let report = ReportRun::begin(&args.out, "calibrate", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
     report.write(
@@ -217,6 +202,37 @@ pub fn run(args: CalibrateArgs, verbosity: Verbosity) -> Result<i32> {
         summary.run_id
     );
     Ok(if passed { 0 } else { 1 })
+}
+
+/// Per scene, its false-alarm rate over the `seeds` seeds against `alpha` from its tally.
+///
+/// # Errors
+/// As [`false_alarms`].
+fn scene_calibrations(
+    scenes: &[Scene],
+    tallies: Vec<SceneTally>,
+    seeds: u64,
+    alpha: f64,
+) -> Result<Vec<SceneCalibration>> {
+    scenes
+        .iter()
+        .zip(tallies)
+        .map(|(scene, tally)| {
+            Ok(SceneCalibration {
+                name: scene.name.clone(),
+                false_alarms: false_alarms(
+                    tally.failed.len() as u64,
+                    tally.run_failures,
+                    seeds,
+                    alpha,
+                )?,
+                checks_per_seed: tally.checks_per_seed,
+                failed_seeds: tally.failed,
+                figure: figure_name(&scene.name),
+                wall_seconds: tally.wall_seconds,
+            })
+        })
+        .collect()
 }
 
 /// Verifies every scene at every seed of `plan` in `scratch` (removed after each), in
