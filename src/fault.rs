@@ -1066,8 +1066,9 @@ mod tests {
         InputError,
     }
 
-    /// Verifies `scene` at the quick budget into a fresh temporary directory.
-    fn verify(scene: Scene, tag: &str) -> Verdict {
+    /// The summary of `scene` verified at the quick budget in a fresh temporary
+    /// directory (removed after).
+    fn quick_verify(scene: Scene, tag: &str) -> crate::Result<crate::verify::summary::Summary> {
         let out =
             std::env::temp_dir().join(format!("langevin-fem-fault-{}-{tag}", std::process::id()));
         let result = run_verification(&VerifyOptions {
@@ -1079,8 +1080,13 @@ mod tests {
             limits: WorkLimits::default(),
         });
         let _ = std::fs::remove_dir_all(&out);
-        match result {
-            Ok((summary, _)) if summary.passed => Verdict::Passed,
+        result.map(|(summary, _)| summary)
+    }
+
+    /// Verifies `scene` at the quick budget ([`quick_verify`]): how it ended.
+    fn verify(scene: Scene, tag: &str) -> Verdict {
+        match quick_verify(scene, tag) {
+            Ok(summary) if summary.passed => Verdict::Passed,
             Ok(_) => Verdict::FailedChecks,
             Err(e) if e.exit_code() == 2 => Verdict::InputError,
             Err(_) => Verdict::RunFailed,
@@ -1137,18 +1143,7 @@ mod tests {
     fn axial_residual_check_finds_a_tiny_von_karman_strain_error() {
         let scene = builtin::find("compression-2d").unwrap().load().unwrap();
         let summary = |scene: Scene, tag: &str| {
-            let out = std::env::temp_dir()
-                .join(format!("langevin-fem-axial-{}-{tag}", std::process::id()));
-            let (summary, _) = run_verification(&VerifyOptions {
-                scenes: vec![scene],
-                budget: crate::scene::Budget::Quick,
-                out: out.clone(),
-                alpha: 0.01,
-                progress: crate::progress::ProgressOptions::HIDDEN,
-                limits: WorkLimits::default(),
-            })
-            .unwrap();
-            let _ = std::fs::remove_dir_all(&out);
+            let summary = quick_verify(scene, &format!("axial-{tag}")).unwrap();
             summary.scenes.into_iter().next().unwrap().checks
         };
         let axial = |checks: &[CheckResult]| -> Vec<bool> {

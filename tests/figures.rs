@@ -24,39 +24,10 @@
 
 mod common;
 
+use common::svg::{element, svg_texts};
 use common::{TempDir, assert_no_panic, describe, json, run, strings};
 use langevin_fem::output::{Figure, Series};
 use std::path::Path;
-
-/// The text content of every `<text>` element, trimmed and unescaped.
-fn svg_texts(svg: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut rest = svg;
-    while let Some(start) = rest.find("<text") {
-        rest = &rest[start..];
-        let open_end = rest.find('>').expect("text tag closed");
-        let close = rest.find("</text>").expect("text element closed");
-        out.push(unescape(rest[open_end + 1..close].trim()));
-        rest = &rest[close..];
-    }
-    out
-}
-
-fn unescape(s: &str) -> String {
-    s.replace("&lt;", "<")
-        .replace("&gt;", ">")
-        .replace("&quot;", "\"")
-        .replace("&apos;", "'")
-        .replace("&amp;", "&")
-}
-
-/// The content of the first `<tag>…</tag>` element, unescaped.
-fn element(svg: &str, tag: &str) -> Option<String> {
-    let open = format!("<{tag}>");
-    let start = svg.find(&open)? + open.len();
-    let end = svg[start..].find(&format!("</{tag}>"))? + start;
-    Some(unescape(&svg[start..end]))
-}
 
 /// The (horizontal, vertical) axis labels the SVG's `<desc>` names.
 fn axis_labels(svg: &str) -> (String, String) {

@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::svg::svg_texts;
 use common::{TempDir, all_files};
 use std::fs;
 use std::path::Path;
@@ -26,28 +27,6 @@ fn file_names(dir: &Path) -> Vec<String> {
         .collect();
     names.sort();
     names
-}
-
-/// The contents of all SVG `<text>` elements, trimmed and with entities decoded.
-fn svg_texts(svg: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut rest = svg;
-    while let Some(start) = rest.find("<text") {
-        rest = &rest[start..];
-        let open_end = rest.find('>').expect("text tag closed");
-        let close = rest.find("</text>").expect("text element closed");
-        out.push(
-            rest[open_end + 1..close]
-                .trim()
-                .replace("&lt;", "<")
-                .replace("&gt;", ">")
-                .replace("&quot;", "\"")
-                .replace("&apos;", "'")
-                .replace("&amp;", "&"),
-        );
-        rest = &rest[close..];
-    }
-    out
 }
 
 /// write_atomic creates missing parent directories, replaces existing content and leaves no

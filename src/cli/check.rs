@@ -2,11 +2,12 @@
 //! any program in the trajectory data format ([`langevin_fem::data`]).
 
 use super::Verbosity;
-use super::terminal::{Totals, print_scenes};
+use super::terminal::{print_scenes, totals_line};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::verify::check_data;
+use langevin_fem::verify::summary::Totals;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -75,7 +76,7 @@ pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     }
     println!(
         "{}",
-        Totals::of(&summary.scenes).line(start.elapsed().as_secs_f64())
+        totals_line(&Totals::of(&summary.scenes), start.elapsed().as_secs_f64())
     );
     Ok(if summary.passed { 0 } else { 1 })
 }

@@ -11,39 +11,11 @@
 //! summed over the scenes; T the command's wall time), for a person and for a script.
 
 use super::Verbosity;
-use langevin_fem::verify::summary::{CheckResult, SceneSummary, Summary};
+use langevin_fem::verify::summary::{CheckResult, Summary, Totals};
 
-/// Checks passed, failed and skipped (not evaluated) in a set of scenes.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Totals {
-    /// Checks that passed.
-    pub passed: usize,
-    /// Checks that failed.
-    pub failed: usize,
-    /// Checks not evaluated ([`SceneSummary::skipped`]).
-    pub skipped: usize,
-}
-
-impl Totals {
-    /// The totals of `scenes`.
-    pub fn of<'a>(scenes: impl IntoIterator<Item = &'a SceneSummary>) -> Self {
-        scenes.into_iter().fold(Totals::default(), |t, s| {
-            let failed = s.checks.iter().filter(|c| !c.passed).count();
-            Totals {
-                passed: t.passed + s.checks.len() - failed,
-                failed: t.failed + failed,
-                skipped: t.skipped + s.skipped.len(),
-            }
-        })
-    }
-
-    /// The closing line: `N passed, N failed, N skipped in T s`.
-    pub fn line(&self, seconds: f64) -> String {
-        format!(
-            "{} passed, {} failed, {} skipped in {seconds:.1} s",
-            self.passed, self.failed, self.skipped
-        )
-    }
+/// The closing line of `verify` and `check`: `N passed, N failed, N skipped in T s`.
+pub fn totals_line(totals: &Totals, seconds: f64) -> String {
+    format!("{} in {seconds:.1} s", totals.text())
 }
 
 /// A number for the terminal: 4 significant digits.
@@ -129,6 +101,7 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use langevin_fem::verify::summary::SceneSummary;
 
     fn check(name: &str, passed: bool) -> CheckResult {
         CheckResult {
@@ -186,7 +159,10 @@ mod tests {
                 skipped: 3
             }
         );
-        assert_eq!(t.line(12.345), "2 passed, 1 failed, 3 skipped in 12.3 s");
+        assert_eq!(
+            totals_line(&t, 12.345),
+            "2 passed, 1 failed, 3 skipped in 12.3 s"
+        );
     }
 
     #[test]

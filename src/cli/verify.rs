@@ -1,11 +1,12 @@
 //! `langevin-fem verify`: run verification scenes and write reports.
 
 use super::Verbosity;
-use super::terminal::{Totals, print_scenes};
+use super::terminal::{print_scenes, totals_line};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::scene::{Budget, load_scenes};
+use langevin_fem::verify::summary::Totals;
 use langevin_fem::verify::{VerifyOptions, run_verification};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -116,7 +117,7 @@ pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
     }
     println!(
         "{}",
-        Totals::of(&summary.scenes).line(start.elapsed().as_secs_f64())
+        totals_line(&Totals::of(&summary.scenes), start.elapsed().as_secs_f64())
     );
     Ok(if summary.passed { 0 } else { 1 })
 }

@@ -817,6 +817,23 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
+/// The inverse of [`xml_escape`]: decodes `&lt;`, `&gt;`, `&quot;`, `&apos;` and `&amp;`.
+pub fn xml_unescape(s: &str) -> String {
+    s.replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&quot;", "\"")
+        .replace("&apos;", "'")
+        .replace("&amp;", "&")
+}
+
+/// The caption an SVG written by [`Figure`] carries as its `<title>`, decoded; `None`
+/// if it has none.
+pub fn svg_caption(svg: &str) -> Option<String> {
+    let (_, rest) = svg.split_once("<title>")?;
+    let (title, _) = rest.split_once("</title>")?;
+    Some(xml_unescape(title))
+}
+
 /// A light tint of `c` (halfway to white and a bit more), for reference curves drawn
 /// beneath data of the same colour.
 fn tint(c: RGBColor) -> RGBColor {

@@ -56,19 +56,10 @@ fn fit(f: Option<&OrderFit>) -> String {
 }
 
 /// The caption of figure `file` in `dir`: the `<title>` every figure of the project
-/// carries ([`crate::output::figure`]), empty if it has none.
+/// carries ([`crate::output::figure::svg_caption`]), empty if it has none.
 fn svg_caption(dir: &Path, file: &str) -> String {
     let text = std::fs::read_to_string(dir.join(file)).unwrap_or_default();
-    text.split_once("<title>")
-        .and_then(|(_, rest)| rest.split_once("</title>"))
-        .map(|(t, _)| {
-            t.replace("&lt;", "<")
-                .replace("&gt;", ">")
-                .replace("&quot;", "\"")
-                .replace("&apos;", "'")
-                .replace("&amp;", "&")
-        })
-        .unwrap_or_default()
+    crate::output::figure::svg_caption(&text).unwrap_or_default()
 }
 
 /// A figure with its caption (what is plotted, what to see) and its file name.

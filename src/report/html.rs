@@ -19,7 +19,7 @@ use crate::output::ProvenanceRef;
 use crate::output::io::json_text;
 use crate::output::{ReportRun, write_atomic};
 use crate::verify::runner::ENTRY_POINTS;
-use crate::verify::summary::{CheckResult, SceneSummary, Summary};
+use crate::verify::summary::{CheckResult, SceneSummary, Summary, Totals};
 
 pub(crate) const CSS: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
@@ -105,52 +105,9 @@ pub fn render_index(summary: &Summary) -> String {
 /// Where [`index_html`] puts the convergence section.
 const CONVERGENCE_MARK: &str = "<!-- convergence -->\n";
 
-/// Passed, failed and skipped checks of a list of checks.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-struct Tally {
-    passed: usize,
-    failed: usize,
-    skipped: usize,
-}
-
-impl Tally {
-    fn of(checks: &[CheckResult], skipped: usize) -> Self {
-        let failed = checks.iter().filter(|c| !c.passed).count();
-        Tally {
-            passed: checks.len() - failed,
-            failed,
-            skipped,
-        }
-    }
-
-    fn add(self, o: Tally) -> Self {
-        Tally {
-            passed: self.passed + o.passed,
-            failed: self.failed + o.failed,
-            skipped: self.skipped + o.skipped,
-        }
-    }
-
-    /// `12 passed, 1 failed, 2 skipped`.
-    fn text(self) -> String {
-        format!(
-            "{} passed, {} failed, {} skipped",
-            self.passed, self.failed, self.skipped
-        )
-    }
-}
-
-fn scene_tally(s: &SceneSummary) -> Tally {
-    Tally::of(&s.checks, s.skipped.len())
-}
-
 /// The verdict and the totals, first on the page.
 fn verdict_box(h: &mut String, summary: &Summary) {
-    let total = summary
-        .scenes
-        .iter()
-        .map(scene_tally)
-        .fold(Tally::default(), Tally::add);
+    let total = Totals::of(&summary.scenes);
     let n = summary.scenes.len();
     let failed_scenes = summary.scenes.iter().filter(|s| !s.passed).count();
     let wall: f64 = summary.scenes.iter().map(|s| s.wall_seconds).sum();
@@ -234,7 +191,7 @@ fn scenes_table(h: &mut String, summary: &Summary) {
          <th>What it checks</th></tr></thead>\n<tbody>\n",
     );
     for (i, s) in summary.scenes.iter().enumerate() {
-        let t = scene_tally(s);
+        let t = Totals::of([s]);
         let verdict = pass_fail(s.passed);
         let _ = writeln!(
             h,
@@ -369,7 +326,7 @@ fn shell_words(args: &[String]) -> String {
 /// its notes, figures, tables, skipped checks and the table of all its checks.
 fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
     let verdict = pass_fail(s.passed);
-    let t = scene_tally(s);
+    let t = Totals::of([s]);
     let _ = writeln!(
         h,
         "<section id=\"scene-{i}\" class=\"scene\">\n<h2>{} <span class=\"badge {}\">{verdict}</span></h2>\n\

@@ -157,6 +157,40 @@ impl CheckResult {
     }
 }
 
+/// Checks passed, failed and skipped (not evaluated) in a set of scenes: the totals the
+/// terminal's closing line and the report's verdict show.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Totals {
+    /// Checks that passed.
+    pub passed: usize,
+    /// Checks that failed.
+    pub failed: usize,
+    /// Checks not evaluated ([`SceneSummary::skipped`]).
+    pub skipped: usize,
+}
+
+impl Totals {
+    /// The totals of `scenes`.
+    pub fn of<'a>(scenes: impl IntoIterator<Item = &'a SceneSummary>) -> Self {
+        scenes.into_iter().fold(Totals::default(), |t, s| {
+            let failed = s.checks.iter().filter(|c| !c.passed).count();
+            Totals {
+                passed: t.passed + s.checks.len() - failed,
+                failed: t.failed + failed,
+                skipped: t.skipped + s.skipped.len(),
+            }
+        })
+    }
+
+    /// `N passed, N failed, N skipped`.
+    pub fn text(&self) -> String {
+        format!(
+            "{} passed, {} failed, {} skipped",
+            self.passed, self.failed, self.skipped
+        )
+    }
+}
+
 /// The result of one scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SceneSummary {
