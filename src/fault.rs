@@ -684,7 +684,7 @@ mod tests {
     use crate::scene::builtin;
     use crate::scene::linear::LinearRun;
     use crate::verify::summary::CheckResult;
-    use crate::verify::{VerifyOptions, run_verification};
+    use crate::verify::{Ensembles, VerifyOptions, run_verification};
     use crate::work::WorkLimits;
 
     /// Seed of every random stream of these tests.
@@ -1078,6 +1078,7 @@ mod tests {
             alpha: 0.01,
             progress: crate::progress::ProgressOptions::HIDDEN,
             limits: WorkLimits::default(),
+            ensembles: Ensembles::Simulate,
         });
         let _ = std::fs::remove_dir_all(&out);
         result.map(|(summary, _)| summary)

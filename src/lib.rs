@@ -64,6 +64,7 @@ pub mod progress;
 pub mod report;
 pub mod rng;
 pub mod scene;
+pub mod shard;
 pub mod spectral;
 pub mod stats;
 pub mod studies;

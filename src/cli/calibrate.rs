@@ -30,7 +30,9 @@ use langevin_fem::verify::calibrate::{
     P_VALUES_CSV, PValueRow, SceneCalibration, SeedPlan, UNIFORMITY_LEVEL, UNIFORMITY_RULE,
     false_alarms, p_value_figure, p_values_csv, p_values_per_check, uniformity_by_kind,
 };
-use langevin_fem::verify::{SceneSummary, VerifyOptions, projected_work, run_verification};
+use langevin_fem::verify::{
+    Ensembles, SceneSummary, VerifyOptions, projected_work, run_verification,
+};
 use langevin_fem::work::{WorkLimits, WorkProjection};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -274,6 +276,7 @@ fn verify_seeds(
                 alpha,
                 progress: ProgressOptions::HIDDEN,
                 limits,
+                ensembles: Ensembles::Simulate,
             });
             remove_scratch(scratch)?;
             match outcome {

@@ -4,6 +4,7 @@ mod calibrate;
 mod check;
 mod converge;
 mod list;
+mod merge;
 #[cfg(feature = "faults")]
 mod power;
 mod run;
@@ -104,6 +105,9 @@ enum Command {
     /// Simulate a scene's ensemble and write every trajectory's time series (NumPy .npy
     /// or CSV, with a data.json sidecar) for your own analysis or `check`.
     Run(run::RunArgs),
+    /// The report of a run split into shards (`verify --shard I/N`): byte for byte the
+    /// report the run makes in one process.
+    Merge(merge::MergeArgs),
     /// Apply a scene's statistical checks to trajectories written by any simulator in
     /// the trajectory data format (the format `run` writes).
     Check(check::CheckArgs),
@@ -175,6 +179,10 @@ pub fn run() -> Result<i32> {
         Command::Run(args) => {
             check_out_dir(&args.out)?;
             run::run(args, v)
+        }
+        Command::Merge(args) => {
+            check_out_dir(&args.out)?;
+            merge::run(args, v)
         }
         Command::Check(args) => {
             check_out_dir(&args.out)?;

@@ -4,10 +4,14 @@ use super::Verbosity;
 use super::terminal::{print_scenes, totals_line};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
+use langevin_fem::output::ReportRun;
 use langevin_fem::report::write_report;
 use langevin_fem::scene::{Budget, load_scenes};
+use langevin_fem::shard::Shard;
+use langevin_fem::verify::Summary;
+use langevin_fem::verify::shard::write_shard;
 use langevin_fem::verify::summary::Totals;
-use langevin_fem::verify::{VerifyOptions, run_verification};
+use langevin_fem::verify::{Ensembles, VerifyOptions, run_verification};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -19,6 +23,8 @@ Examples:
   langevin-fem verify -s my-scene.toml --seed 7 -j 2   a scene file of yours, another seed, 2 threads
   langevin-fem verify --scene-dir scenes/ -q           every scene in scenes/; failures and totals only
   langevin-fem verify -v | cat                         failed and skipped checks in detail, run times
+  langevin-fem verify -b full --shard 2/4 -o shards/2  shard 2 of 4 (records only), then:
+  langevin-fem merge shards/1 shards/2 shards/3 shards/4 -o reports
 
 The last line of stdout is `N passed, N failed, N skipped in T s`; the exit code is 0 if
 every check passed, 1 if one failed, 2 on bad input, 3 if a run failed.";
@@ -45,6 +51,11 @@ pub struct VerifyArgs {
     /// Family-wise significance level per scene (Holm correction).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
+    /// Simulate only shard I of N of every run's trajectories and write their records and
+    /// a manifest to --out, without checks or report; `langevin-fem merge` then writes the
+    /// report of the whole run, byte for byte (see README "Running on a cluster").
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
     #[command(flatten)]
     limits: super::LimitArgs,
     #[command(flatten)]
@@ -92,14 +103,41 @@ pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
         ));
     }
     let seed_notes: Vec<String> = scenes.iter_mut().map(|s| args.sim.apply(s)).collect();
-    let (mut summary, report) = run_verification(&VerifyOptions {
+    let opts = VerifyOptions {
         scenes,
         budget,
         out: args.out.clone(),
         alpha: args.alpha,
         progress: verbosity.progress(),
         limits: args.limits.limits(),
-    })?;
+        ensembles: Ensembles::Simulate,
+    };
+    if let Some(shard) = args.shard {
+        let manifest = write_shard(&opts, shard, &seed_notes)?;
+        println!(
+            "shard {shard}: {} record file(s) in {}; when every shard of {} is done: langevin-fem merge <the {} shard directories> -o <report dir>",
+            manifest.files.len(),
+            args.out.display(),
+            shard.count,
+            shard.count
+        );
+        return Ok(0);
+    }
+    let (summary, report) = run_verification(&opts)?;
+    finish(summary, report, seed_notes, &args.out, verbosity, start)
+}
+
+/// Finishes a verification (or a merge of one): adds each scene's seed note, writes the
+/// report, prints the scenes and the totals at `verbosity`; exit code 0 if every check
+/// passed, 1 otherwise.
+pub(super) fn finish(
+    mut summary: Summary,
+    report: ReportRun,
+    seed_notes: Vec<String>,
+    out: &std::path::Path,
+    verbosity: Verbosity,
+    start: Instant,
+) -> Result<i32> {
     for (scene, note) in summary.scenes.iter_mut().zip(seed_notes) {
         scene.notes.push(note);
     }
@@ -111,7 +149,7 @@ pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
             if summary.passed { "PASSED" } else { "FAILED" },
             summary.budget,
             summary.alpha,
-            args.out.join("index.html").display(),
+            out.join("index.html").display(),
             summary.run_id
         );
     }

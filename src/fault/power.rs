@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::output::io::{CsvWriter, write_atomic, write_json};
 use crate::scene::builtin::find as find_builtin;
 use crate::scene::{Budget, Scene};
-use crate::verify::{VerifyOptions, run_verification};
+use crate::verify::{Ensembles, VerifyOptions, run_verification};
 use crate::work::WorkLimits;
 use serde::Serialize;
 use statrs::distribution::{Beta, ContinuousCDF};
@@ -241,6 +241,7 @@ fn verify_once(scene: Scene, opts: &PowerOptions, scratch: &std::path::Path) -> 
         alpha: opts.alpha,
         progress: crate::progress::ProgressOptions::HIDDEN,
         limits: WorkLimits::default(),
+        ensembles: Ensembles::Simulate,
     });
     match result {
         Ok((summary, _report)) if summary.passed => Outcome::Passed,

@@ -534,6 +534,23 @@ impl CompressionRun {
         sampled_steps: &[u64],
         tick: impl Fn() + Sync,
     ) -> Result<Vec<Vec<ForceRecord>>> {
+        self.simulate_share_per_point(seed, 0..trajectories.max(1) as u64, sampled_steps, tick)
+    }
+
+    /// [`Self::simulate_ensemble_per_point`] for the trajectories `range` of every strain
+    /// only (one shard's share, [`crate::shard`]): strain `i`, trajectory `j` draws from
+    /// `trajectory_rng(seed(i), j)` as in the whole ensemble, so the records are those of
+    /// the whole ensemble's trajectories `range`, bit for bit.
+    ///
+    /// # Errors
+    /// As [`Self::simulate_ensemble_per_point`].
+    pub fn simulate_share_per_point(
+        &self,
+        seed: impl Fn(usize) -> u64 + Sync,
+        range: std::ops::Range<u64>,
+        sampled_steps: &[u64],
+        tick: impl Fn() + Sync,
+    ) -> Result<Vec<Vec<ForceRecord>>> {
         if sampled_steps.len() != self.points() {
             return Err(Error::invalid(
                 "sampled steps per strain",
@@ -541,14 +558,17 @@ impl CompressionRun {
                 format!("one entry per strain ({})", self.points()),
             ));
         }
-        let nt = trajectories.max(1);
-        let flat = crate::dynamics::par_indexed((self.points() * nt) as u64, |t| {
-            let (i, j) = (t as usize / nt, t % nt as u64);
+        let nt = range.end.saturating_sub(range.start);
+        if nt == 0 {
+            return Ok(vec![Vec::new(); self.points()]);
+        }
+        let flat = crate::dynamics::par_indexed(self.points() as u64 * nt, |t| {
+            let (i, j) = ((t / nt) as usize, range.start + t % nt);
             let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps[i]);
             tick();
             rec
         })?;
-        Ok(flat.chunks(nt).map(<[_]>::to_vec).collect())
+        Ok(flat.chunks(nt as usize).map(<[_]>::to_vec).collect())
     }
 
     /// The step search of a budget by target precision at strain `point` (see

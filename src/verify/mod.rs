@@ -16,7 +16,8 @@ pub mod compression;
 pub mod data;
 pub mod oracle;
 pub mod runner;
+pub mod shard;
 pub mod summary;
 
-pub use runner::{VerifyOptions, check_data, projected_work, run_verification};
+pub use runner::{Ensembles, VerifyOptions, check_data, projected_work, run_verification};
 pub use summary::{CheckResult, SceneSummary, Summary};

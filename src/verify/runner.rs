@@ -42,12 +42,14 @@ use crate::output::{AxisUnits, Figure, Provenance, ReportRun, Series, SeriesStyl
 use crate::params::physical::units_note;
 use crate::progress::{Progress, ProgressOptions};
 use crate::rng::derive_seed;
+use crate::scene::compression::ForceRecord;
 use crate::scene::compression::{
     CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
     StepChoice, force_estimates_diagnosed, targeted_duration,
 };
 use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
 use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scene};
+use crate::shard::{Shard, ShardSet};
 use crate::spectral::HingedBeam;
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
@@ -75,6 +77,19 @@ pub struct VerifyOptions {
     /// The caps on the projected work and memory of all the scenes
     /// ([`projected_work`]), checked before anything runs.
     pub limits: WorkLimits,
+    /// Where the runs' trajectories come from: simulated here, or read from shards.
+    pub ensembles: Ensembles,
+}
+
+/// Where a verification's trajectories come from (issue #15, [`crate::shard`]).
+#[derive(Debug, Clone, Default)]
+pub enum Ensembles {
+    /// Every trajectory simulated by this process.
+    #[default]
+    Simulate,
+    /// Every run's records read from a complete set of shards (`merge`), in trajectory
+    /// order: nothing is simulated, and the outputs are those of [`Ensembles::Simulate`].
+    Merge(std::sync::Arc<ShardSet>),
 }
 
 /// The projected work of verifying `scenes` at `budget`: every run of every scene, one
@@ -114,21 +129,13 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes = &opts.scenes;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
-    let work = projected_work(scenes, opts.budget);
-    opts.limits.check(&work)?;
-    // Prepare every run first so that bad input is reported before any long work.
-    let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
-    for (scene, work) in scenes.iter().zip(&prepared) {
-        if let Prepared::Linear(runs, oracles) = work {
-            // A run whose references fail the oracle is not simulated: its sampling
-            // plan (from wrong rates) is not the user's to fix.
-            for (k, run) in runs.iter().enumerate() {
-                if oracles[k].passed() {
-                    check_sample_counts(scene, k, run, opts.budget)?;
-                }
-            }
-        }
+    let mut work = projected_work(scenes, opts.budget);
+    if let Ensembles::Merge(_) = opts.ensembles {
+        // Nothing is simulated: the progress is the reading of the shards.
+        work.parts.clear();
     }
+    opts.limits.check(&work)?;
+    let prepared = prepare_all(scenes, opts.budget)?;
     let report = ReportRun::begin(&opts.out, "verify", MANIFEST, &ENTRY_POINTS)?;
     report.set_provenance(provenance)?;
     let bar = Progress::new(opts.progress, work.dof_steps(), "DOF-steps");
@@ -161,6 +168,27 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         provenance: report.provenance_ref(),
     };
     Ok((summary, report))
+}
+
+/// Prepares every run of every scene and checks, before any long work, that the budget
+/// gives each check the samples it needs ([`check_sample_counts`]).
+///
+/// # Errors
+/// As [`prepare`] and [`check_sample_counts`].
+pub(super) fn prepare_all(scenes: &[Scene], budget: Budget) -> Result<Vec<Prepared>> {
+    let prepared = scenes.iter().map(prepare).collect::<Result<Vec<_>>>()?;
+    for (scene, work) in scenes.iter().zip(&prepared) {
+        if let Prepared::Linear(runs, oracles) = work {
+            // A run whose references fail the oracle is not simulated: its sampling
+            // plan (from wrong rates) is not the user's to fix.
+            for (k, run) in runs.iter().enumerate() {
+                if oracles[k].passed() {
+                    check_sample_counts(scene, k, run, budget)?;
+                }
+            }
+        }
+    }
+    Ok(prepared)
 }
 
 /// The run `k` of `scene` as named in a run failure: file, index and name.
@@ -273,7 +301,7 @@ fn check_sample_counts(scene: &Scene, k: usize, run: &LinearRun, budget: Budget)
 
 /// The prepared work of one scene: the runs, their exact references and the oracle's
 /// verdict on those references ([`oracle`]).
-enum Prepared {
+pub(super) enum Prepared {
     /// A linear scene: its runs and, per run, the oracle of its references.
     Linear(Vec<LinearRun>, Vec<Oracle>),
     /// A compression scene: the exact theory, its oracle, the runs.
@@ -323,7 +351,7 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
 
 /// Starts run `k` of `scene` on `bar`: labelled `scene/run`, of its projected work at
 /// `budget` ([`Scene::projected_work`]).
-fn begin_run(bar: &Progress, scene: &Scene, k: usize, budget: Budget) {
+pub(super) fn begin_run(bar: &Progress, scene: &Scene, k: usize, budget: Budget) {
     let work = scene
         .projected_work(budget)
         .get(k)
@@ -426,23 +454,11 @@ fn run_compression_scene(
     }
     let mut estimates = Vec::new();
     let mut largest_slope: Option<(String, (f64, f64))> = None;
-    let mut fig = force_strain_figure(scene, theory);
-    // Steps chosen by a step search, per run: the second run of the Δt-halving pair runs
-    // at half the first run's steps.
-    let mut chosen: Vec<Option<Vec<f64>>> = Vec::new();
-    for (k, run) in runs.iter().enumerate() {
+    // Each run's points in the scene's force–strain figure.
+    let mut points: Vec<Series> = Vec::new();
+    for_compression_runs(scene, runs, |k, run| {
         begin_run(bar, scene, k, opts.budget);
-        let inherited = halved_steps(scene, runs, &chosen, k);
-        let halved;
-        let run = match inherited {
-            Some(dts) => {
-                halved = run.with_steps(&dts)?;
-                &halved
-            }
-            None => run,
-        };
         let (est, slope, steps) = run_compression(scene, theory, k, run, opts, bar, &mut outputs)?;
-        chosen.push(steps);
         if let Some((s, x, i)) = slope
             && largest_slope.as_ref().is_none_or(|l| s > l.1.0)
         {
@@ -461,7 +477,7 @@ fn run_compression_scene(
             dir.join(format!("{}-force-strain.csv", run.spec.name))
         };
         outputs.write_table(path, &FORCE_STRAIN_HEADER, &rows)?;
-        fig = fig.series(
+        points.push(
             Series::markers(
                 format!("simulated: {} (±1 s.e.)", run.spec.name),
                 rows.iter().map(|r| (r[0], r[1])).collect(),
@@ -477,13 +493,17 @@ fn run_compression_scene(
             });
         }
         estimates.push(est);
-    }
+        Ok(steps)
+    })?;
     let halving = scene_halving_check(scene, runs, &estimates)
         .map_err(|e| Error::run_failed(scene.path.display().to_string(), "dt-halving check", e))?;
     if let Some((check, note)) = halving {
         outputs.checks.push(check);
         outputs.notes.push(note);
     }
+    let fig = points
+        .into_iter()
+        .fold(force_strain_figure(scene, theory), Figure::series);
     outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
     let fig2 = fig2_figure(curves);
     outputs.write_figure(&fig2, opts.out.join("fig2.svg"))?;
@@ -511,6 +531,27 @@ fn add_slope_status(scene: &Scene, summary: &mut SceneSummary, what: &str, slope
     } else {
         summary.warnings.push(text);
     }
+}
+
+/// Calls `each(k, run)` on the runs of a compression scene in order, the second run of
+/// the Δt-halving pair at half the steps that the first chose by a step search
+/// ([`halved_steps`]); `each` returns the steps its run chose by a step search, if any.
+///
+/// # Errors
+/// The first error of `each`, or of the halved run's set-up.
+pub(super) fn for_compression_runs(
+    scene: &Scene,
+    runs: &[CompressionRun],
+    mut each: impl FnMut(usize, &CompressionRun) -> Result<Option<Vec<f64>>>,
+) -> Result<()> {
+    let mut chosen: Vec<Option<Vec<f64>>> = Vec::new();
+    for (k, run) in runs.iter().enumerate() {
+        let halved = halved_steps(scene, runs, &chosen, k)
+            .map(|dts| run.with_steps(&dts))
+            .transpose()?;
+        chosen.push(each(k, halved.as_ref().unwrap_or(run))?);
+    }
+    Ok(())
 }
 
 /// The steps of run `k` if it is the second run of the scene's Δt-halving pair and the
@@ -546,31 +587,14 @@ fn run_compression(
     outputs: &mut SceneOutputs<'_>,
 ) -> Result<(ForceEstimates, Option<RmsSlope>, Option<Vec<f64>>)> {
     let e = run.spec.ensemble(opts.budget);
-    let tick = tick_work(bar, run, &e);
-    let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
-    let searched;
-    let (records, plan, run) = match e.precision_target() {
-        None => {
-            let steps: Vec<u64> = (0..run.points())
-                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
-                .collect();
-            let records = run
-                .simulate_ensemble_per_point(seed, e.trajectories, &steps, || bar.advance(tick))
-                .map_err(|e| simulation_error(scene, k, e))?;
-            (records, None, run)
+    let (records, plan) = match &opts.ensembles {
+        Ensembles::Simulate => {
+            simulate_compression(scene, k, run, &e, opts.budget, bar, Shard::WHOLE)?
         }
-        Some(target) => {
-            let (plan, adapted) = targeted_plan(scene, k, run, &e, target, opts.budget, bar)?;
-            searched = adapted;
-            let run = searched.as_ref().unwrap_or(run);
-            let records = run
-                .simulate_ensemble_per_point(seed, e.trajectories, &plan.main_steps, || {
-                    bar.advance(tick)
-                })
-                .map_err(|e| simulation_error(scene, k, e))?;
-            (records, Some(plan), run)
-        }
+        Ensembles::Merge(set) => super::shard::merged_compression(set, scene, run, &e)?,
     };
+    let adapted = adapted_run(run, plan.as_ref())?;
+    let run = adapted.as_ref().unwrap_or(run);
     let budget_key = match plan {
         None => format!("{}.duration_tau1", opts.budget.name()),
         Some(_) => format!("{}.max_duration_tau1", opts.budget.name()),
@@ -595,6 +619,59 @@ fn run_compression(
     Ok((est, slope, steps))
 }
 
+/// Simulates shard `shard`'s share of the trajectories of compression run `k` at
+/// ensemble `e` (every trajectory for [`Shard::WHOLE`]); returns the records per strain
+/// and, for a budget by target precision, its plan (step search and pilot, run in full
+/// whatever the shard: the plan depends on the scene alone).
+///
+/// # Errors
+/// As [`simulate_error`] and [`targeted_plan`].
+pub(super) fn simulate_compression(
+    scene: &Scene,
+    k: usize,
+    run: &CompressionRun,
+    e: &Ensemble,
+    budget: Budget,
+    bar: &Progress,
+    shard: Shard,
+) -> Result<(Vec<Vec<ForceRecord>>, Option<TargetedPlan>)> {
+    let tick = tick_work(bar, run, e);
+    let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
+    let range = shard.range(e.trajectories.max(1) as u64);
+    let (steps, plan) = match e.precision_target() {
+        None => {
+            let steps: Vec<u64> = (0..run.points())
+                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
+                .collect();
+            (steps, None)
+        }
+        Some(target) => {
+            let plan = targeted_plan(scene, k, run, e, target, budget, bar)?;
+            (plan.main_steps.clone(), Some(plan))
+        }
+    };
+    let adapted = adapted_run(run, plan.as_ref())?;
+    let records = adapted
+        .as_ref()
+        .unwrap_or(run)
+        .simulate_share_per_point(seed, range, &steps, || bar.advance(tick))
+        .map_err(|e| simulation_error(scene, k, e))?;
+    Ok((records, plan))
+}
+
+/// `run` at the steps its plan's step search chose, if it has one.
+///
+/// # Errors
+/// As [`CompressionRun::with_steps`].
+fn adapted_run(
+    run: &CompressionRun,
+    plan: Option<&TargetedPlan>,
+) -> Result<Option<CompressionRun>> {
+    plan.and_then(|p| p.search.as_ref())
+        .map(|s| run.with_steps(&s.iter().map(|c| c.dt_tau1).collect::<Vec<_>>()))
+        .transpose()
+}
+
 /// The work of one trajectory at one strain of compression run `run` at ensemble `e`, for
 /// the progress: the run's projected work shared equally among its trajectories (times
 /// two stages, pilot and main, for a budget by target precision).
@@ -604,19 +681,20 @@ fn tick_work(bar: &Progress, run: &CompressionRun, e: &Ensemble) -> f64 {
 }
 
 /// The pilot of a budget by target precision and the main-stage durations it chose.
-struct TargetedPlan {
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct TargetedPlan {
     /// The target (F_c0, τ1).
-    target: PrecisionTarget,
+    pub(super) target: PrecisionTarget,
     /// Sampled duration of each pilot trajectory actually run (τ1).
-    pilot_tau1: f64,
+    pub(super) pilot_tau1: f64,
     /// The pilot's standard error of ⟨F⟩/F_c0 per strain.
-    pilot_std_error: Vec<f64>,
+    pub(super) pilot_std_error: Vec<f64>,
     /// Main-stage sampled duration per strain (τ1).
-    main_tau1: Vec<f64>,
+    pub(super) main_tau1: Vec<f64>,
     /// Main-stage sampled steps per strain.
-    main_steps: Vec<u64>,
+    pub(super) main_steps: Vec<u64>,
     /// The step search per strain, if the budget has one.
-    search: Option<Vec<StepChoice>>,
+    pub(super) search: Option<Vec<StepChoice>>,
 }
 
 /// Runs the pilot of a budget by target precision at every strain — `trajectories` ×
@@ -632,7 +710,7 @@ fn targeted_plan(
     target: PrecisionTarget,
     budget: Budget,
     bar: &Progress,
-) -> Result<(TargetedPlan, Option<CompressionRun>)> {
+) -> Result<TargetedPlan> {
     let tau1 = scene.filament.tau1();
     let name = &run.spec.name;
     let tick = tick_work(bar, run, e);
@@ -680,15 +758,14 @@ fn targeted_plan(
         .enumerate()
         .map(|(i, &n)| n as f64 * run.dt_at(i) / tau1)
         .collect();
-    let plan = TargetedPlan {
+    Ok(TargetedPlan {
         target,
         pilot_tau1,
         pilot_std_error,
         main_tau1,
         main_steps,
         search,
-    };
-    Ok((plan, adapted))
+    })
 }
 
 /// The note of a budget by target precision: pilot, chosen durations, the strains that
@@ -983,7 +1060,7 @@ fn run_scene(
             continue;
         }
         let e = run.spec.ensemble(opts.budget);
-        let (records, two_time) = simulate_linear(scene, k, run, &e, bar)?;
+        let (records, two_time) = linear_sample(opts, scene, k, run, &e, bar)?;
         let budget_key = format!("{}.duration_tau1", opts.budget.name());
         let est = apply_linear_checks(scene, run, &records, &two_time, &mut outputs)
             .map_err(|e| estimation_error(scene, k, "checks", &budget_key, e))?;
@@ -1189,12 +1266,13 @@ fn check_compression_data(
 
 /// Simulates run `k` of a linear scene with ensemble `e`: the full trajectories, and the
 /// two-time products of all trajectories (the full ones, then the extra short ones).
-fn simulate_linear(
+pub(super) fn simulate_linear(
     scene: &Scene,
     k: usize,
     run: &LinearRun,
     e: &Ensemble,
     bar: &Progress,
+    shard: Shard,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let seed = derive_seed(scene.seed, &run.spec.name);
     let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
@@ -1209,17 +1287,42 @@ fn simulate_linear(
     let extra_work = scene.run_work(k, e, None).dof_steps - full_work;
     let per_full = full_work / e.trajectories.max(1) as f64;
     let per_extra = extra_work / e.two_time_trajectories.max(1) as f64;
+    let own = shard.range(full);
     let records = run
-        .simulate_ensemble(seed, 0, full, steps, |n| bar.advance(n as f64 * per_full))
+        .simulate_ensemble(seed, own.start, own.end - own.start, steps, |n| {
+            bar.advance(n as f64 * per_full)
+        })
         .map_err(|e| simulation_error(scene, k, e))?;
+    let own = shard.range(e.two_time_trajectories as u64);
     let extra: Vec<Vec<f64>> = run
-        .simulate_ensemble(seed, full, e.two_time_trajectories as u64, 0, |n| {
+        .simulate_ensemble(seed, full + own.start, own.end - own.start, 0, |n| {
             bar.advance(n as f64 * per_extra)
         })
         .map_err(|e| simulation_error(scene, k, e))?
         .into_iter()
         .map(|r| r.two_time)
         .collect();
+    Ok((records, extra))
+}
+
+/// The trajectories of linear run `k` at ensemble `e`, simulated or read from shards
+/// (`opts.ensembles`): the records and the two-time products of every trajectory, the
+/// full trajectories' first and then the extra two-time trajectories'.
+///
+/// # Errors
+/// As [`simulate_linear`] and [`super::shard::merged_linear`].
+fn linear_sample(
+    opts: &VerifyOptions,
+    scene: &Scene,
+    k: usize,
+    run: &LinearRun,
+    e: &Ensemble,
+    bar: &Progress,
+) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
+    let (records, extra) = match &opts.ensembles {
+        Ensembles::Simulate => simulate_linear(scene, k, run, e, bar, Shard::WHOLE)?,
+        Ensembles::Merge(set) => super::shard::merged_linear(set, scene, run, e)?,
+    };
     let two_time = records
         .iter()
         .map(|r| r.two_time.clone())

@@ -1,0 +1,69 @@
+//! `langevin-fem merge`: the report of a run split into shards (`--shard I/N`), from the
+//! shards' records, byte for byte the report of the same run made in one process (wall
+//! times, run id and provenance aside). See [`langevin_fem::shard`].
+
+use super::Verbosity;
+use clap::Args;
+use langevin_fem::error::Result;
+use langevin_fem::shard::ShardSet;
+use langevin_fem::verify::shard::{COMMAND, settings_of};
+use langevin_fem::verify::{Ensembles, VerifyOptions, run_verification};
+use langevin_fem::work::WorkLimits;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The examples of `merge --help`.
+const EXAMPLES: &str = "\
+Examples:
+  langevin-fem verify -b full --shard 1/2 -o shards/1      (one process or array task each)
+  langevin-fem verify -b full --shard 2/2 -o shards/2
+  langevin-fem merge shards/1 shards/2 -o reports          the report of the whole run
+  langevin-fem merge shards -o reports                     the same: every shard under shards/
+
+Refused (exit 2, naming the shard): a missing or duplicated shard, shards of other scenes,
+seeds, budgets or builds, a damaged record file. The exit code is otherwise verify's: 0 if
+every check passed, 1 if one failed.";
+
+/// Command-line arguments of `langevin-fem merge`.
+#[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
+pub struct MergeArgs {
+    /// Shard directories (each with a shard.json), or directories whose sub-directories
+    /// are shards; together exactly the shards 1/N … N/N of one run.
+    #[arg(required = true, value_name = "DIR")]
+    shards: Vec<PathBuf>,
+    /// Output directory of the merged report (summary.json, index.html, tables, figures).
+    #[arg(short, long, default_value = "reports")]
+    pub(super) out: PathBuf,
+}
+
+/// Opens the shard set, checks it, and writes the whole run's report to `--out`.
+///
+/// # Errors
+/// Exit 2 for a shard set that is not one complete, consistent set
+/// ([`ShardSet::open`]); as `verify` otherwise.
+pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
+    let start = Instant::now();
+    let set = ShardSet::open(&args.shards, COMMAND)?;
+    let (budget, alpha) = settings_of(&set)?;
+    let (scenes, seed_notes): (Vec<_>, Vec<_>) = set.scenes()?.into_iter().unzip();
+    if verbosity.shows_progress() {
+        eprintln!(
+            "merging {} shards of verify (budget {}, {} scene(s))",
+            set.shards.len(),
+            budget.name(),
+            scenes.len()
+        );
+    }
+    let (summary, report) = run_verification(&VerifyOptions {
+        scenes,
+        budget,
+        out: args.out.clone(),
+        alpha,
+        progress: verbosity.progress(),
+        limits: WorkLimits::default(),
+        ensembles: Ensembles::Merge(Arc::new(set)),
+    })?;
+    super::verify::finish(summary, report, seed_notes, &args.out, verbosity, start)
+}

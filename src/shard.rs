@@ -1,0 +1,631 @@
+//! Shards (issue #15): one command's ensembles split across processes or machines, and
+//! merged back exactly.
+//!
+//! `--shard I/N` (1 ≤ I ≤ N) makes a process simulate only its share of every run's
+//! trajectories: of `T` trajectories, shard `I` takes the contiguous range
+//! `⌊(I−1)T/N⌋ .. ⌊IT/N⌋` ([`Shard::range`]), so the shards' ranges tile `0..T` in order
+//! and a shard may be empty when `N > T`. Every trajectory's random stream depends only
+//! on the scene seed, the run and the trajectory index ([`crate::rng`]), so trajectory
+//! `j` is the same bits whichever process simulates it.
+//!
+//! A shard writes, under its output directory, the per-trajectory sufficient statistics
+//! of each run that the checks need (`records/<scene>/<run>.<ext>`, bit for bit, see
+//! [`crate::scene::records`]) and, last, the manifest [`SHARD_MANIFEST`]: the command,
+//! the shard `I/N`, the build (version and commit), the command's settings (budget, α),
+//! every scene's text, SHA-256 and seed, and every record file with its size, SHA-256
+//! and trajectory range. A directory without the manifest is an unfinished shard.
+//!
+//! `langevin-fem merge DIR...` opens the shards ([`ShardSet::open`]) and refuses (exit
+//! 2, naming the directory and what differs) shards of another command, build, scene
+//! text, seed, setting or shard count, a missing or duplicated shard index, and a record
+//! file whose size or SHA-256 is not the manifest's. The command then runs as an
+//! unsharded run would, with every run's records read from the shards in trajectory
+//! order instead of simulated: its outputs are the unsharded run's, byte for byte, apart
+//! from the wall times, run id and provenance.
+
+use crate::error::{Error, Result};
+use crate::output::io::write_json;
+use crate::output::provenance::{Provenance, SceneProvenance, VERSION_LINE};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::ops::Range;
+use std::path::{Component, Path, PathBuf};
+use std::str::FromStr;
+
+/// File name of a shard's manifest, written last.
+pub const SHARD_MANIFEST: &str = "shard.json";
+/// The `format` field of a shard manifest.
+pub const SHARD_FORMAT: &str = "langevin-fem shard";
+/// The version of the shard format (bumped when a reader of the old one would misread).
+pub const SHARD_FORMAT_VERSION: u32 = 1;
+/// The largest shard count `N` of `--shard I/N`.
+pub const MAX_SHARDS: usize = 1_000_000;
+/// The directory of a shard's record files, under its output directory.
+pub const RECORDS_DIR: &str = "records";
+
+/// Shard `index` of `count` (1-based: `1/4` … `4/4`), as in `--shard I/N`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Shard {
+    /// The shard's index, in `1..=count`.
+    pub index: usize,
+    /// The number of shards.
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole ensemble: shard 1 of 1.
+    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
+
+    /// This shard's share of `total` trajectories: `⌊(I−1)·total/N⌋ .. ⌊I·total/N⌋`.
+    /// The shards `1/N … N/N` tile `0..total` in order, with sizes differing by at
+    /// most one.
+    pub fn range(self, total: u64) -> Range<u64> {
+        let at = |i: usize| (u128::from(total) * i as u128 / self.count as u128) as u64;
+        at(self.index - 1)..at(self.index)
+    }
+
+    /// The fraction `1/N` of the work this shard does (for progress and work caps).
+    pub fn fraction(self) -> f64 {
+        1.0 / self.count as f64
+    }
+
+    /// Whether this is the whole ensemble (`1/1`).
+    pub fn is_whole(self) -> bool {
+        self.count == 1
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl FromStr for Shard {
+    type Err = String;
+
+    /// Parses `I/N` with `1 ≤ I ≤ N ≤` [`MAX_SHARDS`]; the error names what is allowed.
+    fn from_str(s: &str) -> std::result::Result<Shard, String> {
+        let allowed = format!(
+            "I/N with integers 1 <= I <= N <= {MAX_SHARDS} (shard I of N, e.g. 2/4; under Slurm: $SLURM_ARRAY_TASK_ID/N with --array=1-N)"
+        );
+        let (i, n) = s.split_once('/').ok_or_else(|| allowed.clone())?;
+        let (Ok(index), Ok(count)) = (i.trim().parse::<usize>(), n.trim().parse::<usize>()) else {
+            return Err(allowed);
+        };
+        if index < 1 || index > count || count > MAX_SHARDS {
+            return Err(allowed);
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+/// A scene as a shard ran it: enough to rebuild it exactly at the merge.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ShardScene {
+    /// The scene's name.
+    pub name: String,
+    /// The scene's file path, or the label of a built-in scene.
+    pub source: String,
+    /// The scene text as parsed.
+    pub text: String,
+    /// SHA-256 of `text`.
+    pub sha256: String,
+    /// The master seed as run (after `--seed`).
+    pub seed: u64,
+    /// The report's note on the seed ([`crate::verify`]'s callers add it).
+    pub seed_note: String,
+}
+
+impl ShardScene {
+    /// `scene` as run, with the report's note on its seed.
+    pub fn of(scene: &Scene, seed_note: &str) -> ShardScene {
+        ShardScene {
+            name: scene.name.clone(),
+            source: scene.path.to_string_lossy().into_owned(),
+            text: scene.source_text.clone(),
+            sha256: SceneProvenance::hash(&scene.source_text),
+            seed: scene.seed,
+            seed_note: seed_note.to_string(),
+        }
+    }
+
+    /// The scene rebuilt from its text, with the seed as run.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if the text no longer parses (a manifest edited by hand).
+    pub fn scene(&self) -> Result<Scene> {
+        let mut scene = Scene::parse_named(&self.text, Path::new(&self.source), &self.name)?;
+        scene.seed = self.seed;
+        Ok(scene)
+    }
+}
+
+/// One record file of a shard: one run's share of trajectories.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardFile {
+    /// The scene.
+    pub scene: String,
+    /// The run.
+    pub run: String,
+    /// Path relative to the shard directory (`records/<scene>/<run>.<ext>`).
+    pub path: String,
+    /// Size in bytes.
+    pub bytes: u64,
+    /// SHA-256 of the content.
+    pub sha256: String,
+    /// The trajectories of this shard: `first..first + count` (per strain for a
+    /// compression run).
+    pub first: u64,
+    /// Number of trajectories.
+    pub count: u64,
+    /// What every shard computes in full and the merge needs (e.g. the plan of a budget
+    /// by target precision); equal in every shard of a set.
+    #[serde(default, skip_serializing_if = "serde_json::Value::is_null")]
+    pub common: serde_json::Value,
+}
+
+/// A shard's manifest ([`SHARD_MANIFEST`]).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShardManifest {
+    /// [`SHARD_FORMAT`].
+    pub format: String,
+    /// [`SHARD_FORMAT_VERSION`].
+    pub format_version: u32,
+    /// The build ([`VERSION_LINE`]: version, commit, dirty).
+    pub build: String,
+    /// The command (`verify`).
+    pub command: String,
+    /// This shard.
+    pub shard: Shard,
+    /// The command's settings that shape the results (budget, α, …); equal in every
+    /// shard of a set.
+    pub settings: serde_json::Value,
+    /// The scenes, in the order run.
+    pub scenes: Vec<ShardScene>,
+    /// The record files, in the order written.
+    pub files: Vec<ShardFile>,
+    /// The shard process's provenance (its command line and wall time; not compared).
+    pub provenance: Provenance,
+}
+
+/// A shard being written: record files first, the manifest last ([`ShardWriter::finish`]).
+#[derive(Debug)]
+pub struct ShardWriter {
+    dir: PathBuf,
+    manifest: ShardManifest,
+}
+
+impl ShardWriter {
+    /// Starts shard `shard` of `command` in `dir`, removing an earlier manifest there
+    /// first (so that an interrupted shard is never taken for a finished one).
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the earlier manifest cannot be removed.
+    pub fn begin(
+        dir: &Path,
+        command: &str,
+        shard: Shard,
+        settings: serde_json::Value,
+        scenes: Vec<ShardScene>,
+        provenance: Provenance,
+    ) -> Result<ShardWriter> {
+        let old = dir.join(SHARD_MANIFEST);
+        match std::fs::remove_file(&old) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&old, e)),
+            _ => {}
+        }
+        Ok(ShardWriter {
+            dir: dir.to_path_buf(),
+            manifest: ShardManifest {
+                format: SHARD_FORMAT.to_string(),
+                format_version: SHARD_FORMAT_VERSION,
+                build: VERSION_LINE.to_string(),
+                command: command.to_string(),
+                shard,
+                settings,
+                scenes,
+                files: Vec::new(),
+                provenance,
+            },
+        })
+    }
+
+    /// This shard.
+    pub fn shard(&self) -> Shard {
+        self.manifest.shard
+    }
+
+    /// Writes one run's records (`bytes`, trajectories `range`) atomically as
+    /// `records/<scene>/<run>.<ext>` and lists it, with `common`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the file cannot be written.
+    pub fn write(
+        &mut self,
+        (scene, run, ext): (&str, &str, &str),
+        range: Range<u64>,
+        bytes: &[u8],
+        common: serde_json::Value,
+    ) -> Result<()> {
+        let rel = format!("{RECORDS_DIR}/{scene}/{run}.{ext}");
+        crate::output::io::write_atomic(&self.dir.join(&rel), bytes)?;
+        self.manifest.files.push(ShardFile {
+            scene: scene.to_string(),
+            run: run.to_string(),
+            path: rel,
+            bytes: bytes.len() as u64,
+            sha256: sha256_hex(bytes),
+            first: range.start,
+            count: range.end - range.start,
+            common,
+        });
+        Ok(())
+    }
+
+    /// Writes the manifest (atomically, last) and returns it.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if it cannot be written.
+    pub fn finish(mut self) -> Result<ShardManifest> {
+        self.manifest.provenance.finish();
+        write_json(&self.dir.join(SHARD_MANIFEST), &self.manifest)?;
+        Ok(self.manifest)
+    }
+}
+
+/// The SHA-256 of `bytes` in lower-case hex.
+fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::{Digest, Sha256};
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// A complete, consistent set of shards `1/N … N/N` of one command, opened for the merge.
+#[derive(Debug, Clone)]
+pub struct ShardSet {
+    /// Each shard's directory and manifest, in shard order.
+    pub shards: Vec<(PathBuf, ShardManifest)>,
+}
+
+/// Refusal of a shard set (exit 2): names the manifest, the key and what is wrong.
+fn refuse(dir: &Path, key: &str, message: String) -> Error {
+    Error::Scene {
+        file: dir.join(SHARD_MANIFEST),
+        key: key.to_string(),
+        message,
+    }
+}
+
+impl ShardSet {
+    /// The shard directories named by `dirs`: each a shard directory (with a
+    /// [`SHARD_MANIFEST`]) or a directory whose sub-directories are shards.
+    fn expand(dirs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+        let mut out = Vec::new();
+        for dir in dirs {
+            if dir.join(SHARD_MANIFEST).is_file() {
+                out.push(dir.clone());
+                continue;
+            }
+            let entries = std::fs::read_dir(dir).map_err(|e| {
+                refuse(
+                    dir,
+                    "-",
+                    format!("cannot read the directory {}: {e}", dir.display()),
+                )
+            })?;
+            let mut subs: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.join(SHARD_MANIFEST).is_file())
+                .collect();
+            if subs.is_empty() {
+                return Err(refuse(
+                    dir,
+                    "-",
+                    format!(
+                        "no {SHARD_MANIFEST} in {} nor in its sub-directories: not a shard (an unfinished shard has no manifest yet; rerun it)",
+                        dir.display()
+                    ),
+                ));
+            }
+            subs.sort();
+            out.extend(subs);
+        }
+        Ok(out)
+    }
+
+    /// Reads a manifest.
+    fn read_manifest(dir: &Path) -> Result<ShardManifest> {
+        let path = dir.join(SHARD_MANIFEST);
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let m: ShardManifest = serde_json::from_str(&text)
+            .map_err(|e| refuse(dir, "-", format!("not a shard manifest: {e}")))?;
+        if m.format != SHARD_FORMAT || m.format_version != SHARD_FORMAT_VERSION {
+            return Err(refuse(
+                dir,
+                "format_version",
+                format!(
+                    "{} version {}; this build reads {SHARD_FORMAT} version {SHARD_FORMAT_VERSION}",
+                    m.format, m.format_version
+                ),
+            ));
+        }
+        Ok(m)
+    }
+
+    /// Opens the shards in `dirs` (shard directories, or directories of them) of
+    /// `command`, and checks that they are one complete set.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming the shard's manifest: not a shard; another format,
+    /// command, build (also than this merge's), shard count, setting, scene or seed than
+    /// the first shard; a duplicated index (naming both directories); missing indices.
+    pub fn open(dirs: &[PathBuf], command: &str) -> Result<ShardSet> {
+        let mut shards: Vec<(PathBuf, ShardManifest)> = Vec::new();
+        for dir in Self::expand(dirs)? {
+            let m = Self::read_manifest(&dir)?;
+            if m.command != command {
+                return Err(refuse(
+                    &dir,
+                    "command",
+                    format!("a shard of `{}`, not of `{command}`", m.command),
+                ));
+            }
+            if m.build != VERSION_LINE {
+                return Err(refuse(
+                    &dir,
+                    "build",
+                    format!(
+                        "written by langevin-fem {}, but this is {VERSION_LINE}: merge with the build that ran the shards",
+                        m.build
+                    ),
+                ));
+            }
+            if let Some((first_dir, first)) = shards.first() {
+                same_set(&dir, &m, first_dir, first)?;
+            }
+            if let Some((other, _)) = shards.iter().find(|(_, o)| o.shard == m.shard) {
+                return Err(refuse(
+                    &dir,
+                    "shard",
+                    format!(
+                        "shard {} given twice: in {} and in {}",
+                        m.shard,
+                        other.display(),
+                        dir.display()
+                    ),
+                ));
+            }
+            shards.push((dir, m));
+        }
+        shards.sort_by_key(|(_, m)| m.shard.index);
+        let count = shards[0].1.shard.count;
+        let missing: Vec<String> = (1..=count)
+            .filter(|i| !shards.iter().any(|(_, m)| m.shard.index == *i))
+            .map(|i| format!("{i}/{count}"))
+            .collect();
+        if !missing.is_empty() {
+            let shown = missing
+                .iter()
+                .take(20)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ");
+            let more = if missing.len() > 20 {
+                format!(" and {} more", missing.len() - 20)
+            } else {
+                String::new()
+            };
+            return Err(refuse(
+                &shards[0].0,
+                "shard",
+                format!(
+                    "the set of {count} shards is incomplete: missing shard {shown}{more} (given: {} director{})",
+                    shards.len(),
+                    if shards.len() == 1 { "y" } else { "ies" }
+                ),
+            ));
+        }
+        Ok(ShardSet { shards })
+    }
+
+    /// The first shard's manifest: the command's settings and scenes.
+    pub fn manifest(&self) -> &ShardManifest {
+        &self.shards[0].1
+    }
+
+    /// The scenes, rebuilt from their text, and each one's seed note.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if a scene's text does not parse.
+    pub fn scenes(&self) -> Result<Vec<(Scene, String)>> {
+        self.manifest()
+            .scenes
+            .iter()
+            .map(|s| Ok((s.scene()?, s.seed_note.clone())))
+            .collect()
+    }
+
+    /// Every shard's record file of run `run` of scene `scene`, in shard order (hence in
+    /// trajectory order), each with its manifest entry, checked for contiguous ranges,
+    /// size and SHA-256.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming the shard: a file not listed, unreadable, of
+    /// another size or hash; ranges that do not follow one another; a `common` value
+    /// that differs from the first shard's.
+    pub fn read(&self, scene: &str, run: &str) -> Result<Vec<(ShardFile, Vec<u8>)>> {
+        let mut out: Vec<(ShardFile, Vec<u8>)> = Vec::new();
+        for (dir, m) in &self.shards {
+            let key = format!("files[{scene}/{run}]");
+            let entry = m
+                .files
+                .iter()
+                .find(|f| f.scene == scene && f.run == run)
+                .ok_or_else(|| {
+                    refuse(
+                        dir,
+                        &key,
+                        format!(
+                            "shard {} has no records of run {run} of scene {scene}",
+                            m.shard
+                        ),
+                    )
+                })?;
+            let rel = Path::new(&entry.path);
+            if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
+                return Err(refuse(
+                    dir,
+                    &key,
+                    format!(
+                        "path {} leaves the shard directory: a relative path inside it is required",
+                        entry.path
+                    ),
+                ));
+            }
+            let path = dir.join(rel);
+            let bytes = std::fs::read(&path)
+                .map_err(|e| refuse(dir, &key, format!("cannot read {}: {e}", path.display())))?;
+            if bytes.len() as u64 != entry.bytes || sha256_hex(&bytes) != entry.sha256 {
+                return Err(refuse(
+                    dir,
+                    &key,
+                    format!(
+                        "{} is {} bytes with SHA-256 {}, the manifest says {} bytes with {}: damaged or replaced; rerun shard {}",
+                        path.display(),
+                        bytes.len(),
+                        sha256_hex(&bytes),
+                        entry.bytes,
+                        entry.sha256,
+                        m.shard
+                    ),
+                ));
+            }
+            if let Some((prev, _)) = out.last() {
+                if entry.first != prev.first + prev.count {
+                    return Err(refuse(
+                        dir,
+                        &key,
+                        format!(
+                            "trajectories {}..{} do not follow the previous shard's {}..{}",
+                            entry.first,
+                            entry.first + entry.count,
+                            prev.first,
+                            prev.first + prev.count
+                        ),
+                    ));
+                }
+                if entry.common != out[0].0.common {
+                    return Err(refuse(
+                        dir,
+                        &key,
+                        format!(
+                            "shard {} computed another plan for this run than shard {}: not the same inputs or build",
+                            m.shard, self.shards[0].1.shard
+                        ),
+                    ));
+                }
+            }
+            out.push((entry.clone(), bytes));
+        }
+        Ok(out)
+    }
+}
+
+/// Checks that shard `m` (in `dir`) belongs to the set of `first` (in `first_dir`).
+fn same_set(dir: &Path, m: &ShardManifest, first_dir: &Path, first: &ShardManifest) -> Result<()> {
+    let against = format!("{} (shard {})", first_dir.display(), first.shard);
+    if m.shard.count != first.shard.count {
+        return Err(refuse(
+            dir,
+            "shard",
+            format!(
+                "shard {} of a set of {}, but {against} is of a set of {}",
+                m.shard, m.shard.count, first.shard.count
+            ),
+        ));
+    }
+    if m.settings != first.settings {
+        return Err(refuse(
+            dir,
+            "settings",
+            format!("{} differ from {against}'s {}", m.settings, first.settings),
+        ));
+    }
+    let names = |m: &ShardManifest| m.scenes.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+    if names(m) != names(first) {
+        return Err(refuse(
+            dir,
+            "scenes",
+            format!(
+                "scenes [{}], but {against} ran [{}]",
+                names(m).join(", "),
+                names(first).join(", ")
+            ),
+        ));
+    }
+    for (k, (a, b)) in m.scenes.iter().zip(&first.scenes).enumerate() {
+        if a.sha256 != b.sha256 || a.text != b.text || a.source != b.source {
+            return Err(refuse(
+                dir,
+                &format!("scenes[{k}].sha256"),
+                format!(
+                    "scene {} has SHA-256 {}, but {against} ran it with {}: another scene file",
+                    a.name, a.sha256, b.sha256
+                ),
+            ));
+        }
+        if a.seed != b.seed || a.seed_note != b.seed_note {
+            return Err(refuse(
+                dir,
+                &format!("scenes[{k}].seed"),
+                format!(
+                    "scene {} ran with seed {}, but {against} with seed {}",
+                    a.name, a.seed, b.seed
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shards' ranges tile `0..total` in order, sizes differing by at most one,
+    /// including empty shares when there are more shards than trajectories.
+    #[test]
+    fn ranges_tile_the_ensemble() {
+        for total in [0u64, 1, 5, 16, 17, 1000] {
+            for count in [1usize, 2, 3, 4, 7, 16, 40] {
+                let mut next = 0;
+                for index in 1..=count {
+                    let r = Shard { index, count }.range(total);
+                    assert_eq!(r.start, next, "{index}/{count} of {total}");
+                    let size = r.end - r.start;
+                    assert!(size * count as u64 <= total + count as u64, "{size}");
+                    assert!((size + 1) * count as u64 >= total, "{size}");
+                    next = r.end;
+                }
+                assert_eq!(next, total);
+            }
+        }
+        assert_eq!(Shard::WHOLE.range(16), 0..16);
+    }
+
+    /// `I/N` parses with 1 ≤ I ≤ N ≤ MAX_SHARDS; anything else is refused with the rule.
+    #[test]
+    fn shard_flag_parses_and_refuses() {
+        assert_eq!("2/4".parse::<Shard>(), Ok(Shard { index: 2, count: 4 }));
+        assert_eq!(" 1 / 1 ".parse::<Shard>(), Ok(Shard::WHOLE));
+        for bad in ["0/4", "5/4", "2", "a/b", "-1/3", "1/0", "1/2000000", ""] {
+            let e = bad.parse::<Shard>().unwrap_err();
+            assert!(e.contains("1 <= I <= N"), "{bad}: {e}");
+        }
+        assert_eq!(Shard { index: 3, count: 7 }.to_string(), "3/7");
+    }
+}

@@ -1,0 +1,343 @@
+//! A verification split into shards and merged (issue #15; the format and the checks of
+//! a shard set are [`crate::shard`]'s).
+//!
+//! [`write_shard`] is `verify --shard I/N`: it checks the input as a whole run does
+//! (every scene, every run's set-up, the samples each check will get), then simulates
+//! shard `I`'s share of every run that a whole run simulates, and writes each run's
+//! per-trajectory records — no checks, no report. A budget by target precision runs its
+//! step search and pilot in full in every shard (they depend on the scene alone, and
+//! every shard gets the same plan, which the merge checks) and shares the main stage.
+//!
+//! `merge` is [`super::run_verification`] with [`super::runner::Ensembles::Merge`]: the
+//! records of every run are read here ([`merged_linear`], [`merged_compression`]) in
+//! trajectory order, and everything else — references, checks, the family-wise
+//! correction, tables, figures, the report — is the whole run's code on the whole run's
+//! records, so the outputs are the whole run's.
+
+use super::runner::{
+    Prepared, TargetedPlan, VerifyOptions, begin_run, for_compression_runs, prepare_all,
+    projected_work, simulate_compression, simulate_linear,
+};
+use crate::error::{Error, Result};
+use crate::output::Provenance;
+use crate::progress::Progress;
+use crate::scene::compression::{CompressionRun, ForceRecord, StepChoice};
+use crate::scene::linear::{LinearRun, TrajectoryRecord};
+use crate::scene::records::{decode_force, decode_linear, encode_force, encode_linear};
+use crate::scene::{Ensemble, Scene};
+use crate::shard::{Shard, ShardManifest, ShardScene, ShardSet, ShardWriter};
+use serde::{Deserialize, Serialize};
+
+/// The name of the command in a verification shard's manifest.
+pub const COMMAND: &str = "verify";
+/// Extension of a linear run's record file ([`encode_linear`]).
+const LINEAR_EXT: &str = "lin";
+/// Extension of a compression run's record file ([`encode_force`]).
+const FORCE_EXT: &str = "frc";
+
+/// The settings of a verification that shape its results: equal in every shard of a set,
+/// and the merge's.
+fn settings(opts: &VerifyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "budget": opts.budget.name(),
+        "alpha": opts.alpha,
+    })
+}
+
+/// The budget and α of a verification shard set (its manifest's settings).
+///
+/// # Errors
+/// [`Error::Scene`] naming the first shard's manifest if they are missing or invalid.
+pub fn settings_of(set: &ShardSet) -> Result<(crate::scene::Budget, f64)> {
+    let s = &set.manifest().settings;
+    let budget: Option<crate::scene::Budget> = serde_json::from_value(s["budget"].clone()).ok();
+    let alpha = s["alpha"].as_f64();
+    match (budget, alpha) {
+        (Some(b), Some(a)) => Ok((b, a)),
+        _ => Err(Error::Scene {
+            file: set.shards[0].0.join(crate::shard::SHARD_MANIFEST),
+            key: "settings".to_string(),
+            message: format!("{s}: a budget name and a number alpha are required"),
+        }),
+    }
+}
+
+/// Runs shard `shard` of the verification `opts` (see the [module docs](self)) into
+/// `opts.out`; `seed_notes` are the reports' notes on each scene's seed, kept for the
+/// merge. Returns the manifest written.
+///
+/// # Errors
+/// As [`super::run_verification`] before and while it simulates (input: exit 2; a run
+/// failure: exit 3); I/O errors writing the shard.
+pub fn write_shard(
+    opts: &VerifyOptions,
+    shard: Shard,
+    seed_notes: &[String],
+) -> Result<ShardManifest> {
+    let scenes = &opts.scenes;
+    let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
+    let mut work = projected_work(scenes, opts.budget);
+    for part in &mut work.parts {
+        part.work.trajectory_steps *= shard.fraction();
+        part.work.dof_steps *= shard.fraction();
+    }
+    opts.limits.check(&work)?;
+    let prepared = prepare_all(scenes, opts.budget)?;
+    let described = scenes
+        .iter()
+        .zip(seed_notes)
+        .map(|(s, n)| ShardScene::of(s, n))
+        .collect();
+    let mut writer = ShardWriter::begin(
+        &opts.out,
+        COMMAND,
+        shard,
+        settings(opts),
+        described,
+        provenance,
+    )?;
+    let bar = Progress::new(opts.progress, work.dof_steps(), "DOF-steps");
+    for (scene, prepared) in scenes.iter().zip(&prepared) {
+        match prepared {
+            Prepared::Linear(runs, oracles) => {
+                for (k, run) in runs.iter().enumerate() {
+                    // As in a whole run: a run whose references fail the oracle is not
+                    // simulated.
+                    if oracles[k].passed() {
+                        begin_run(&bar, scene, k, opts.budget);
+                        write_linear(opts, scene, k, run, &bar, &mut writer)?;
+                    }
+                }
+            }
+            Prepared::Compression(_, oracle, runs) if oracle.passed() => {
+                for_compression_runs(scene, runs, |k, run| {
+                    begin_run(&bar, scene, k, opts.budget);
+                    write_compression(opts, scene, k, run, &bar, &mut writer)
+                })?;
+            }
+            Prepared::Compression(..) => {}
+        }
+    }
+    bar.finish();
+    writer.finish()
+}
+
+/// Simulates and writes the writer's share of linear run `k`.
+fn write_linear(
+    opts: &VerifyOptions,
+    scene: &Scene,
+    k: usize,
+    run: &LinearRun,
+    bar: &Progress,
+    writer: &mut ShardWriter,
+) -> Result<()> {
+    let e = run.spec.ensemble(opts.budget);
+    let (records, extra) = simulate_linear(scene, k, run, &e, bar, writer.shard())?;
+    writer.write(
+        (&scene.name, &run.spec.name, LINEAR_EXT),
+        writer.shard().range(e.trajectories as u64),
+        &encode_linear(&records, &extra),
+        serde_json::Value::Null,
+    )
+}
+
+/// Simulates and writes the writer's share of compression run `k`, with its plan;
+/// returns the steps its step search chose, if any (for the Δt-halving pair).
+fn write_compression(
+    opts: &VerifyOptions,
+    scene: &Scene,
+    k: usize,
+    run: &CompressionRun,
+    bar: &Progress,
+    writer: &mut ShardWriter,
+) -> Result<Option<Vec<f64>>> {
+    let e = run.spec.ensemble(opts.budget);
+    let (records, plan) =
+        simulate_compression(scene, k, run, &e, opts.budget, bar, writer.shard())?;
+    let common = match &plan {
+        Some(p) => serde_json::to_value(PlanBits::of(p))
+            .map_err(|e| Error::io(&opts.out, std::io::Error::other(e)))?,
+        None => serde_json::Value::Null,
+    };
+    writer.write(
+        (&scene.name, &run.spec.name, FORCE_EXT),
+        writer.shard().range(e.trajectories.max(1) as u64),
+        &encode_force(&records),
+        common,
+    )?;
+    Ok(plan
+        .and_then(|p| p.search)
+        .map(|s| s.iter().map(|c| c.dt_tau1).collect()))
+}
+
+/// The refusal of a merge whose shards do not hold what run `run` of `scene` needs.
+fn incomplete(set: &ShardSet, scene: &Scene, run: &str, message: String) -> Error {
+    Error::Scene {
+        file: set.shards[0].0.join(crate::shard::SHARD_MANIFEST),
+        key: format!("files[{}/{run}]", scene.name),
+        message,
+    }
+}
+
+/// The records of linear run `run` of `scene` from every shard, in trajectory order:
+/// the full trajectories' records and the extra two-time trajectories' products, as
+/// [`simulate_linear`] returns them for the whole ensemble `e`.
+///
+/// # Errors
+/// [`Error::Scene`] (exit 2): a shard's file is missing, damaged ([`ShardSet::read`],
+/// [`decode_linear`]) or the shards together do not hold `e`'s trajectories.
+pub(super) fn merged_linear(
+    set: &ShardSet,
+    scene: &Scene,
+    run: &LinearRun,
+    e: &Ensemble,
+) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
+    let (mut records, mut extra) = (Vec::new(), Vec::new());
+    for (file, bytes) in set.read(&scene.name, &run.spec.name)? {
+        let (r, x) = decode_linear(&bytes, &file.path)?;
+        records.extend(r);
+        extra.extend(x);
+    }
+    if records.len() != e.trajectories || extra.len() != e.two_time_trajectories {
+        return Err(incomplete(
+            set,
+            scene,
+            &run.spec.name,
+            format!(
+                "the shards hold {} trajectories and {} two-time trajectories, the budget {} and {}",
+                records.len(),
+                extra.len(),
+                e.trajectories,
+                e.two_time_trajectories
+            ),
+        ));
+    }
+    Ok((records, extra))
+}
+
+/// The records per strain of compression run `run` of `scene` from every shard, in
+/// trajectory order, and its plan (every shard's, checked equal by [`ShardSet::read`]),
+/// as [`simulate_compression`] returns them for the whole ensemble `e`.
+///
+/// # Errors
+/// [`Error::Scene`] (exit 2): a shard's file is missing or damaged, the shards together
+/// do not hold `e`'s trajectories at every strain, or the plan is unreadable.
+pub(super) fn merged_compression(
+    set: &ShardSet,
+    scene: &Scene,
+    run: &CompressionRun,
+    e: &Ensemble,
+) -> Result<(Vec<Vec<ForceRecord>>, Option<TargetedPlan>)> {
+    let name = &run.spec.name;
+    let files = set.read(&scene.name, name)?;
+    let mut records: Vec<Vec<ForceRecord>> = vec![Vec::new(); run.points()];
+    for (file, bytes) in &files {
+        let share = decode_force(bytes, &file.path)?;
+        if share.len() != run.points() {
+            return Err(incomplete(
+                set,
+                scene,
+                name,
+                format!(
+                    "{} has {} strains, the scene {}",
+                    file.path,
+                    share.len(),
+                    run.points()
+                ),
+            ));
+        }
+        for (all, part) in records.iter_mut().zip(share) {
+            all.extend(part);
+        }
+    }
+    let want = e.trajectories.max(1);
+    if let Some(n) = records.iter().map(Vec::len).find(|&n| n != want) {
+        return Err(incomplete(
+            set,
+            scene,
+            name,
+            format!("the shards hold {n} trajectories at a strain, the budget {want}"),
+        ));
+    }
+    let plan = match (e.precision_target(), &files[0].0.common) {
+        (None, _) => None,
+        (Some(target), common) => {
+            let bits: PlanBits = serde_json::from_value(common.clone())
+                .map_err(|err| incomplete(set, scene, name, format!("no readable plan: {err}")))?;
+            let plan = bits.plan(target);
+            let n = run.points();
+            let lengths = [
+                plan.pilot_std_error.len(),
+                plan.main_tau1.len(),
+                plan.main_steps.len(),
+                plan.search.as_ref().map_or(n, Vec::len),
+            ];
+            if lengths.iter().any(|&l| l != n) {
+                return Err(incomplete(
+                    set,
+                    scene,
+                    name,
+                    format!("a plan with {lengths:?} values, not one per strain ({n})"),
+                ));
+            }
+            Some(plan)
+        }
+    };
+    Ok((records, plan))
+}
+
+/// A [`TargetedPlan`] in JSON with every float as its bits (exact), for the manifest.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct PlanBits {
+    pilot_tau1: u64,
+    pilot_std_error: Vec<u64>,
+    main_tau1: Vec<u64>,
+    main_steps: Vec<u64>,
+    /// Per strain: the chosen step and the candidates tried (step, acceptance).
+    search: Option<Vec<ChoiceBits>>,
+}
+
+/// A [`StepChoice`] as bits: the chosen step and the candidates (step, acceptance).
+type ChoiceBits = (u64, Vec<(u64, u64)>);
+
+impl PlanBits {
+    fn of(p: &TargetedPlan) -> PlanBits {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect();
+        PlanBits {
+            pilot_tau1: p.pilot_tau1.to_bits(),
+            pilot_std_error: bits(&p.pilot_std_error),
+            main_tau1: bits(&p.main_tau1),
+            main_steps: p.main_steps.clone(),
+            search: p.search.as_ref().map(|s| {
+                s.iter()
+                    .map(|c| {
+                        let tried = c.tried.iter().map(|t| (t.0.to_bits(), t.1.to_bits()));
+                        (c.dt_tau1.to_bits(), tried.collect())
+                    })
+                    .collect()
+            }),
+        }
+    }
+
+    fn plan(&self, target: crate::scene::PrecisionTarget) -> TargetedPlan {
+        let floats = |v: &[u64]| v.iter().map(|&b| f64::from_bits(b)).collect();
+        TargetedPlan {
+            target,
+            pilot_tau1: f64::from_bits(self.pilot_tau1),
+            pilot_std_error: floats(&self.pilot_std_error),
+            main_tau1: floats(&self.main_tau1),
+            main_steps: self.main_steps.clone(),
+            search: self.search.as_ref().map(|s| {
+                s.iter()
+                    .map(|(dt, tried)| StepChoice {
+                        dt_tau1: f64::from_bits(*dt),
+                        tried: tried
+                            .iter()
+                            .map(|&(a, b)| (f64::from_bits(a), f64::from_bits(b)))
+                            .collect(),
+                    })
+                    .collect()
+            }),
+        }
+    }
+}

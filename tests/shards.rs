@@ -1,0 +1,312 @@
+//! Shards and merge (issue #15): a verification split into 3 shards, each run in a process
+//! of its own, and merged gives the report of the same verification run in one process,
+//! byte for byte apart from wall times, run id and provenance; a merge refuses (exit 2,
+//! naming the shard) a missing, duplicated, foreign or damaged shard.
+//!
+//! The scenes are two tiny fixtures that run in about a second together: a linear one
+//! (full trajectories and extra two-time trajectories, both sharded) and a compression
+//! one whose quick budget is by target precision with a step search and a Δt-halving
+//! pair (the plan every shard computes in full, and the merge checks equal).
+
+mod common;
+
+use common::{TempDir, all_files, describe, fixture, json, run, stderr_of};
+use std::path::Path;
+use std::process::Output;
+
+const LINEAR: &str = "tests/scenes/good/tiny-linear.toml";
+const COMPRESSION: &str = "tests/scenes/good/tiny-compression.toml";
+
+/// `verify` of both fixtures into `out` with `extra` flags; asserts exit 0 or 1.
+fn verify(out: &Path, extra: &[&str]) -> Output {
+    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let mut args = vec![
+        "verify",
+        "-q",
+        "-s",
+        lin.to_str().unwrap(),
+        "-s",
+        comp.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        describe(&args, &o)
+    );
+    o
+}
+
+/// Runs shards `1/n … n/n` of both fixtures concurrently, each in a process of its own,
+/// into `<root>/<i>`, with `extra` flags.
+fn shards(root: &Path, n: usize, extra: &[&str]) {
+    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let children: Vec<_> = (1..=n)
+        .map(|i| {
+            let out = root.join(i.to_string());
+            let shard = format!("{i}/{n}");
+            let mut c = common::command();
+            c.args(["verify", "-q", "-s"])
+                .arg(&lin)
+                .arg("-s")
+                .arg(&comp)
+                .args(["--shard", &shard, "-o"])
+                .arg(&out)
+                .args(extra);
+            (shard, c.output())
+        })
+        .collect();
+    for (shard, o) in children {
+        let o = o.expect("run a shard");
+        assert_eq!(o.status.code(), Some(0), "shard {shard}: {}", stderr_of(&o));
+        assert!(
+            root.join(format!("{}/shard.json", &shard[..shard.find('/').unwrap()]))
+                .is_file(),
+            "shard {shard} wrote no manifest"
+        );
+    }
+}
+
+/// `merge` of `dirs` into `out`.
+fn merge(dirs: &[&Path], out: &Path) -> Output {
+    let mut args = vec!["merge".to_string()];
+    args.extend(dirs.iter().map(|d| d.display().to_string()));
+    args.extend(["-o".to_string(), out.display().to_string()]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    run(&args)
+}
+
+/// `v` without the fields that differ between two runs of the same work: wall times,
+/// run id and provenance (start time, command line).
+fn without_volatile(v: &serde_json::Value) -> serde_json::Value {
+    match v {
+        serde_json::Value::Object(m) => serde_json::Value::Object(
+            m.iter()
+                .filter(|(k, _)| !matches!(k.as_str(), "wall_seconds" | "run_id" | "provenance"))
+                .map(|(k, v)| (k.clone(), without_volatile(v)))
+                .collect(),
+        ),
+        serde_json::Value::Array(a) => {
+            serde_json::Value::Array(a.iter().map(without_volatile).collect())
+        }
+        other => other.clone(),
+    }
+}
+
+/// `html` without its volatile parts: the run id, the provenance block, and every
+/// number of seconds (`6.17 s`: the wall times).
+fn html_without_volatile(html: &str, run_id: &str) -> String {
+    let html = html.replace(run_id, "RUN-ID");
+    let html = match (
+        html.find("<details class=\"provenance\""),
+        html.rfind("</details>"),
+    ) {
+        (Some(a), Some(b)) if b > a => format!("{}PROVENANCE{}", &html[..a], &html[b..]),
+        _ => html,
+    };
+    // Drop every run of digits and dots directly followed by " s" and a non-letter.
+    let chars: Vec<char> = html.chars().collect();
+    let mut out = String::with_capacity(html.len());
+    let mut i = 0;
+    while i < chars.len() {
+        if chars[i].is_ascii_digit() {
+            let mut j = i;
+            while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+                j += 1;
+            }
+            let seconds = chars.get(j) == Some(&' ')
+                && chars.get(j + 1) == Some(&'s')
+                && !chars.get(j + 2).is_some_and(|c| c.is_alphanumeric());
+            if seconds {
+                out.push('T');
+            } else {
+                out.extend(&chars[i..j]);
+            }
+            i = j;
+        } else {
+            out.push(chars[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+/// What: both fixtures verified in one process, and as 3 shards run concurrently in
+/// processes of their own and merged (from the parent directory of the shards).
+/// Reference: the whole run's outputs.
+/// Tolerance: every table, figure and other file byte-identical; `summary.json` and
+/// `manifest.json` equal as JSON without wall times, run id and provenance; `index.html`
+/// equal without the run id, the provenance block and the wall times. The exit codes are
+/// equal.
+#[test]
+fn three_shards_merge_to_the_whole_run_byte_for_byte() {
+    let tmp = TempDir::new("shards");
+    let whole = tmp.join("whole");
+    let w = verify(&whole, &[]);
+    let root = tmp.join("shards");
+    shards(&root, 3, &[]);
+    let merged = tmp.join("merged");
+    let m = merge(&[&root], &merged);
+    assert_eq!(m.status.code(), w.status.code(), "{}", stderr_of(&m));
+
+    let files = all_files(&whole);
+    assert_eq!(files, all_files(&merged), "different files");
+    assert!(
+        files.iter().any(|f| f.ends_with("force-strain.csv"))
+            && files.iter().any(|f| f.ends_with("-two-time.csv")),
+        "the fixtures wrote no force-strain or two-time table: {files:?}"
+    );
+    for f in &files {
+        let (a, b) = (whole.join(f), merged.join(f));
+        match f.as_str() {
+            "summary.json" | "manifest.json" => assert_eq!(
+                without_volatile(&json(&a)),
+                without_volatile(&json(&b)),
+                "{f} differs"
+            ),
+            "index.html" => {
+                let id = |p: &Path| json(&p.join("summary.json"))["run_id"].to_string();
+                let id = |p: &Path| id(p).trim_matches('"').to_string();
+                let (ha, hb) = (
+                    std::fs::read_to_string(&a).unwrap(),
+                    std::fs::read_to_string(&b).unwrap(),
+                );
+                assert_eq!(
+                    html_without_volatile(&ha, &id(&whole)),
+                    html_without_volatile(&hb, &id(&merged)),
+                    "index.html differs beyond wall times, run id and provenance"
+                );
+            }
+            _ => assert!(
+                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+                "{f} differs between the whole run and the merged shards"
+            ),
+        }
+    }
+}
+
+/// The exit code and stderr of a merge that must be refused; asserts exit 2 and that
+/// stderr names every string of `names`.
+fn refused(dirs: &[&Path], out: &Path, names: &[&str]) {
+    let o = merge(dirs, out);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "not refused: {err}");
+    for n in names {
+        assert!(err.contains(n), "the refusal does not name {n:?}: {err}");
+    }
+    assert!(
+        !out.join("summary.json").exists(),
+        "a refused merge wrote a report"
+    );
+}
+
+/// What: merges that must be refused before anything is written: a missing shard, a
+/// duplicated one, one of another seed, budget, shard count or scene set, a damaged
+/// record file, and a directory that is not a shard.
+/// Reference: exit 2, the message naming the shard (its directory and index) and what
+/// differs; no report written.
+#[test]
+fn merge_refuses_missing_duplicate_foreign_and_damaged_shards() {
+    let tmp = TempDir::new("shards-refused");
+    let root = tmp.join("set");
+    shards(&root, 3, &[]);
+    let (s1, s2, s3) = (root.join("1"), root.join("2"), root.join("3"));
+    let out = tmp.join("out");
+
+    refused(&[&s1, &s3], &out, &["missing shard 2/3"]);
+
+    let copy = tmp.join("copy-of-1");
+    std::fs::create_dir_all(&copy).unwrap();
+    for f in all_files(&s1) {
+        std::fs::create_dir_all(copy.join(&f).parent().unwrap()).unwrap();
+        std::fs::copy(s1.join(&f), copy.join(&f)).unwrap();
+    }
+    refused(
+        &[&s1, &copy, &s2, &s3],
+        &out,
+        &["shard 1/3 given twice", "copy-of-1", s1.to_str().unwrap()],
+    );
+
+    let seed = tmp.join("seed");
+    shards(&seed, 3, &["--seed", "7"]);
+    let foreign = seed.join("2");
+    refused(
+        &[&s1, &foreign, &s3],
+        &out,
+        &[foreign.to_str().unwrap(), "seed 7"],
+    );
+
+    let budget = tmp.join("budget");
+    shards(&budget, 3, &["-b", "standard"]);
+    refused(
+        &[&s1, &budget.join("2"), &s3],
+        &out,
+        &["settings", "standard"],
+    );
+
+    let four = tmp.join("four");
+    shards(&four, 4, &[]);
+    refused(
+        &[&s1, &four.join("2"), &s3],
+        &out,
+        &["set of 4", "set of 3"],
+    );
+
+    let other = tmp.join("other");
+    let o = run(&[
+        "verify",
+        "-q",
+        "-s",
+        fixture(LINEAR).to_str().unwrap(),
+        "--shard",
+        "2/3",
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
+    refused(&[&s1, &other, &s3], &out, &["scenes", "tiny-compression"]);
+
+    let record = s2.join("records/tiny-linear/crank-nicolson.lin");
+    let mut bytes = std::fs::read(&record).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 1;
+    std::fs::write(&record, bytes).unwrap();
+    refused(
+        &[&s1, &s2, &s3],
+        &out,
+        &["crank-nicolson.lin", "SHA-256", "rerun shard 2/3"],
+    );
+
+    let empty = tmp.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    refused(&[&empty], &out, &["not a shard"]);
+}
+
+/// What: `--shard` outside 1 ≤ I ≤ N is refused before anything runs.
+/// Reference: exit 2 naming the flag and the rule.
+#[test]
+fn shard_flag_out_of_range_is_refused() {
+    let tmp = TempDir::new("shard-flag");
+    for bad in ["0/3", "4/3", "3", "x/y"] {
+        let args = [
+            "verify",
+            "-s",
+            LINEAR,
+            "--shard",
+            bad,
+            "-o",
+            &tmp.join_str("out"),
+        ];
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let err = stderr_of(&o);
+        assert!(
+            err.contains("--shard") && err.contains("1 <= I <= N"),
+            "{}",
+            describe(&args, &o)
+        );
+    }
+}
