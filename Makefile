@@ -3,12 +3,15 @@
 #   make verify            quick verification suite (CI), reports in reports/
 #   make verify BUDGET=full   publication-grade error bars
 #   make test              all tests (unit, integration, statistical validation, golden),
-#                          then `check` against the NumPy example simulator, then the
-#                          reports rendered in headless Chromium (browser-check)
+#                          then `check` against the NumPy example simulator, Fig. 2 in
+#                          shards merged (fig2-shards), then the reports rendered in
+#                          headless Chromium (browser-check)
 #   make check             fmt --check, clippy -D warnings, tests
 #   make bench             benchmarks (benches/), see README performance table
 #   make golden            re-run golden snapshots, accept changes, show the diff
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
+#   make fig2-shards       Fig. 2 as SHARDS concurrent shards and as an emulated Slurm array,
+#                          each merged and compared byte for byte with the single run
 #   make converge          convergence studies (orders in h and dt), reports/convergence/
 #   make bench-peers       Fig. 2 against a plain NumPy implementation: CPU times and ratio
 #   make calibrate         the verifier's false-alarm rate and p-value uniformity over
@@ -20,7 +23,7 @@ BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 converge bench-peers example-check browser-check calibrate power
+.PHONY: all build verify test check bench golden clean fig2 fig2-shards converge bench-peers example-check browser-check calibrate power
 
 all: build
 
@@ -53,6 +56,7 @@ calibrate: build
 test:
 	$(CARGO) test --release --locked
 	$(MAKE) --no-print-directory example-check
+	$(MAKE) --no-print-directory fig2-shards
 	$(MAKE) --no-print-directory browser-check
 
 # `check` against an independent simulator (examples/numpy-simulator, NumPy in a venv):
@@ -108,8 +112,28 @@ clean:
 	$(CARGO) clean
 
 # The paper's Fig. 2, both dimensions, publication-grade (standard error <= 0.01 F_c0).
+FIG2_ARGS = --scene compression-2d --scene compression-3d --budget full
 fig2: build
-	$(BIN) verify --scene compression-2d --scene compression-3d --budget full --out $(OUT)
+	$(BIN) verify $(FIG2_ARGS) --out $(OUT)
+
+# Fig. 2 split into SHARDS shards (issue #15): run concurrently on this machine
+# (examples/slurm/parallel.sh: GNU parallel, or xargs -P without it) and as the Slurm
+# job array of examples/slurm/ run in turn without Slurm (emulate.sh: the array tasks,
+# then the merge job), each merged; both force-strain.csv tables and fig2.svg must equal
+# the single run's byte for byte. A few seconds; part of `make test` (CI).
+SHARDS    ?= 4
+SHARD_OUT ?= target/fig2-shards
+fig2-shards: build
+	rm -rf $(SHARD_OUT)
+	$(BIN) verify -q $(FIG2_ARGS) --out $(SHARD_OUT)/single
+	LANGEVIN_FEM=$(BIN) examples/slurm/parallel.sh $(SHARDS) $(SHARD_OUT)/parallel $(FIG2_ARGS)
+	LANGEVIN_FEM=$(CURDIR)/$(BIN) SHARDS_DIR=$(SHARD_OUT)/array/shards REPORT_DIR=$(SHARD_OUT)/array/report \
+		VERIFY_ARGS="-q $(FIG2_ARGS)" examples/slurm/emulate.sh $(SHARDS) >/dev/null
+	for f in compression-2d/force-strain.csv compression-3d/force-strain.csv fig2.svg; do \
+		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/parallel/report/$$f && \
+		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/array/report/$$f || exit 1; \
+	done
+	@echo "fig2-shards: $(SHARDS) shards (concurrent, and as an emulated Slurm array) merged to the single run's force-strain.csv and fig2.svg, byte for byte"
 
 # Convergence studies, written to reports/convergence/ with an index page (about 6 min
 # after the build on 2 cores; see the README):

@@ -251,16 +251,51 @@ impl ShardWriter {
     ) -> Result<()> {
         let rel = format!("{RECORDS_DIR}/{scene}/{run}.{ext}");
         crate::output::io::write_atomic(&self.dir.join(&rel), bytes)?;
+        self.list((scene, run), &rel, bytes, range, common);
+        Ok(())
+    }
+
+    /// Lists the file `rel` with content `bytes` in the manifest.
+    fn list(
+        &mut self,
+        (scene, run): (&str, &str),
+        rel: &str,
+        bytes: &[u8],
+        range: Range<u64>,
+        common: serde_json::Value,
+    ) {
         self.manifest.files.push(ShardFile {
             scene: scene.to_string(),
             run: run.to_string(),
-            path: rel,
+            path: rel.to_string(),
             bytes: bytes.len() as u64,
             sha256: sha256_hex(bytes),
             first: range.start,
             count: range.end - range.start,
             common,
         });
+    }
+
+    /// The shard's output directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Lists a file already written (atomically) under the shard directory at `rel`:
+    /// one run's trajectories `range`, with `common`; its size and SHA-256 are read back.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the file cannot be read.
+    pub fn add_file(
+        &mut self,
+        (scene, run): (&str, &str),
+        rel: &str,
+        range: Range<u64>,
+        common: serde_json::Value,
+    ) -> Result<()> {
+        let path = self.dir.join(rel);
+        let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+        self.list((scene, run), rel, &bytes, range, common);
         Ok(())
     }
 
@@ -356,24 +391,17 @@ impl ShardSet {
         Ok(m)
     }
 
-    /// Opens the shards in `dirs` (shard directories, or directories of them) of
-    /// `command`, and checks that they are one complete set.
+    /// Opens the shards in `dirs` (shard directories, or directories of them) and checks
+    /// that they are one complete set of one command ([`ShardManifest::command`]).
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the shard's manifest: not a shard; another format,
     /// command, build (also than this merge's), shard count, setting, scene or seed than
     /// the first shard; a duplicated index (naming both directories); missing indices.
-    pub fn open(dirs: &[PathBuf], command: &str) -> Result<ShardSet> {
+    pub fn open(dirs: &[PathBuf]) -> Result<ShardSet> {
         let mut shards: Vec<(PathBuf, ShardManifest)> = Vec::new();
         for dir in Self::expand(dirs)? {
             let m = Self::read_manifest(&dir)?;
-            if m.command != command {
-                return Err(refuse(
-                    &dir,
-                    "command",
-                    format!("a shard of `{}`, not of `{command}`", m.command),
-                ));
-            }
             if m.build != VERSION_LINE {
                 return Err(refuse(
                     &dir,
@@ -449,8 +477,64 @@ impl ShardSet {
             .collect()
     }
 
-    /// Every shard's record file of run `run` of scene `scene`, in shard order (hence in
-    /// trajectory order), each with its manifest entry, checked for contiguous ranges,
+    /// The content of `entry`, a file of shard number `k` (0-based, in shard order),
+    /// checked against the manifest's size and SHA-256.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming the shard: a path that leaves the shard
+    /// directory, a file unreadable, of another size or hash.
+    pub fn read_file(&self, k: usize, entry: &ShardFile) -> Result<Vec<u8>> {
+        let (dir, m) = &self.shards[k];
+        let key = format!("files[{}/{}]", entry.scene, entry.run);
+        let rel = Path::new(&entry.path);
+        if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
+            return Err(refuse(
+                dir,
+                &key,
+                format!(
+                    "path {} leaves the shard directory: a relative path inside it is required",
+                    entry.path
+                ),
+            ));
+        }
+        let path = dir.join(rel);
+        let bytes = std::fs::read(&path)
+            .map_err(|e| refuse(dir, &key, format!("cannot read {}: {e}", path.display())))?;
+        if bytes.len() as u64 != entry.bytes || sha256_hex(&bytes) != entry.sha256 {
+            return Err(refuse(
+                dir,
+                &key,
+                format!(
+                    "{} is {} bytes with SHA-256 {}, the manifest says {} bytes with {}: damaged or replaced; rerun shard {}",
+                    path.display(),
+                    bytes.len(),
+                    sha256_hex(&bytes),
+                    entry.bytes,
+                    entry.sha256,
+                    m.shard
+                ),
+            ));
+        }
+        Ok(bytes)
+    }
+
+    /// Every shard's files of run `run` of scene `scene`, in shard order (hence in
+    /// trajectory order), each with the index of its shard (for [`Self::read_file`]).
+    pub fn files<'a>(
+        &'a self,
+        scene: &'a str,
+        run: &'a str,
+    ) -> impl Iterator<Item = (usize, &'a ShardFile)> + 'a {
+        self.shards.iter().enumerate().flat_map(move |(k, (_, m))| {
+            m.files
+                .iter()
+                .filter(move |f| f.scene == scene && f.run == run)
+                .map(move |f| (k, f))
+        })
+    }
+
+    /// Every shard's one record file of run `run` of scene `scene`, in shard order (hence
+    /// in trajectory order), each with its manifest entry, checked for contiguous ranges,
     /// size and SHA-256.
     ///
     /// # Errors
@@ -459,7 +543,7 @@ impl ShardSet {
     /// that differs from the first shard's.
     pub fn read(&self, scene: &str, run: &str) -> Result<Vec<(ShardFile, Vec<u8>)>> {
         let mut out: Vec<(ShardFile, Vec<u8>)> = Vec::new();
-        for (dir, m) in &self.shards {
+        for (k, (dir, m)) in self.shards.iter().enumerate() {
             let key = format!("files[{scene}/{run}]");
             let entry = m
                 .files
@@ -475,35 +559,7 @@ impl ShardSet {
                         ),
                     )
                 })?;
-            let rel = Path::new(&entry.path);
-            if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
-                return Err(refuse(
-                    dir,
-                    &key,
-                    format!(
-                        "path {} leaves the shard directory: a relative path inside it is required",
-                        entry.path
-                    ),
-                ));
-            }
-            let path = dir.join(rel);
-            let bytes = std::fs::read(&path)
-                .map_err(|e| refuse(dir, &key, format!("cannot read {}: {e}", path.display())))?;
-            if bytes.len() as u64 != entry.bytes || sha256_hex(&bytes) != entry.sha256 {
-                return Err(refuse(
-                    dir,
-                    &key,
-                    format!(
-                        "{} is {} bytes with SHA-256 {}, the manifest says {} bytes with {}: damaged or replaced; rerun shard {}",
-                        path.display(),
-                        bytes.len(),
-                        sha256_hex(&bytes),
-                        entry.bytes,
-                        entry.sha256,
-                        m.shard
-                    ),
-                ));
-            }
+            let bytes = self.read_file(k, entry)?;
             if let Some((prev, _)) = out.last() {
                 if entry.first != prev.first + prev.count {
                     return Err(refuse(
@@ -538,6 +594,16 @@ impl ShardSet {
 /// Checks that shard `m` (in `dir`) belongs to the set of `first` (in `first_dir`).
 fn same_set(dir: &Path, m: &ShardManifest, first_dir: &Path, first: &ShardManifest) -> Result<()> {
     let against = format!("{} (shard {})", first_dir.display(), first.shard);
+    if m.command != first.command {
+        return Err(refuse(
+            dir,
+            "command",
+            format!(
+                "a shard of `{}`, but {against} is of `{}`",
+                m.command, first.command
+            ),
+        ));
+    }
     if m.shard.count != first.shard.count {
         return Err(refuse(
             dir,

@@ -5,6 +5,7 @@
 use super::Verbosity;
 use clap::Args;
 use langevin_fem::error::Result;
+use langevin_fem::progress::ProgressOptions;
 use langevin_fem::shard::ShardSet;
 use langevin_fem::verify::shard::{COMMAND, settings_of};
 use langevin_fem::verify::{Ensembles, VerifyOptions, run_verification};
@@ -45,7 +46,24 @@ pub struct MergeArgs {
 /// ([`ShardSet::open`]); as `verify` otherwise.
 pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
-    let set = ShardSet::open(&args.shards, COMMAND)?;
+    let set = ShardSet::open(&args.shards)?;
+    match set.manifest().command.as_str() {
+        COMMAND => merge_verify(set, &args, verbosity, start),
+        other => Err(langevin_fem::Error::invalid(
+            "merge DIR",
+            format!("shards of `{other}`"),
+            "shards of `verify`",
+        )),
+    }
+}
+
+/// `merge` of a verification's shards.
+fn merge_verify(
+    set: ShardSet,
+    args: &MergeArgs,
+    verbosity: Verbosity,
+    start: Instant,
+) -> Result<i32> {
     let (budget, alpha) = settings_of(&set)?;
     let (scenes, seed_notes): (Vec<_>, Vec<_>) = set.scenes()?.into_iter().unzip();
     if verbosity.shows_progress() {
@@ -61,7 +79,8 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
         budget,
         out: args.out.clone(),
         alpha,
-        progress: verbosity.progress(),
+        // Nothing is simulated: no progress bar over DOF-steps.
+        progress: ProgressOptions::HIDDEN,
         limits: WorkLimits::default(),
         ensembles: Ensembles::Merge(Arc::new(set)),
     })?;
