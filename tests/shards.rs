@@ -40,31 +40,33 @@ fn verify(out: &Path, extra: &[&str]) -> Output {
     o
 }
 
-/// Runs shards `1/n … n/n` of both fixtures concurrently, each in a process of its own,
-/// into `<root>/<i>`, with `extra` flags.
+/// Runs shards `1/n … n/n` of both fixtures' verification concurrently, each in a
+/// process of its own, into `<root>/<i>`, with `extra` flags.
 fn shards(root: &Path, n: usize, extra: &[&str]) {
     let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let mut args = vec!["verify", "-q", "-s", lin.to_str().unwrap()];
+    args.extend(["-s", comp.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    shards_of(root, n, &args);
+}
+
+/// Runs `args` with `--shard i/n -o <root>/<i>` for i = 1 … n concurrently, each in a
+/// process of its own; asserts that each exits 0 and writes its manifest.
+fn shards_of(root: &Path, n: usize, args: &[&str]) {
     let children: Vec<_> = (1..=n)
         .map(|i| {
             let out = root.join(i.to_string());
             let shard = format!("{i}/{n}");
             let mut c = common::command();
-            c.args(["verify", "-q", "-s"])
-                .arg(&lin)
-                .arg("-s")
-                .arg(&comp)
-                .args(["--shard", &shard, "-o"])
-                .arg(&out)
-                .args(extra);
-            (shard, c.output())
+            c.args(args).args(["--shard", &shard, "-o"]).arg(&out);
+            (out, shard, c.spawn().expect("start a shard"))
         })
         .collect();
-    for (shard, o) in children {
-        let o = o.expect("run a shard");
+    for (out, shard, child) in children {
+        let o = child.wait_with_output().expect("run a shard");
         assert_eq!(o.status.code(), Some(0), "shard {shard}: {}", stderr_of(&o));
         assert!(
-            root.join(format!("{}/shard.json", &shard[..shard.find('/').unwrap()]))
-                .is_file(),
+            out.join("shard.json").is_file(),
             "shard {shard} wrote no manifest"
         );
     }
@@ -96,16 +98,15 @@ fn without_volatile(v: &serde_json::Value) -> serde_json::Value {
     }
 }
 
-/// `html` without its volatile parts: the run id, the provenance block, and every
-/// number of seconds (`6.17 s`: the wall times).
-fn html_without_volatile(html: &str, run_id: &str) -> String {
-    let html = html.replace(run_id, "RUN-ID");
+/// `html` without its volatile parts: the provenance block and every number of seconds
+/// (`6.17 s`: the wall times).
+fn html_without_volatile(html: &str) -> String {
     let html = match (
         html.find("<details class=\"provenance\""),
         html.rfind("</details>"),
     ) {
         (Some(a), Some(b)) if b > a => format!("{}PROVENANCE{}", &html[..a], &html[b..]),
-        _ => html,
+        _ => html.to_string(),
     };
     // Drop every run of digits and dots directly followed by " s" and a non-letter.
     let chars: Vec<char> = html.chars().collect();
@@ -152,39 +153,117 @@ fn three_shards_merge_to_the_whole_run_byte_for_byte() {
     let m = merge(&[&root], &merged);
     assert_eq!(m.status.code(), w.status.code(), "{}", stderr_of(&m));
 
-    let files = all_files(&whole);
-    assert_eq!(files, all_files(&merged), "different files");
+    let files = same_outputs(&whole, &merged);
     assert!(
         files.iter().any(|f| f.ends_with("force-strain.csv"))
             && files.iter().any(|f| f.ends_with("-two-time.csv")),
         "the fixtures wrote no force-strain or two-time table: {files:?}"
     );
+}
+
+/// Every run id in the JSON files of `dir`.
+fn run_ids(dir: &Path) -> Vec<String> {
+    all_files(dir)
+        .iter()
+        .filter(|f| f.ends_with(".json"))
+        .filter_map(|f| json(&dir.join(f))["run_id"].as_str().map(str::to_string))
+        .collect()
+}
+
+/// Asserts that `merged` holds the outputs of `whole`: the same files, every one
+/// byte-identical except that JSON files are compared as JSON without wall times, run
+/// ids and provenance, and HTML files without run ids, the provenance block and wall
+/// times; returns the files.
+fn same_outputs(whole: &Path, merged: &Path) -> Vec<String> {
+    let files = all_files(whole);
+    assert_eq!(files, all_files(merged), "different files");
+    let (ids_a, ids_b) = (run_ids(whole), run_ids(merged));
+    let html = |p: &Path, ids: &[String]| {
+        let mut text = std::fs::read_to_string(p).unwrap();
+        for id in ids {
+            text = text.replace(id.as_str(), "RUN-ID");
+        }
+        html_without_volatile(&text)
+    };
     for f in &files {
         let (a, b) = (whole.join(f), merged.join(f));
-        match f.as_str() {
-            "summary.json" | "manifest.json" => assert_eq!(
+        if f.ends_with(".json") {
+            assert_eq!(
                 without_volatile(&json(&a)),
                 without_volatile(&json(&b)),
                 "{f} differs"
-            ),
-            "index.html" => {
-                let id = |p: &Path| json(&p.join("summary.json"))["run_id"].to_string();
-                let id = |p: &Path| id(p).trim_matches('"').to_string();
-                let (ha, hb) = (
-                    std::fs::read_to_string(&a).unwrap(),
-                    std::fs::read_to_string(&b).unwrap(),
-                );
-                assert_eq!(
-                    html_without_volatile(&ha, &id(&whole)),
-                    html_without_volatile(&hb, &id(&merged)),
-                    "index.html differs beyond wall times, run id and provenance"
-                );
-            }
-            _ => assert!(
+            );
+        } else if f.ends_with(".html") {
+            assert_eq!(
+                html(&a, &ids_a),
+                html(&b, &ids_b),
+                "{f} differs beyond wall times, run id and provenance"
+            );
+        } else {
+            assert!(
                 std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
                 "{f} differs between the whole run and the merged shards"
-            ),
+            );
         }
+    }
+    files
+}
+
+/// What: convergence studies (a compression one over elements, a linear one over dt)
+/// run whole, and as 3 shards run concurrently in processes of their own and merged.
+/// Reference: the whole study's outputs.
+/// Tolerance: as `three_shards_merge_to_the_whole_run_byte_for_byte` (tables and
+/// figures byte-identical; JSON and the index without wall times, run ids, provenance).
+#[test]
+fn converge_in_three_shards_merges_to_the_whole_study() {
+    let tmp = TempDir::new("converge-shards");
+    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let studies: [Vec<&str>; 2] = [
+        vec![
+            "converge",
+            "-q",
+            "-s",
+            comp.to_str().unwrap(),
+            "--over",
+            "elements",
+            "--values",
+            "4,8",
+            "--strain-ratios",
+            "0,2",
+            "--trajectories",
+            "6",
+            "--duration-tau1",
+            "5",
+        ],
+        vec![
+            "converge",
+            "-q",
+            "-s",
+            lin.to_str().unwrap(),
+            "--over",
+            "dt",
+            "--values",
+            "0.02,0.01",
+        ],
+    ];
+    for (k, study) in studies.iter().enumerate() {
+        let whole = tmp.join(&format!("whole-{k}"));
+        let mut args = study.clone();
+        let out = whole.display().to_string();
+        args.extend(["-o", &out]);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+        let root = tmp.join(&format!("shards-{k}"));
+        shards_of(&root, 3, study);
+        let merged = tmp.join(&format!("merged-{k}"));
+        let m = merge(&[&root], &merged);
+        assert_eq!(m.status.code(), Some(0), "{}", stderr_of(&m));
+        let files = same_outputs(&whole, &merged);
+        assert!(
+            files
+                .iter()
+                .any(|f| f.ends_with("-elements.csv") || f.ends_with("-dt.csv"))
+        );
     }
 }
 

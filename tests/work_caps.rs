@@ -284,6 +284,7 @@ fn converge_projection(line: &ConvergeLine, budget: Budget) -> WorkProjection {
         out: PathBuf::from("unused"),
         progress: false,
         limits: WorkLimits::default(),
+        merge: None,
     };
     let run = select_run(&scene, line.run).expect("run");
     if let Some(k) = line.integrator {

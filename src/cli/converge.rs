@@ -9,10 +9,14 @@ use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_convergence_index;
 use langevin_fem::scene::load_scene;
+use langevin_fem::shard::{Shard, ShardSet};
+use langevin_fem::studies::converge::shard::{ConvergeSettings, write_convergence_shard};
 use langevin_fem::studies::converge::{
     ConvergeOptions, ConvergeSummary, ObservableSummary, OrderFit, Over, run_convergence,
 };
+use langevin_fem::work::WorkLimits;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The examples of `converge --help`.
 const EXAMPLES: &str = "\
@@ -69,6 +73,11 @@ pub struct ConvergeArgs {
     /// built-in scenes.
     #[arg(long, value_name = "DIR")]
     scene_dir: Option<PathBuf>,
+    /// Simulate only shard I of N of every value's trajectories and write their records
+    /// and a manifest to --out, without the study's tables; `langevin-fem merge` then
+    /// writes the whole study, byte for byte (see README "Running on a cluster").
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
     #[command(flatten)]
     limits: super::LimitArgs,
     #[command(flatten)]
@@ -86,9 +95,55 @@ enum OverArg {
 /// or 3 if every value failed (diverged or too short for its correlation time).
 pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
     let out = args.out.clone();
-    let s = run_convergence(&options(args, verbosity)?)?;
-    write_convergence_index(&out)?;
-    print_summary(&s, &out);
+    let shard = args.shard;
+    let (opts, seed_note) = options(args, verbosity)?;
+    if let Some(shard) = shard {
+        let m = write_convergence_shard(&opts, shard, &seed_note)?;
+        println!(
+            "shard {shard}: {} record file(s) in {}; when every shard of {} is done: langevin-fem merge <the {} shard directories> -o <study dir>",
+            m.files.len(),
+            out.display(),
+            shard.count,
+            shard.count
+        );
+        return Ok(0);
+    }
+    finish(&run_convergence(&opts)?, &out)
+}
+
+/// `merge` of a study's shards into `out`: the whole study's output set and index.
+///
+/// # Errors
+/// Exit 2 for settings that do not parse; as `converge` otherwise.
+pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
+    let settings = ConvergeSettings::of_set(&set)?;
+    let (mut scenes, _) = set.scenes()?.into_iter().unzip::<_, _, Vec<_>, Vec<_>>();
+    let scene = scenes.pop().ok_or_else(|| {
+        Error::invalid("merge DIR", "a converge shard without a scene", "one scene")
+    })?;
+    let mut opts = ConvergeOptions {
+        scene,
+        run: None,
+        over: settings.over,
+        values: None,
+        integrator: None,
+        strain_ratios: None,
+        budget: settings.budget,
+        trajectories: None,
+        duration_tau1: None,
+        out: out.to_path_buf(),
+        progress: verbosity.shows_progress(),
+        limits: WorkLimits::default(),
+        merge: Some(Arc::new(set)),
+    };
+    settings.apply(&mut opts)?;
+    finish(&run_convergence(&opts)?, out)
+}
+
+/// Writes the index of `out`, prints the study; exit code 3 if every value failed.
+fn finish(s: &ConvergeSummary, out: &Path) -> Result<i32> {
+    write_convergence_index(out)?;
+    print_summary(s, out);
     // Every value failed: nothing was measured (exit 3, as for a failed run).
     if s.rows.is_empty() && !s.failed.is_empty() {
         eprintln!("error: every value of the study failed (see above); no rows were written");
@@ -99,7 +154,7 @@ pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
 
 /// The study's options from the command line (the scene resolved last, after the
 /// flags are parsed).
-fn options(args: ConvergeArgs, verbosity: Verbosity) -> Result<ConvergeOptions> {
+fn options(args: ConvergeArgs, verbosity: Verbosity) -> Result<(ConvergeOptions, String)> {
     let over = match args.over {
         OverArg::Elements => Over::Elements,
         OverArg::Dt => Over::Dt,
@@ -121,8 +176,8 @@ fn options(args: ConvergeArgs, verbosity: Verbosity) -> Result<ConvergeOptions> 
         .map(parse_integrator)
         .transpose()?;
     let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
-    args.sim.apply(&mut scene);
-    Ok(ConvergeOptions {
+    let seed_note = args.sim.apply(&mut scene);
+    let opts = ConvergeOptions {
         scene,
         run: args.run,
         over,
@@ -135,7 +190,9 @@ fn options(args: ConvergeArgs, verbosity: Verbosity) -> Result<ConvergeOptions> 
         out: args.out,
         progress: verbosity.shows_progress(),
         limits: args.limits.limits(),
-    })
+        merge: None,
+    };
+    Ok((opts, seed_note))
 }
 
 /// The integrator named by `--integrator`.

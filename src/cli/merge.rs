@@ -7,6 +7,7 @@ use clap::Args;
 use langevin_fem::error::Result;
 use langevin_fem::progress::ProgressOptions;
 use langevin_fem::shard::ShardSet;
+use langevin_fem::studies::converge::shard::COMMAND as CONVERGE;
 use langevin_fem::verify::shard::{COMMAND, settings_of};
 use langevin_fem::verify::{Ensembles, VerifyOptions, run_verification};
 use langevin_fem::work::WorkLimits;
@@ -49,10 +50,11 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     let set = ShardSet::open(&args.shards)?;
     match set.manifest().command.as_str() {
         COMMAND => merge_verify(set, &args, verbosity, start),
+        CONVERGE => super::converge::merge(set, &args.out, verbosity),
         other => Err(langevin_fem::Error::invalid(
             "merge DIR",
             format!("shards of `{other}`"),
-            "shards of `verify`",
+            "shards of `verify` or `converge`",
         )),
     }
 }

@@ -56,6 +56,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub mod compression;
+pub mod shard;
 
 /// A total error is resolved (not at the sampling floor) if it exceeds this many
 /// standard errors.
@@ -565,6 +566,9 @@ pub struct ConvergeOptions {
     /// The caps on the study's projected work and memory ([`projected_work`]), checked
     /// before any simulation.
     pub limits: WorkLimits,
+    /// The shards whose records a merge reads instead of simulating (issue #15,
+    /// [`shard`]); `None` simulates every trajectory.
+    pub merge: Option<std::sync::Arc<crate::shard::ShardSet>>,
 }
 
 /// The projected work of a study of run `run` of `scene` with `ensemble` at `values`
@@ -1001,6 +1005,47 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 /// fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
+    let setup = setup(opts)?;
+    let mut source = match &opts.merge {
+        Some(set) => shard::Source::Merge(set),
+        None => shard::Source::Simulate,
+    };
+    let study = study_of(opts, &setup, &mut source)?;
+    let Setup {
+        scene,
+        spec,
+        label,
+        ensemble,
+        provenance,
+        ..
+    } = setup;
+    finish(
+        opts,
+        &scene,
+        &spec,
+        &label,
+        study,
+        ensemble,
+        (start, provenance),
+    )
+}
+
+/// What a study runs: the scene with any integrator override, its run (index, spec,
+/// label), the ensemble and the provenance started.
+pub(crate) struct Setup {
+    run: usize,
+    scene: Scene,
+    spec: RunSpec,
+    label: String,
+    ensemble: Ensemble,
+    pub(crate) provenance: Provenance,
+}
+
+/// The set-up of the study `opts` ([`Setup`]).
+///
+/// # Errors
+/// Bad input (exit 2) naming the flag.
+fn setup(opts: &ConvergeOptions) -> Result<Setup> {
     let run = select_run(&opts.scene, opts.run.as_deref())?;
     let mut scene = opts.scene.clone();
     let mut label = scene.runs[run].name.clone();
@@ -1013,28 +1058,37 @@ pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let spec = scene.runs[run].clone();
     let provenance = Provenance::begin(&[&scene]);
     let ensemble = study_ensemble(opts, &spec)?;
-    let study = match scene.model {
-        ModelKind::Compression => compression::study(&scene, run, opts, ensemble)?,
-        ModelKind::Fem | ModelKind::Spectral => {
-            if opts.strain_ratios.is_some() {
-                return Err(Error::invalid(
-                    "--strain-ratios",
-                    &scene.name,
-                    "a compression scene (model = \"compression\"): the linear scenes have no imposed strain",
-                ));
-            }
-            linear_study(&scene, run, opts, ensemble)?
-        }
-    };
-    finish(
-        opts,
-        &scene,
-        &spec,
-        &label,
-        study,
+    if scene.model != ModelKind::Compression && opts.strain_ratios.is_some() {
+        return Err(Error::invalid(
+            "--strain-ratios",
+            &scene.name,
+            "a compression scene (model = \"compression\"): the linear scenes have no imposed strain",
+        ));
+    }
+    Ok(Setup {
+        run,
+        scene,
+        spec,
+        label,
         ensemble,
-        (start, provenance),
-    )
+        provenance,
+    })
+}
+
+/// The study of `setup`, its trajectories from `source`.
+///
+/// # Errors
+/// As [`run_convergence`].
+fn study_of(
+    opts: &ConvergeOptions,
+    setup: &Setup,
+    source: &mut shard::Source<'_>,
+) -> Result<Study> {
+    let (scene, run, ensemble) = (&setup.scene, setup.run, setup.ensemble);
+    match scene.model {
+        ModelKind::Compression => compression::study(scene, run, opts, ensemble, source),
+        ModelKind::Fem | ModelKind::Spectral => linear_study(scene, run, opts, ensemble, source),
+    }
 }
 
 /// The linear study: ⟨w²(L/2)⟩ and the variances of modes 1–3 per value.
@@ -1043,6 +1097,7 @@ fn linear_study(
     run: usize,
     opts: &ConvergeOptions,
     ensemble: Ensemble,
+    source: &mut shard::Source<'_>,
 ) -> Result<Study> {
     let spec = &scene.runs[run];
     let over = opts.over;
@@ -1065,8 +1120,24 @@ fn linear_study(
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
-        let (est, records) = match simulate_value(s, lr, &spec.name, over, v, ensemble) {
-            Ok(r) => r,
+        let seed = derive_seed(
+            s.seed,
+            &format!("{}/converge/{}={v}", spec.name, over.name()),
+        );
+        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+        let outcome = source.linear((scene, &spec.name, over, v), &ensemble, |first, count| {
+            lr.simulate_ensemble(seed, first, count, steps, |_| {})
+        })?;
+        let records = match outcome {
+            shard::Outcome::Records(r) => r,
+            shard::Outcome::Written => continue,
+            shard::Outcome::Failed(f) => {
+                failed.push(f);
+                continue;
+            }
+        };
+        let est = match estimates(lr, &records) {
+            Ok(est) => est,
             Err(e) => {
                 failed.push(FailedValue::record(v, e)?);
                 continue;
@@ -1129,23 +1200,6 @@ fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Ve
 
 /// An estimate and its standard error.
 type Estimate = (f64, f64);
-
-/// Simulates the ensemble of one value (`s`, `lr` prepared for it; one PCG stream per
-/// trajectory, seeded from the run's name and the value) and forms the estimates of
-/// the observables; the records are returned for the slope diagnostics.
-fn simulate_value(
-    s: &Scene,
-    lr: &LinearRun,
-    run_name: &str,
-    over: Over,
-    v: f64,
-    ensemble: Ensemble,
-) -> Result<(Vec<Estimate>, Vec<TrajectoryRecord>)> {
-    let seed = derive_seed(s.seed, &format!("{run_name}/converge/{}={v}", over.name()));
-    let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-    let records = lr.simulate_ensemble(seed, 0, ensemble.trajectories as u64, steps, |_| {})?;
-    Ok((estimates(lr, &records)?, records))
-}
 
 /// The rows of one value: one per observable, from its estimates and exact references.
 fn value_rows(names: &[String], refp: &PointReference, est: &[Estimate]) -> Vec<Row> {

@@ -28,6 +28,7 @@
 //! ([`crate::scene::compression::force_estimates`]): per trajectory the time average of
 //! F with an integrated-autocorrelation-time error, trajectories independent.
 
+use super::shard::{Outcome, Source};
 use super::{ConvergeOptions, Expected, FailedValue, Over, Row, Study, validate_values};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
@@ -357,6 +358,7 @@ pub(super) fn study(
     run: usize,
     opts: &ConvergeOptions,
     ensemble: Ensemble,
+    source: &mut Source<'_>,
 ) -> Result<Study> {
     let over = opts.over;
     let spec = &scene.runs[run];
@@ -389,13 +391,21 @@ pub(super) fn study(
     let mut largest_slope: Option<(String, (f64, f64))> = None;
     for (((s, cr), point), &v) in prepared.iter().zip(&points).zip(&values) {
         let t0 = Instant::now();
-        let (est, records) = match simulate_value(s, cr, &spec.name, over, v, ensemble) {
-            Ok(r) => r,
-            Err(e) => {
-                failed.push(record_failure(scene, spec, opts, v, e)?);
-                continue;
-            }
-        };
+        let (est, records) =
+            match value_records((scene, s), cr, &spec.name, (over, v), ensemble, source)? {
+                Outcome::Records(r) => match force_estimates_diagnosed(&r, &s.filament) {
+                    Ok(est) => (est, r),
+                    Err(e) => {
+                        failed.push(record_failure(scene, spec, opts, v, e)?);
+                        continue;
+                    }
+                },
+                Outcome::Written => continue,
+                Outcome::Failed(f) => {
+                    failed.push(announce_failure(scene, spec, opts, f));
+                    continue;
+                }
+            };
         let slope = cr.largest_rms_slope(&records);
         notes.push(value_note(
             over,
@@ -458,7 +468,22 @@ fn record_failure(
     v: f64,
     e: Error,
 ) -> Result<FailedValue> {
-    let f = FailedValue::record(v, e)?;
+    Ok(announce_failure(
+        scene,
+        spec,
+        opts,
+        FailedValue::record(v, e)?,
+    ))
+}
+
+/// `f` with its progress line.
+fn announce_failure(
+    scene: &Scene,
+    spec: &RunSpec,
+    opts: &ConvergeOptions,
+    f: FailedValue,
+) -> FailedValue {
+    let v = f.value;
     if opts.progress {
         eprintln!(
             "converge {} {}: {}={v}: {}: {}",
@@ -469,7 +494,7 @@ fn record_failure(
             f.error
         );
     }
-    Ok(f)
+    f
 }
 
 /// The strains and values of a study (the options' or the defaults), validated; the
@@ -497,26 +522,35 @@ fn strains_and_values(
     Ok((strains, values))
 }
 
-/// Simulates the ensemble of one value (`s`, `cr` prepared for it; one seed per
-/// trajectory, from the run's name and the value) and forms the force estimates; the
-/// records are returned for the slope diagnostics.
-fn simulate_value(
-    s: &Scene,
+/// The records of one value of the study of `scene` (`s`, `cr` prepared for it; one
+/// seed per trajectory, from the run's name and the value), from `source`: simulated,
+/// this shard's share written, or every shard's read ([`super::shard`]).
+///
+/// # Errors
+/// As [`Source::force`] (a divergence is an [`Outcome::Failed`], not an error).
+fn value_records(
+    (scene, s): (&Scene, &Scene),
     cr: &CompressionRun,
     run_name: &str,
-    over: Over,
-    v: f64,
+    (over, v): (Over, f64),
     ensemble: Ensemble,
-) -> Result<(ForceEstimates, Vec<Vec<ForceRecord>>)> {
-    let steps = cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+    source: &mut Source<'_>,
+) -> Result<Outcome<Vec<Vec<ForceRecord>>>> {
+    let steps = vec![cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1()); cr.points()];
     let label = format!("{run_name}/converge/{}={v}", over.name());
-    let records = cr.simulate_ensemble(
-        |i| derive_seed(s.seed, &format!("{label}/{i}")),
-        ensemble.trajectories,
-        steps,
-        || {},
-    )?;
-    Ok((force_estimates_diagnosed(&records, &s.filament)?, records))
+    source.force(
+        (scene, run_name, over, v),
+        &ensemble,
+        cr.points(),
+        |range| {
+            cr.simulate_share_per_point(
+                |i| derive_seed(s.seed, &format!("{label}/{i}")),
+                range,
+                &steps,
+                || {},
+            )
+        },
+    )
 }
 
 /// The note of one value: acceptance (Metropolis), correlation time of F and largest RMS
