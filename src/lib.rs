@@ -22,7 +22,9 @@
 //!    driver and parallel ensembles).
 //! 5. Statistics: [`stats`] (estimators and hypothesis tests, validated on exactly
 //!    solvable processes).
-//! 6. Scenes: [`scene`] (scene files, their validation, and run preparation).
+//! 6. Scenes: [`scene`] (scene files, their validation, and run preparation), and
+//!    [`shard`] (a command's ensembles split across processes: the shard format, and the
+//!    checks of a shard set before a merge).
 //! 7. Verification and studies, side by side: [`verify`] (pass/fail checks and the
 //!    runner) and [`studies`] (convergence, stability map, work–precision).
 //! 8. Reports: [`report`] (the HTML index and the convergence pages).

@@ -186,8 +186,9 @@ pub struct ShardManifest {
     pub scenes: Vec<ShardScene>,
     /// The record files, in the order written.
     pub files: Vec<ShardFile>,
-    /// The shard process's provenance (its command line and wall time; not compared).
-    pub provenance: Provenance,
+    /// The shard process's provenance ([`Provenance`]: its command line and wall time;
+    /// not compared, and dropped by [`ShardSet::open`] but for the first shard).
+    pub provenance: serde_json::Value,
 }
 
 /// A shard being written: record files first, the manifest last ([`ShardWriter::finish`]).
@@ -195,6 +196,7 @@ pub struct ShardManifest {
 pub struct ShardWriter {
     dir: PathBuf,
     manifest: ShardManifest,
+    provenance: Provenance,
 }
 
 impl ShardWriter {
@@ -227,8 +229,9 @@ impl ShardWriter {
                 settings,
                 scenes,
                 files: Vec::new(),
-                provenance,
+                provenance: serde_json::Value::Null,
             },
+            provenance,
         })
     }
 
@@ -304,7 +307,9 @@ impl ShardWriter {
     /// # Errors
     /// [`Error::Io`] if it cannot be written.
     pub fn finish(mut self) -> Result<ShardManifest> {
-        self.manifest.provenance.finish();
+        self.provenance.finish();
+        self.manifest.provenance = serde_json::to_value(&self.provenance)
+            .map_err(|e| Error::io(&self.dir.join(SHARD_MANIFEST), e.into()))?;
         write_json(&self.dir.join(SHARD_MANIFEST), &self.manifest)?;
         Ok(self.manifest)
     }
@@ -322,8 +327,11 @@ fn sha256_hex(bytes: &[u8]) -> String {
 /// A complete, consistent set of shards `1/N … N/N` of one command, opened for the merge.
 #[derive(Debug, Clone)]
 pub struct ShardSet {
-    /// Each shard's directory and manifest, in shard order.
+    /// Each shard's directory and manifest, in shard order, without the scenes and the
+    /// provenance (equal in every shard: see [`Self::manifest`]).
     pub shards: Vec<(PathBuf, ShardManifest)>,
+    /// The first manifest read, whole.
+    first: ShardManifest,
 }
 
 /// Refusal of a shard set (exit 2): names the manifest, the key and what is wrong.
@@ -400,8 +408,11 @@ impl ShardSet {
     /// the first shard; a duplicated index (naming both directories); missing indices.
     pub fn open(dirs: &[PathBuf]) -> Result<ShardSet> {
         let mut shards: Vec<(PathBuf, ShardManifest)> = Vec::new();
+        let mut first: Option<(PathBuf, ShardManifest)> = None;
+        // Index → position in `shards`: duplicates and gaps in O(N log N).
+        let mut seen: std::collections::BTreeMap<usize, usize> = Default::default();
         for dir in Self::expand(dirs)? {
-            let m = Self::read_manifest(&dir)?;
+            let mut m = Self::read_manifest(&dir)?;
             if m.build != VERSION_LINE {
                 return Err(refuse(
                     &dir,
@@ -412,27 +423,40 @@ impl ShardSet {
                     ),
                 ));
             }
-            if let Some((first_dir, first)) = shards.first() {
-                same_set(&dir, &m, first_dir, first)?;
+            match &first {
+                Some((first_dir, first)) => same_set(&dir, &m, first_dir, first)?,
+                None => first = Some((dir.clone(), m.clone())),
             }
-            if let Some((other, _)) = shards.iter().find(|(_, o)| o.shard == m.shard) {
+            if let Some(&k) = seen.get(&m.shard.index) {
                 return Err(refuse(
                     &dir,
                     "shard",
                     format!(
                         "shard {} given twice: in {} and in {}",
                         m.shard,
-                        other.display(),
+                        shards[k].0.display(),
                         dir.display()
                     ),
                 ));
             }
+            seen.insert(m.shard.index, shards.len());
+            // Checked equal to the first shard's: not kept (10⁴ shards' scene texts and
+            // provenance would be most of the merge's memory).
+            m.scenes = Vec::new();
+            m.provenance = serde_json::Value::Null;
             shards.push((dir, m));
         }
         shards.sort_by_key(|(_, m)| m.shard.index);
-        let count = shards[0].1.shard.count;
+        let Some((_, first)) = first else {
+            return Err(Error::invalid(
+                "merge DIR",
+                "no directory",
+                "at least one shard",
+            ));
+        };
+        let count = first.shard.count;
         let missing: Vec<String> = (1..=count)
-            .filter(|i| !shards.iter().any(|(_, m)| m.shard.index == *i))
+            .filter(|i| !seen.contains_key(i))
             .map(|i| format!("{i}/{count}"))
             .collect();
         if !missing.is_empty() {
@@ -457,12 +481,13 @@ impl ShardSet {
                 ),
             ));
         }
-        Ok(ShardSet { shards })
+        Ok(ShardSet { shards, first })
     }
 
-    /// The first shard's manifest: the command's settings and scenes.
+    /// The first manifest read, whole: the command's settings and scenes (equal in every
+    /// shard of the set).
     pub fn manifest(&self) -> &ShardManifest {
-        &self.shards[0].1
+        &self.first
     }
 
     /// The scenes, rebuilt from their text, and each one's seed note.

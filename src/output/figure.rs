@@ -817,7 +817,7 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
-/// The inverse of [`xml_escape`]: decodes `&lt;`, `&gt;`, `&quot;`, `&apos;` and `&amp;`.
+/// The inverse of `xml_escape`: decodes `&lt;`, `&gt;`, `&quot;`, `&apos;` and `&amp;`.
 pub fn xml_unescape(s: &str) -> String {
     s.replace("&lt;", "<")
         .replace("&gt;", ">")

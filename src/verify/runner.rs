@@ -3,6 +3,10 @@
 //! [`ReportRun`]; it returns the [`Summary`] and the open report run, which
 //! [`crate::report::write_report`] finishes with `summary.json` and `index.html`.
 //!
+//! The runs' trajectories are simulated here, or, for `merge`, read from a complete set
+//! of shards ([`Ensembles::Merge`], [`super::shard`]): everything after that is the same
+//! code on the same records, so a merged report is the unsharded one.
+//!
 //! # Errors and exit codes
 //! Everything that can be checked before a simulation is (scene files, every run's
 //! set-up, the samples each check will get at the budget: [`Error::Scene`], exit 2), and

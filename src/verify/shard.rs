@@ -9,7 +9,7 @@
 //! every shard gets the same plan, which the merge checks) and shares the main stage.
 //!
 //! `merge` is [`super::run_verification`] with [`super::runner::Ensembles::Merge`]: the
-//! records of every run are read here ([`merged_linear`], [`merged_compression`]) in
+//! records of every run are read here (`merged_linear`, `merged_compression`) in
 //! trajectory order, and everything else — references, checks, the family-wise
 //! correction, tables, figures, the report — is the whole run's code on the whole run's
 //! records, so the outputs are the whole run's.

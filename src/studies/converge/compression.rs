@@ -427,15 +427,8 @@ pub(super) fn study(
         rows.extend(point_rows(&names, point, &est));
         if opts.progress {
             eprintln!(
-                "converge {} {} ({}): {}={v}: {} strains x {} trajectories x {} tau1, {:.1} s",
-                scene.name,
-                spec.name,
-                spec.integrator,
-                over.name(),
-                strains.len(),
-                ensemble.trajectories,
-                ensemble.duration_tau1,
-                t0.elapsed().as_secs_f64()
+                "{}",
+                progress_line(scene, spec, (over, v), strains.len(), ensemble, t0)
             );
         }
     }
@@ -455,6 +448,27 @@ pub(super) fn study(
         notes,
         warnings,
     })
+}
+
+/// The progress line of value `v` of a study, simulated since `t0`.
+fn progress_line(
+    scene: &Scene,
+    spec: &RunSpec,
+    (over, v): (Over, f64),
+    strains: usize,
+    ensemble: Ensemble,
+    t0: Instant,
+) -> String {
+    format!(
+        "converge {} {} ({}): {}={v}: {strains} strains x {} trajectories x {} tau1, {:.1} s",
+        scene.name,
+        spec.name,
+        spec.integrator,
+        over.name(),
+        ensemble.trajectories,
+        ensemble.duration_tau1,
+        t0.elapsed().as_secs_f64()
+    )
 }
 
 /// Records the failure of value `v` ([`FailedValue::record`]), with a progress line.

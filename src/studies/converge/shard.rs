@@ -4,7 +4,7 @@
 //! At every value of the study, shard `I/N` simulates its share of the trajectories
 //! ([`Shard::range`]; every strain's for a compression study) and writes their records
 //! (`records/<scene>/<run>/<over>=<value>.lin|frc`), or, if its share diverged, the
-//! failure (`….failed`, the [`FailedValue`] as JSON). The merge ([`Source::Merge`])
+//! failure (`….failed`, the [`FailedValue`] as JSON). The merge
 //! reads every shard's records of a value in trajectory order, or takes the first
 //! shard's failure in shard order, which is the failure of the smallest failing
 //! trajectory, as the whole study records it; everything else is the whole study's code.
