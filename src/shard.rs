@@ -309,7 +309,7 @@ impl ShardWriter {
     pub fn finish(mut self) -> Result<ShardManifest> {
         self.provenance.finish();
         self.manifest.provenance = serde_json::to_value(&self.provenance)
-            .map_err(|e| Error::io(&self.dir.join(SHARD_MANIFEST), e.into()))?;
+            .map_err(|e| Error::io(self.dir.join(SHARD_MANIFEST), e.into()))?;
         write_json(&self.dir.join(SHARD_MANIFEST), &self.manifest)?;
         Ok(self.manifest)
     }
