@@ -49,6 +49,7 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     let set = ShardSet::open(&args.shards)?;
     match set.manifest().command.as_str() {
         COMMAND => merge_verify(set, &args, verbosity, start),
+        super::run::COMMAND => super::run::merge(set, &args.out, verbosity),
         other => Err(langevin_fem::Error::invalid(
             "merge DIR",
             format!("shards of `{other}`"),
