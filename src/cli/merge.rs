@@ -1,6 +1,7 @@
-//! `langevin-fem merge`: the report of a run split into shards (`--shard I/N`), from the
-//! shards' records, byte for byte the report of the same run made in one process (wall
-//! times, run id and provenance aside). See [`langevin_fem::shard`].
+//! `langevin-fem merge`: the output of a command split into shards (`verify`, `converge`
+//! or `run` with `--shard I/N`), from the shards' records, byte for byte the output of
+//! the same command run in one process (wall times, run id and provenance aside). See
+//! [`langevin_fem::shard`].
 
 use super::Verbosity;
 use clap::Args;
@@ -22,10 +23,14 @@ Examples:
   langevin-fem verify -b full --shard 2/2 -o shards/2
   langevin-fem merge shards/1 shards/2 -o reports          the report of the whole run
   langevin-fem merge shards -o reports                     the same: every shard under shards/
+  langevin-fem converge -s compression-2d --over elements --shard 1/2 -o cv/1   (and 2/2)
+  langevin-fem merge cv/1 cv/2 -o reports/convergence      the whole study and its index
+  langevin-fem run -s hinged-linear-2d --shard 1/2 -o traj/1                     (and 2/2)
+  langevin-fem merge traj/1 traj/2 -o traj                 the whole run's trajectories
 
 Refused (exit 2, naming the shard): a missing or duplicated shard, shards of other scenes,
-seeds, budgets or builds, a damaged record file. The exit code is otherwise verify's: 0 if
-every check passed, 1 if one failed.";
+seeds, budgets, settings or builds, a damaged record file. The exit code is otherwise the
+command's: for verify 0 if every check passed, 1 if one failed.";
 
 /// Command-line arguments of `langevin-fem merge`.
 #[derive(Debug, Args)]
@@ -35,12 +40,13 @@ pub struct MergeArgs {
     /// are shards; together exactly the shards 1/N … N/N of one run.
     #[arg(required = true, value_name = "DIR")]
     shards: Vec<PathBuf>,
-    /// Output directory of the merged report (summary.json, index.html, tables, figures).
+    /// Output directory of the merged output (verify: summary.json, index.html, tables,
+    /// figures; converge: the study's set and index; run: the trajectories and data.json).
     #[arg(short, long, default_value = "reports")]
     pub(super) out: PathBuf,
 }
 
-/// Opens the shard set, checks it, and writes the whole run's report to `--out`.
+/// Opens the shard set, checks it, and writes the whole command's output to `--out`.
 ///
 /// # Errors
 /// Exit 2 for a shard set that is not one complete, consistent set
@@ -51,10 +57,11 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     match set.manifest().command.as_str() {
         COMMAND => merge_verify(set, &args, verbosity, start),
         CONVERGE => super::converge::merge(set, &args.out, verbosity),
+        super::run::COMMAND => super::run::merge(set, &args.out, verbosity),
         other => Err(langevin_fem::Error::invalid(
             "merge DIR",
             format!("shards of `{other}`"),
-            "shards of `verify` or `converge`",
+            "shards of `verify`, `converge` or `run`",
         )),
     }
 }

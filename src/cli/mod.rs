@@ -105,8 +105,8 @@ enum Command {
     /// Simulate a scene's ensemble and write every trajectory's time series (NumPy .npy
     /// or CSV, with a data.json sidecar) for your own analysis or `check`.
     Run(run::RunArgs),
-    /// The report of a run split into shards (`verify --shard I/N`): byte for byte the
-    /// report the run makes in one process.
+    /// The output of a command split into shards (`verify`, `converge` or `run` with
+    /// `--shard I/N`): byte for byte what the command writes in one process.
     Merge(merge::MergeArgs),
     /// Apply a scene's statistical checks to trajectories written by any simulator in
     /// the trajectory data format (the format `run` writes).

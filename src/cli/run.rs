@@ -1,6 +1,16 @@
 //! `langevin-fem run`: simulate a scene's ensemble and write every trajectory's time
 //! series in the trajectory data format ([`langevin_fem::data`]), ready for NumPy, pandas
 //! or `langevin-fem check`.
+//!
+//! With `--shard I/N` (issue #15, [`langevin_fem::shard`]) the process simulates only
+//! shard `I`'s share of every chosen run's trajectories (per strain for a compression
+//! run) and writes their files under the same relative names as the whole run, with a
+//! shard manifest instead of `data.json` and `manifest.json`; `langevin-fem merge`
+//! ([`merge`]) then assembles the whole run's directory from the shards.
+
+mod merge;
+
+pub use merge::merge;
 
 use super::{Verbosity, usize_in};
 use clap::Args;
@@ -16,9 +26,14 @@ use langevin_fem::rng::derive_seed;
 use langevin_fem::scene::compression::CompressionRun;
 use langevin_fem::scene::linear::{LinearRun, RowPlan};
 use langevin_fem::scene::{Budget, ModelKind, Scene};
-use langevin_fem::work::{RunWork, WorkProjection};
+use langevin_fem::shard::{Shard, ShardScene, ShardWriter};
+use langevin_fem::work::{RunWork, WorkLimits, WorkProjection};
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The name of the command in a `run` shard's manifest.
+pub const COMMAND: &str = "run";
 
 /// The examples of `run --help`.
 const EXAMPLES: &str = "\
@@ -27,6 +42,8 @@ Examples:
   langevin-fem run -s hinged-linear-2d --run crank-nicolson --trajectories 8 \\
       --duration-tau1 40 --every 10 --format csv -o traj
   langevin-fem check -s hinged-linear-2d -d traj               then check them
+  langevin-fem run -s hinged-linear-2d --shard 2/4 -o shards/2 shard 2 of 4, then:
+  langevin-fem merge shards/1 shards/2 shards/3 shards/4 -o traj
 
 Progress goes to stderr, the closing line (what was written, where) to stdout.";
 
@@ -57,6 +74,11 @@ pub struct RunArgs {
     /// File format of the trajectories.
     #[arg(long, value_enum, default_value = "npy")]
     format: FormatArg,
+    /// Simulate only shard I of N of every chosen run's trajectories and write their
+    /// files and a manifest (shard.json) to --out, without data.json; `langevin-fem
+    /// merge` then writes the whole run's directory, byte for byte.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
     #[command(flatten)]
     sim: super::SimArgs,
     /// Output directory: data.json (the sidecar), manifest.json and <run>/trajectory-NNNN.<format>.
@@ -70,65 +92,245 @@ pub struct RunArgs {
     limits: super::LimitArgs,
 }
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+/// The file format of the trajectories.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 enum FormatArg {
     Npy,
     Csv,
 }
 
-/// What one `run` command does: the scene (seed applied), the chosen runs and their
-/// ensembles.
-struct Job<'a> {
-    args: &'a RunArgs,
+/// Everything of a `run` that shapes its files, apart from the scene and its seed: a
+/// shard manifest's settings, from which `merge` rebuilds the job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RunSettings {
+    /// The budget whose ensembles the flags amend.
+    budget: Budget,
+    /// The chosen runs' names, in the scene's order.
+    runs: Vec<String>,
+    /// `--trajectories`.
+    trajectories: Option<usize>,
+    /// `--duration-tau1`.
+    duration_tau1: Option<f64>,
+    /// `--every`.
+    every: Option<u64>,
+    /// `--format`.
+    format: FormatArg,
+}
+
+/// What one `run` command (or a merge of its shards) does: the scene (seed applied), the
+/// chosen runs and their ensembles, and where the files go.
+struct Job {
+    settings: RunSettings,
+    /// The output directory.
+    out: PathBuf,
+    /// The scene as named on the command line (for the closing line's `check` hint).
+    scene_arg: String,
     /// What is printed on stderr while it runs.
     verbosity: Verbosity,
     scene: Scene,
     seed_note: String,
-    budget: Budget,
     /// Indices of the chosen runs in the scene.
     chosen: Vec<usize>,
+    /// The share of every run's trajectories simulated ([`Shard::WHOLE`] but with
+    /// `--shard`).
+    shard: Shard,
+    limits: WorkLimits,
 }
 
-impl Job<'_> {
+/// Where a job's files go: a whole run's report directory, with its provenance (its
+/// journal `manifest.json` and sidecar `data.json` written at the end), or a shard.
+enum Sink {
+    /// A whole run (or a merge): every file listed in the journal before it is written.
+    Whole(Provenance, ReportRun),
+    /// A shard: every file listed in the shard manifest once written.
+    Shard(ShardWriter),
+}
+
+impl Sink {
+    /// Lists the file `rel` (relative to the output directory `out`) in the journal of a
+    /// whole run before it is written.
+    fn record(&self, out: &Path, rel: &str) -> Result<()> {
+        match self {
+            Sink::Whole(_, report) => report.record(&out.join(rel)).map(|_| ()),
+            Sink::Shard(_) => Ok(()),
+        }
+    }
+
+    /// Lists the file `rel`, trajectory `j` of run `key` (`<run>` or
+    /// `<run>/strain-NN`), in a shard's manifest once written.
+    fn written(&mut self, (scene, key): (&str, &str), rel: &str, j: u64) -> Result<()> {
+        match self {
+            Sink::Whole(..) => Ok(()),
+            Sink::Shard(w) => w.add_file((scene, key), rel, j..j + 1, serde_json::Value::Null),
+        }
+    }
+}
+
+/// The relative name of linear run `run`'s trajectory `j` in format `ext`.
+fn linear_file(run: &str, j: u64, ext: &str) -> String {
+    format!("{run}/trajectory-{j:04}.{ext}")
+}
+
+/// The shard-manifest key of compression run `run` at strain `i`.
+fn strain_key(run: &str, i: usize) -> String {
+    format!("{run}/strain-{i:02}")
+}
+
+/// The relative name of compression run `run`'s trajectory `j` at strain `i`.
+fn compression_file(run: &str, i: usize, j: u64, ext: &str) -> String {
+    format!("{}/trajectory-{j:04}.{ext}", strain_key(run, i))
+}
+
+impl Job {
+    /// The job of `settings` on `scene`: the chosen runs checked against the scene.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `--run` for a run the scene lacks, or
+    /// `--duration-tau1` out of range.
+    fn new(
+        settings: RunSettings,
+        scene: Scene,
+        seed_note: String,
+        (out, scene_arg): (PathBuf, String),
+        verbosity: Verbosity,
+        (shard, limits): (Shard, WorkLimits),
+    ) -> Result<Job> {
+        if let Some(d) = settings.duration_tau1
+            && !(d.is_finite() && (1.0..=1e6).contains(&d))
+        {
+            return Err(Error::invalid(
+                "--duration-tau1",
+                d,
+                "a duration in [1, 1e6] tau1",
+            ));
+        }
+        for r in &settings.runs {
+            if !scene.runs.iter().any(|s| &s.name == r) {
+                let names: Vec<&str> = scene.runs.iter().map(|s| s.name.as_str()).collect();
+                return Err(Error::invalid(
+                    "--run",
+                    r,
+                    format!("a run of {}: {}", scene.name, names.join(", ")),
+                ));
+            }
+        }
+        let chosen = (0..scene.runs.len())
+            .filter(|&k| settings.runs.contains(&scene.runs[k].name))
+            .collect();
+        Ok(Job {
+            settings,
+            out,
+            scene_arg,
+            verbosity,
+            scene,
+            seed_note,
+            chosen,
+            shard,
+            limits,
+        })
+    }
+
+    /// The budget whose ensembles the flags amend.
+    fn budget(&self) -> Budget {
+        self.settings.budget
+    }
+
     /// Trajectories and sampled duration (τ1) of run `k`: the flags, else the budget's.
     fn ensemble(&self, k: usize) -> (usize, f64) {
-        let e = self.scene.runs[k].ensemble(self.budget);
+        let e = self.scene.runs[k].ensemble(self.budget());
         (
-            self.args.trajectories.unwrap_or(e.trajectories),
-            self.args.duration_tau1.unwrap_or(e.duration_tau1),
+            self.settings.trajectories.unwrap_or(e.trajectories),
+            self.settings.duration_tau1.unwrap_or(e.duration_tau1),
         )
     }
 
     /// The file extension of the trajectories.
     fn ext(&self) -> &'static str {
-        match self.args.format {
+        match self.settings.format {
             FormatArg::Npy => "npy",
             FormatArg::Csv => "csv",
         }
     }
 
-    /// Starts the report directory with its provenance.
-    fn begin(&self) -> Result<(Provenance, ReportRun)> {
-        let provenance = Provenance::begin(&[&self.scene]);
-        let report = ReportRun::begin(&self.args.out, "run", "manifest.json", &[SIDECAR])?;
-        report.set_provenance(provenance.clone())?;
-        Ok((provenance, report))
+    /// Checks the projected work (this shard's share of it) against the caps.
+    fn check_work(&self, mut work: WorkProjection) -> Result<()> {
+        for part in &mut work.parts {
+            part.work.trajectory_steps *= self.shard.fraction();
+            part.work.dof_steps *= self.shard.fraction();
+        }
+        self.limits.check(&work)
     }
 
-    /// Completes the report directory: the final provenance, then the sidecar listing
-    /// `runs` (EA given for compression data), and the closing line naming `what`.
+    /// Starts the output: the report directory with its provenance, or the shard.
+    fn begin(&self) -> Result<Sink> {
+        let provenance = Provenance::begin(&[&self.scene]);
+        if !self.shard.is_whole() {
+            let settings = serde_json::to_value(&self.settings).map_err(|e| {
+                Error::io(self.out.join(langevin_fem::shard::SHARD_MANIFEST), e.into())
+            })?;
+            let scenes = vec![ShardScene::of(&self.scene, &self.seed_note)];
+            let writer =
+                ShardWriter::begin(&self.out, COMMAND, self.shard, settings, scenes, provenance)?;
+            return Ok(Sink::Shard(writer));
+        }
+        let report = ReportRun::begin(&self.out, "run", "manifest.json", &[SIDECAR])?;
+        report.set_provenance(provenance.clone())?;
+        Ok(Sink::Whole(provenance, report))
+    }
+
+    /// Completes the output: a shard's manifest, or the whole run's final provenance
+    /// and sidecar listing `runs` (EA given for compression data); then the closing line
+    /// naming `what`.
     fn finish(
         &self,
-        mut provenance: Provenance,
-        report: ReportRun,
+        sink: Sink,
         runs: Vec<DataRun>,
         stretch_rigidity: Option<f64>,
         what: String,
     ) -> Result<i32> {
+        let (mut provenance, report) = match sink {
+            Sink::Whole(provenance, report) => (provenance, report),
+            Sink::Shard(writer) => {
+                let manifest = writer.finish()?;
+                let n = self.shard.count;
+                println!(
+                    "shard {}: {} trajectory file(s) in {}; when every shard of {n} is done: langevin-fem merge <the {n} shard directories> -o <output dir>",
+                    self.shard,
+                    manifest.files.len(),
+                    self.out.display(),
+                );
+                return Ok(0);
+            }
+        };
         provenance.finish();
         report.set_provenance(provenance.clone())?;
+        let sidecar = self.sidecar(&report, provenance, runs, stretch_rigidity);
+        let out = &self.out;
+        let text = serde_json::to_string_pretty(&sidecar)
+            .map_err(|e| Error::io(out.join(SIDECAR), e.into()))?
+            + "\n";
+        report.finish(&[(SIDECAR, text.as_bytes())])?;
+        println!(
+            "wrote {what} to {}; check them with: langevin-fem check --scene {} --data {}",
+            out.display(),
+            self.scene_arg,
+            out.display()
+        );
+        Ok(0)
+    }
+
+    /// The sidecar (`data.json`) of the whole run `report` listing `runs`.
+    fn sidecar(
+        &self,
+        report: &ReportRun,
+        provenance: Provenance,
+        runs: Vec<DataRun>,
+        stretch_rigidity: Option<f64>,
+    ) -> DataSidecar {
         let (scene, f) = (&self.scene, self.scene.filament);
-        let sidecar = DataSidecar {
+        DataSidecar {
             format: FORMAT.to_string(),
             version: VERSION,
             producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
@@ -143,7 +345,7 @@ impl Job<'_> {
             runs,
             provenance: Some(serde_json::json!({
                 "run_id": report.run_id(),
-                "budget": self.budget.name(),
+                "budget": self.budget().name(),
                 "seed": scene.seed,
                 "seed_note": self.seed_note,
                 "tau1": f.tau1(),
@@ -151,19 +353,7 @@ impl Job<'_> {
                 "record": provenance,
             })),
             columns: Some(trajectory_columns()),
-        };
-        let out = &self.args.out;
-        let text = serde_json::to_string_pretty(&sidecar)
-            .map_err(|e| Error::io(out.join(SIDECAR), e.into()))?
-            + "\n";
-        report.finish(&[(SIDECAR, text.as_bytes())])?;
-        println!(
-            "wrote {what} to {}; check them with: langevin-fem check --scene {} --data {}",
-            out.display(),
-            self.args.scene,
-            out.display()
-        );
-        Ok(0)
+        }
     }
 
     /// The discretization of run `k` at time step `dt`, as the sidecar records it.
@@ -188,36 +378,27 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
-    if let Some(d) = args.duration_tau1
-        && !(d.is_finite() && (1.0..=1e6).contains(&d))
-    {
-        return Err(Error::invalid(
-            "--duration-tau1",
-            d,
-            "a duration in [1, 1e6] tau1",
-        ));
-    }
-    for r in &args.runs {
-        if !scene.runs.iter().any(|s| &s.name == r) {
-            let names: Vec<&str> = scene.runs.iter().map(|s| s.name.as_str()).collect();
-            return Err(Error::invalid(
-                "--run",
-                r,
-                format!("a run of {}: {}", scene.name, names.join(", ")),
-            ));
-        }
-    }
-    let chosen: Vec<usize> = (0..scene.runs.len())
-        .filter(|&k| args.runs.is_empty() || args.runs.contains(&scene.runs[k].name))
-        .collect();
-    let job = Job {
+    let runs = if args.runs.is_empty() {
+        scene.runs.iter().map(|r| r.name.clone()).collect()
+    } else {
+        args.runs.clone()
+    };
+    let settings = RunSettings {
         budget: args.budget.budget(),
-        args: &args,
-        verbosity,
+        runs,
+        trajectories: args.trajectories,
+        duration_tau1: args.duration_tau1,
+        every: args.every,
+        format: args.format,
+    };
+    let job = Job::new(
+        settings,
         scene,
         seed_note,
-        chosen,
-    };
+        (args.out, args.scene),
+        verbosity,
+        (args.shard.unwrap_or(Shard::WHOLE), args.limits.limits()),
+    )?;
     if job.scene.compression.is_some() {
         run_compression(&job)
     } else {
@@ -225,9 +406,9 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     }
 }
 
-/// `run` of a linear scene: every chosen run's trajectories from rest, streamed.
-fn run_linear(job: &Job<'_>) -> Result<i32> {
-    let (scene, args) = (&job.scene, job.args);
+/// The chosen runs of a linear scene, prepared, with their row plans.
+fn prepare_linear(job: &Job) -> Result<(Vec<LinearRun>, Vec<RowPlan>)> {
+    let scene = &job.scene;
     let tau1 = scene.filament.tau1();
     let runs = job
         .chosen
@@ -243,66 +424,105 @@ fn run_linear(job: &Job<'_>) -> Result<i32> {
         .zip(&runs)
         .map(|(&k, run)| {
             let steps = run.sampled_steps(job.ensemble(k).1 * tau1);
-            run.row_plan(scene, steps, args.every)
+            run.row_plan(scene, steps, job.settings.every)
         })
         .collect::<Result<Vec<_>>>()?;
-    let work = projection(job, &plans);
-    args.limits.limits().check(&work)?;
-    let (provenance, report) = job.begin()?;
+    Ok((runs, plans))
+}
+
+/// What a linear job writes, for the closing line.
+fn linear_what(job: &Job) -> String {
     let total: u64 = job.chosen.iter().map(|&k| job.ensemble(k).0 as u64).sum();
-    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
+    format!(
+        "{total} trajectories of {} ({} run(s))",
+        job.scene.name,
+        job.chosen.len()
+    )
+}
+
+/// `run` of a linear scene: every chosen run's trajectories (this shard's) from rest,
+/// streamed.
+fn run_linear(job: &Job) -> Result<i32> {
+    let scene = &job.scene;
+    let (runs, plans) = prepare_linear(job)?;
+    let work = projection(job, &plans);
+    job.check_work(work.clone())?;
+    let mut sink = job.begin()?;
+    let bar = Progress::new(
+        job.verbosity.progress(),
+        work.dof_steps() * job.shard.fraction(),
+        "DOF-steps",
+    );
     let mut data_runs = Vec::new();
     for (((&k, run), plan), part) in job.chosen.iter().zip(&runs).zip(&plans).zip(&work.parts) {
         let label = format!("{}/{}", scene.name, scene.runs[k].name);
-        bar.begin_run(&scene.name, &label, part.work.dof_steps);
-        data_runs.push(write_linear_run(job, &report, k, run, plan, &bar)?);
+        bar.begin_run(
+            &scene.name,
+            &label,
+            part.work.dof_steps * job.shard.fraction(),
+        );
+        data_runs.push(write_linear_run(job, &mut sink, k, run, plan, &bar)?);
     }
     bar.finish();
-    let what = format!(
-        "{total} trajectories of {} ({} run(s))",
-        scene.name,
-        job.chosen.len()
-    );
-    job.finish(provenance, report, data_runs, None, what)
+    job.finish(sink, data_runs, None, linear_what(job))
 }
 
-/// Simulates and writes the trajectories of linear run `k`; returns its sidecar entry.
+/// Simulates and writes this shard's trajectories of linear run `k`; returns its
+/// sidecar entry.
 fn write_linear_run(
-    job: &Job<'_>,
-    report: &ReportRun,
+    job: &Job,
+    sink: &mut Sink,
     k: usize,
     run: &LinearRun,
     plan: &RowPlan,
     bar: &Progress,
 ) -> Result<DataRun> {
-    let (scene, out) = (&job.scene, &job.args.out);
+    let (scene, out) = (&job.scene, &job.out);
     let spec = &scene.runs[k];
     let count = job.ensemble(k).0 as u64;
-    let per_trajectory = bar.run_work() / count.max(1) as f64;
+    let range = job.shard.range(count);
+    let per_trajectory = bar.run_work() / (range.end - range.start).max(1) as f64;
     let files: Vec<String> = (0..count)
-        .map(|j| format!("{}/trajectory-{j:04}.{}", spec.name, job.ext()))
+        .map(|j| linear_file(&spec.name, j, job.ext()))
         .collect();
-    for f in &files {
-        report.record(&out.join(f))?;
+    for j in range.clone() {
+        sink.record(out, &files[j as usize])?;
     }
     let seed = derive_seed(scene.seed, &spec.name);
     run.write_ensemble(
         seed,
-        count,
+        range.clone(),
         plan,
         |j| out.join(&files[j as usize]),
         |n| bar.advance(n as f64 * per_trajectory),
     )
     .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
+    for j in range.clone() {
+        sink.written((&scene.name, &spec.name), &files[j as usize], j)?;
+    }
     if job.verbosity == Verbosity::Verbose {
         bar.println(&format!(
-            "{} / {}: {count} trajectories x {} rows",
-            scene.name, spec.name, plan.rows
+            "{} / {}: {} trajectories x {} rows",
+            scene.name,
+            spec.name,
+            range.end - range.start,
+            plan.rows
         ));
     }
+    Ok(linear_data_run(job, k, run, plan, files))
+}
+
+/// The sidecar entry of linear run `k` with its trajectory files `files`.
+fn linear_data_run(
+    job: &Job,
+    k: usize,
+    run: &LinearRun,
+    plan: &RowPlan,
+    files: Vec<String>,
+) -> DataRun {
     let dt = run.reference.dt;
-    Ok(DataRun {
-        name: spec.name.clone(),
+    DataRun {
+        name: job.scene.runs[k].name.clone(),
         dt_sample: plan.every as f64 * dt,
         start: Start::Rest,
         burn_in: run.burn_in_steps as f64 * dt,
@@ -311,13 +531,14 @@ fn write_linear_run(
         discretization: Some(job.discretization(k, dt)),
         files,
         strain_ratio: None,
-    })
+    }
 }
 
-/// The projected work: per chosen run, every trajectory's steps (burn-in included)
-/// times the unknowns each updates, at the cost per step of the scene's own projection.
-fn projection(job: &Job<'_>, plans: &[RowPlan]) -> WorkProjection {
-    let parts = job.scene.projected_work(job.budget);
+/// The projected work of the whole run: per chosen run, every trajectory's steps
+/// (burn-in included) times the unknowns each updates, at the cost per step of the
+/// scene's own projection.
+fn projection(job: &Job, plans: &[RowPlan]) -> WorkProjection {
+    let parts = job.scene.projected_work(job.budget());
     WorkProjection {
         command: "run".to_string(),
         parts: job
@@ -352,72 +573,89 @@ fn projection(job: &Job<'_>, plans: &[RowPlan]) -> WorkProjection {
     }
 }
 
-/// `run` of a compression scene: per run and strain, every trajectory's F and stored
-/// length after the burn-in (the samples `verify` takes, same seeds), one data run per
-/// strain in the sidecar. A budget by target precision chooses durations by a pilot:
-/// `--duration-tau1` is then required.
-fn run_compression(job: &Job<'_>) -> Result<i32> {
-    let (scene, args) = (&job.scene, job.args);
+/// The chosen runs of a compression scene, prepared. A budget by target precision
+/// chooses durations by a pilot: `--duration-tau1` is then required.
+fn prepare_compression(job: &Job) -> Result<Vec<CompressionRun>> {
+    let scene = &job.scene;
     let Some(comp) = &scene.compression else {
-        return run_linear(job);
+        return Ok(Vec::new());
     };
     for &k in &job.chosen {
-        let e = scene.runs[k].ensemble(job.budget);
-        if e.precision_target().is_some() && args.duration_tau1.is_none() {
+        let e = scene.runs[k].ensemble(job.budget());
+        if e.precision_target().is_some() && job.settings.duration_tau1.is_none() {
             return Err(Error::invalid(
                 "--duration-tau1",
                 "not given",
                 format!(
                     "a duration in tau1: the {} budget of run {} chooses its durations by a pilot (target precision), which run does not do",
-                    job.budget.name(),
+                    job.budget().name(),
                     scene.runs[k].name
                 ),
             ));
         }
     }
-    let runs = job
-        .chosen
+    job.chosen
         .iter()
         .map(|&k| {
             CompressionRun::prepare(scene, comp, &scene.runs[k])
                 .map_err(|e| scene.run_error(k, "integrator", e))
         })
-        .collect::<Result<Vec<_>>>()?;
-    let work = compression_projection(job);
-    args.limits.limits().check(&work)?;
-    let (provenance, report) = job.begin()?;
-    let strains = comp.strain_ratios.len();
+        .collect()
+}
+
+/// What a compression job writes, for the closing line.
+fn compression_what(job: &Job) -> String {
+    let strains = job
+        .scene
+        .compression
+        .as_ref()
+        .map_or(0, |c| c.strain_ratios.len());
     let total: u64 = job
         .chosen
         .iter()
         .map(|&k| (job.ensemble(k).0 * strains) as u64)
         .sum();
-    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
-    let mut data_runs = Vec::new();
-    for ((&k, run), part) in job.chosen.iter().zip(&runs).zip(&work.parts) {
-        let label = format!("{}/{}", scene.name, scene.runs[k].name);
-        bar.begin_run(&scene.name, &label, part.work.dof_steps);
-        data_runs.extend(write_compression_run(job, &report, k, run, &bar)?);
-    }
-    bar.finish();
-    let what = format!(
+    format!(
         "{total} trajectories of {} ({} run(s) x {strains} strains)",
-        scene.name,
+        job.scene.name,
         job.chosen.len()
-    );
-    job.finish(
-        provenance,
-        report,
-        data_runs,
-        Some(scene.filament.stretch_rigidity),
-        what,
     )
 }
 
+/// `run` of a compression scene: per run and strain, every trajectory's (this shard's)
+/// F and stored length after the burn-in (the samples `verify` takes, same seeds), one
+/// data run per strain in the sidecar.
+fn run_compression(job: &Job) -> Result<i32> {
+    let scene = &job.scene;
+    let runs = prepare_compression(job)?;
+    let work = compression_projection(job);
+    job.check_work(work.clone())?;
+    let mut sink = job.begin()?;
+    let bar = Progress::new(
+        job.verbosity.progress(),
+        work.dof_steps() * job.shard.fraction(),
+        "DOF-steps",
+    );
+    let mut data_runs = Vec::new();
+    for ((&k, run), part) in job.chosen.iter().zip(&runs).zip(&work.parts) {
+        let label = format!("{}/{}", scene.name, scene.runs[k].name);
+        bar.begin_run(
+            &scene.name,
+            &label,
+            part.work.dof_steps * job.shard.fraction(),
+        );
+        data_runs.extend(write_compression_run(job, &mut sink, k, run, &bar)?);
+    }
+    bar.finish();
+    let ea = Some(scene.filament.stretch_rigidity);
+    job.finish(sink, data_runs, ea, compression_what(job))
+}
+
 /// The projected work of the chosen compression runs: the scene's projection at the
-/// budget, scaled up to the flags' trajectories and duration.
-fn compression_projection(job: &Job<'_>) -> WorkProjection {
-    let parts = job.scene.projected_work(job.budget);
+/// budget, scaled up to the flags' trajectories and duration (against the longest
+/// duration of a budget by target precision).
+fn compression_projection(job: &Job) -> WorkProjection {
+    let parts = job.scene.projected_work(job.budget());
     WorkProjection {
         command: "run".to_string(),
         parts: job
@@ -426,9 +664,11 @@ fn compression_projection(job: &Job<'_>) -> WorkProjection {
             .map(|&k| {
                 let mut part = parts[k].clone();
                 let (n, d) = job.ensemble(k);
-                let e = job.scene.runs[k].ensemble(job.budget);
-                let scale =
-                    (n as f64 / e.trajectories.max(1) as f64) * (d / e.duration_tau1.max(1e-300));
+                let e = job.scene.runs[k].ensemble(job.budget());
+                let projected = e
+                    .precision_target()
+                    .map_or(e.duration_tau1, |t| t.max_duration_tau1);
+                let scale = (n as f64 / e.trajectories.max(1) as f64) * (d / projected.max(1e-300));
                 if scale.is_finite() {
                     part.work.trajectory_steps *= scale.max(1.0);
                     part.work.dof_steps *= scale.max(1.0);
@@ -439,11 +679,11 @@ fn compression_projection(job: &Job<'_>) -> WorkProjection {
     }
 }
 
-/// Simulates compression run `k` at every strain and writes each trajectory's F and
-/// stored length; returns one sidecar entry per strain.
+/// Simulates this shard's trajectories of compression run `k` at every strain and
+/// writes each one's F and stored length; returns one sidecar entry per strain.
 fn write_compression_run(
-    job: &Job<'_>,
-    report: &ReportRun,
+    job: &Job,
+    sink: &mut Sink,
     k: usize,
     run: &CompressionRun,
     bar: &Progress,
@@ -454,30 +694,25 @@ fn write_compression_run(
     };
     let spec = &scene.runs[k];
     let (n, duration) = job.ensemble(k);
-    let per_trajectory = bar.run_work() / (n * run.points()).max(1) as f64;
+    let range = job.shard.range(n as u64);
+    let share = (range.end - range.start) as usize;
+    let per_trajectory = bar.run_work() / (share * run.points()).max(1) as f64;
     let steps: Vec<u64> = (0..run.points())
         .map(|i| run.sampled_steps_at(i, duration * f.tau1()))
         .collect();
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", spec.name));
     let records = run
-        .simulate_ensemble_per_point(seed, n, &steps, || bar.advance(per_trajectory))
+        .simulate_share_per_point(seed, range.clone(), &steps, || bar.advance(per_trajectory))
         .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
     let columns: Vec<String> = COMPRESSION_COLUMNS.iter().map(|c| c.to_string()).collect();
     let euler_strain = PI.powi(2) * f.bending_rigidity / (f.stretch_rigidity * f.length.powi(2));
-    let mut data_runs = Vec::new();
     for (i, at_strain) in records.iter().enumerate() {
-        let ratio = comp.strain_ratios[i];
-        let strain = ratio * euler_strain;
+        let strain = comp.strain_ratios[i] * euler_strain;
         let (dts, burn_in) = (run.sample_dt_at(i), run.burn_in_at(i));
-        let mut files = Vec::new();
-        for (j, rec) in at_strain.iter().enumerate() {
-            let rel = format!(
-                "{}/strain-{i:02}/trajectory-{j:04}.{}",
-                spec.name,
-                job.ext()
-            );
-            let path = job.args.out.join(&rel);
-            report.record(&path)?;
+        for (j, rec) in (range.start..).zip(at_strain) {
+            let rel = compression_file(&spec.name, i, j, job.ext());
+            let path = job.out.join(&rel);
+            sink.record(&job.out, &rel)?;
             let mut file = TrajectoryFile::create(&path, &columns, rec.force_ratio.len() as u64)?;
             for (r, fr) in rec.force_ratio.iter().enumerate() {
                 let force = fr * run.euler_load;
@@ -485,19 +720,35 @@ fn write_compression_run(
                 file.push_row(&[burn_in + (r + 1) as f64 * dts, force, stored])?;
             }
             file.commit()?;
-            files.push(rel);
+            sink.written((&scene.name, &strain_key(&spec.name, i)), &rel, j)?;
         }
-        data_runs.push(DataRun {
-            name: spec.name.clone(),
-            dt_sample: dts,
+    }
+    Ok(compression_data_runs(job, k, run, n as u64))
+}
+
+/// The sidecar entries of compression run `k`, one per strain, each listing the `n`
+/// trajectory files of its strain.
+fn compression_data_runs(job: &Job, k: usize, run: &CompressionRun, n: u64) -> Vec<DataRun> {
+    let Some(comp) = &job.scene.compression else {
+        return Vec::new();
+    };
+    let name = &job.scene.runs[k].name;
+    comp.strain_ratios
+        .iter()
+        .take(run.points())
+        .enumerate()
+        .map(|(i, &ratio)| DataRun {
+            name: name.clone(),
+            dt_sample: run.sample_dt_at(i),
             start: Start::Stationary,
-            burn_in,
+            burn_in: run.burn_in_at(i),
             positions: Vec::new(),
             modes: 0,
             discretization: Some(job.discretization(k, run.dt_at(i))),
-            files,
+            files: (0..n)
+                .map(|j| compression_file(name, i, j, job.ext()))
+                .collect(),
             strain_ratio: Some(ratio),
-        });
-    }
-    Ok(data_runs)
+        })
+        .collect()
 }

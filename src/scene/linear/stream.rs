@@ -6,6 +6,7 @@ use crate::data::TrajectoryFile;
 use crate::dynamics::Observer;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+use std::ops::Range;
 use std::path::PathBuf;
 
 /// What [`LinearRun::write_ensemble`] writes per trajectory.
@@ -78,25 +79,27 @@ impl LinearRun {
         })
     }
 
-    /// Simulates the trajectories `0..count` of the ensemble seeded `seed` (the same
-    /// trajectories as [`Self::simulate_ensemble`]) and writes each, as `plan` says, to
-    /// `path(j)` (`.csv` or `.npy`), streaming; a file appears only once complete.
-    /// `done(k)` is called as `k` more trajectories finish.
+    /// Simulates the trajectories `range` of the ensemble seeded `seed` (the same
+    /// trajectories as [`Self::simulate_ensemble`]: `0..count` for a whole run, one
+    /// shard's share for `run --shard`, [`crate::shard`]) and writes each, as `plan`
+    /// says, to `path(j)` (`.csv` or `.npy`), streaming; a file appears only once
+    /// complete. Trajectory `j`'s file depends only on `seed`, `j` and `plan`, not on
+    /// the range it is written in. `done(k)` is called as `k` more trajectories finish.
     ///
     /// # Errors
     /// A divergence naming the step; [`Error::Io`] naming the file.
     pub fn write_ensemble(
         &self,
         seed: u64,
-        count: u64,
+        range: Range<u64>,
         plan: &RowPlan,
         path: impl Fn(u64) -> PathBuf + Sync,
         done: impl Fn(u64) + Sync,
     ) -> Result<()> {
         let writers = self.observe_ensemble(
             seed,
-            0,
-            count,
+            range.start,
+            range.end.saturating_sub(range.start),
             plan.sampled_steps,
             |j| RowWriter::new(self, plan, &path(j)),
             done,

@@ -1,0 +1,373 @@
+//! `run --shard I/N` and the merge of `run` shards (issue #15): a scene's trajectories
+//! written as 3 shards, each in a process of its own, and merged give the directory of the
+//! same `run` made in one process, byte for byte apart from the run id and the
+//! provenance; `check` says the same of both; a merge refuses (exit 2, naming the shard)
+//! a missing shard, a trajectory missing from or given twice in the shards' manifests, and
+//! shards of other settings or of another command.
+//!
+//! The scenes are the tiny fixtures of tests/shards.rs: a linear one (4 trajectories of
+//! one run: shards of 1, 1 and 2 files, `.npy`) and a compression one (2 runs × 3 strains
+//! of 7 and 5 trajectories, `--duration-tau1 5` since its quick budget is by target
+//! precision, `.csv`). Each runs in well under a second.
+
+mod common;
+
+use common::{TempDir, all_files, describe, fixture, json, stderr_of, stdout_of};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+const LINEAR: &str = "tests/scenes/good/tiny-linear.toml";
+const COMPRESSION: &str = "tests/scenes/good/tiny-compression.toml";
+/// The flags of the compression case: a duration (its quick budget chooses durations by
+/// a pilot, which `run` does not do) and the CSV format.
+const COMPRESSION_FLAGS: &[&str] = &["--duration-tau1", "5", "--format", "csv"];
+
+/// The binary with `args` run in `cwd`; asserts that it did not panic.
+fn run_in(cwd: &Path, args: &[String]) -> Output {
+    let o = common::command()
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("run langevin-fem");
+    let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+    common::assert_no_panic(&shown, &o);
+    o
+}
+
+/// The `run` command line of `scene` into `out` with `extra` flags.
+fn run_args(scene: &str, out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut args = vec![
+        "run".to_string(),
+        "-q".to_string(),
+        "-s".to_string(),
+        fixture(scene).display().to_string(),
+        "-o".to_string(),
+        out.display().to_string(),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
+/// `run` of `scene` into `out` in one process; asserts exit 0.
+fn whole(scene: &str, out: &Path, extra: &[&str]) {
+    let args = run_args(scene, out, extra);
+    let o = run_in(common::manifest_dir(), &args);
+    let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&shown, &o));
+}
+
+/// Shards `1/n … n/n` of `run` of `scene`, run concurrently in processes of their own
+/// into `<root>/<i>`; asserts exit 0, a manifest and the closing line of each. Returns
+/// the shard directories.
+fn shards(scene: &str, root: &Path, n: usize, extra: &[&str]) -> Vec<PathBuf> {
+    let children: Vec<_> = (1..=n)
+        .map(|i| {
+            let out = root.join(i.to_string());
+            let shard = format!("{i}/{n}");
+            let mut args = run_args(scene, &out, extra);
+            args.extend(["--shard".to_string(), shard.clone()]);
+            let child = common::command()
+                .args(&args)
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("start a shard");
+            (shard, out, child)
+        })
+        .collect();
+    children
+        .into_iter()
+        .map(|(shard, out, child)| {
+            let o = child.wait_with_output().expect("run a shard");
+            assert_eq!(o.status.code(), Some(0), "shard {shard}: {}", stderr_of(&o));
+            assert!(
+                out.join("shard.json").is_file(),
+                "shard {shard}: no manifest"
+            );
+            assert!(
+                stdout_of(&o).starts_with(&format!("shard {shard}: ")),
+                "shard {shard}'s closing line: {}",
+                stdout_of(&o)
+            );
+            out
+        })
+        .collect()
+}
+
+/// `merge` of `dirs` into `out`.
+fn merge(dirs: &[PathBuf], out: &Path) -> Output {
+    let mut args = vec!["merge".to_string(), "-q".to_string()];
+    args.extend(dirs.iter().map(|d| d.display().to_string()));
+    args.extend(["-o".to_string(), out.display().to_string()]);
+    run_in(common::manifest_dir(), &args)
+}
+
+/// `v` without the object keys `drop`, at any depth.
+fn without(v: &serde_json::Value, drop: &[&str]) -> serde_json::Value {
+    match v {
+        serde_json::Value::Object(m) => serde_json::Value::Object(
+            m.iter()
+                .filter(|(k, _)| !drop.contains(&k.as_str()))
+                .map(|(k, v)| (k.clone(), without(v, drop)))
+                .collect(),
+        ),
+        serde_json::Value::Array(a) => {
+            serde_json::Value::Array(a.iter().map(|v| without(v, drop)).collect())
+        }
+        other => other.clone(),
+    }
+}
+
+/// The keys that differ between two whole runs of the same work, per JSON file: in
+/// `data.json` the run id and the provenance record (command line, start, wall time,
+/// build state) inside its `provenance` (whose budget, seed and τ1 are compared); in the
+/// journal `manifest.json` the run id and its provenance.
+fn volatile(file: &str) -> &'static [&'static str] {
+    if file.ends_with("data.json") {
+        &["run_id", "record"]
+    } else {
+        &["run_id", "provenance"]
+    }
+}
+
+/// Asserts that the run directories `a` and `b` hold the same files: every trajectory
+/// file byte-identical, `data.json` and `manifest.json` equal as JSON without their
+/// volatile keys ([`volatile`]). Returns the files.
+fn assert_same_run(a: &Path, b: &Path) -> Vec<String> {
+    let files = all_files(a);
+    assert_eq!(files, all_files(b), "different files");
+    for f in &files {
+        let (fa, fb) = (a.join(f), b.join(f));
+        if f == "data.json" || f == "manifest.json" {
+            assert_eq!(
+                without(&json(&fa), volatile(f)),
+                without(&json(&fb), volatile(f)),
+                "{f} differs beyond the run id and provenance"
+            );
+        } else {
+            assert!(
+                std::fs::read(&fa).unwrap() == std::fs::read(&fb).unwrap(),
+                "{f} differs"
+            );
+        }
+    }
+    files
+}
+
+/// `check` of `scene` on `<root>/data` into `<root>/check`, run in `root` (so that the
+/// paths in its report are the same for every `root`).
+fn check(scene: &str, root: &Path) -> Output {
+    let args: Vec<String> = ["check", "-q", "-s", &fixture(scene).display().to_string()]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(["-d", "data", "-o", "check"].map(String::from))
+        .collect();
+    run_in(root, &args)
+}
+
+/// What: `run` of `scene` (with `extra` flags) in one process, and as 3 shards run
+/// concurrently in processes of their own, merged; then `check` of both.
+/// Reference: the whole run's directory; `check` on it.
+/// Tolerance: the same files; every trajectory file byte-identical (the shards' shares
+/// tile the run: each of the whole run's trajectory files is in exactly one shard, and a
+/// shard holds no data.json nor manifest.json); `data.json` and `manifest.json` equal as
+/// JSON without the run id and provenance. `check` gives the same exit code and the same
+/// `summary.json` (run id, wall times and provenance aside) and tables on both.
+fn three_shards_merge_to_the_whole_run(scene: &str, extra: &[&str], trajectories: usize) {
+    let tmp = TempDir::new("run-shards");
+    let (w, m) = (tmp.join("whole"), tmp.join("merged"));
+    whole(scene, &w.join("data"), extra);
+    let dirs = shards(scene, &tmp.join("shards"), 3, extra);
+    let o = merge(&dirs, &m.join("data"));
+    assert_eq!(o.status.code(), Some(0), "merge: {}", stderr_of(&o));
+
+    let files = assert_same_run(&w.join("data"), &m.join("data"));
+    let traj: Vec<&String> = files.iter().filter(|f| f.contains("trajectory-")).collect();
+    assert_eq!(traj.len(), trajectories, "trajectory files: {files:?}");
+    let mut in_shards: Vec<String> = Vec::new();
+    for d in &dirs {
+        let own = all_files(d);
+        assert!(own.contains(&"shard.json".to_string()), "{}", d.display());
+        assert!(
+            !own.iter().any(|f| f == "data.json" || f == "manifest.json"),
+            "a shard wrote a whole run's entry point: {own:?}"
+        );
+        assert!(own.len() > 1, "shard {} holds no trajectory", d.display());
+        in_shards.extend(own.into_iter().filter(|f| f != "shard.json"));
+    }
+    in_shards.sort();
+    let traj: Vec<String> = traj.into_iter().cloned().collect();
+    assert_eq!(in_shards, traj, "the shards do not tile the run");
+
+    let (cw, cm) = (check(scene, &w), check(scene, &m));
+    assert_eq!(cw.status.code(), cm.status.code(), "{}", stderr_of(&cm));
+    assert!(
+        matches!(cw.status.code(), Some(0 | 1)),
+        "check: {}",
+        stderr_of(&cw)
+    );
+    let (rw, rm) = (w.join("check"), m.join("check"));
+    let reports = all_files(&rw);
+    assert_eq!(reports, all_files(&rm), "check wrote different files");
+    for f in &reports {
+        let (a, b) = (rw.join(f), rm.join(f));
+        match f.as_str() {
+            "index.html" => {}
+            "summary.json" | "manifest.json" => {
+                let drop = &["run_id", "wall_seconds", "provenance"];
+                assert_eq!(
+                    without(&json(&a), drop),
+                    without(&json(&b), drop),
+                    "check's {f} differs"
+                );
+            }
+            _ => assert!(
+                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+                "check's {f} differs"
+            ),
+        }
+    }
+}
+
+/// What/Reference/Tolerance: [`three_shards_merge_to_the_whole_run`], the linear fixture
+/// in `.npy` (4 trajectories).
+#[test]
+fn linear_run_in_three_shards_merges_to_the_whole_run() {
+    three_shards_merge_to_the_whole_run(LINEAR, &[], 4);
+}
+
+/// What/Reference/Tolerance: [`three_shards_merge_to_the_whole_run`], the compression
+/// fixture in `.csv` (2 runs × 3 strains × 7 and 5 trajectories).
+#[test]
+fn compression_run_in_three_shards_merges_to_the_whole_run() {
+    three_shards_merge_to_the_whole_run(COMPRESSION, COMPRESSION_FLAGS, 3 * (7 + 5));
+}
+
+/// Asserts that merging `dirs` into `out` exits 2, that stderr names every string of
+/// `names`, and that nothing of a run was written.
+fn refused(dirs: &[PathBuf], out: &Path, names: &[&str]) {
+    let o = merge(dirs, out);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "not refused: {err}");
+    for n in names {
+        assert!(err.contains(n), "the refusal does not name {n:?}: {err}");
+    }
+    assert!(
+        !out.join("data.json").exists(),
+        "a refused merge wrote data.json"
+    );
+    assert!(
+        !out.join("manifest.json").exists(),
+        "a refused merge started a run"
+    );
+}
+
+/// Rewrites the shard manifest in `dir` with `edit`.
+fn edit_manifest(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+    let path = dir.join("shard.json");
+    let mut m = json(&path);
+    edit(&mut m);
+    std::fs::write(&path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+}
+
+/// What: merges of `run` shards that must be refused before anything is written: a
+/// missing shard; shard 2's manifest without one of its trajectories; shard 3's listing
+/// a trajectory of shard 2 too; a shard run with other settings (`--trajectories`); a
+/// shard of `verify` among `run` shards.
+/// Reference: exit 2, the message naming the shard (its index, or its directory) and
+/// what is wrong; no data.json nor manifest.json written.
+#[test]
+fn run_merge_refuses_missing_duplicated_and_foreign_shards() {
+    let tmp = TempDir::new("run-shards-refused");
+    let dirs = shards(LINEAR, &tmp.join("set"), 3, &[]);
+    let out = tmp.join("out");
+
+    refused(
+        &[dirs[0].clone(), dirs[2].clone()],
+        &out,
+        &["missing shard 2/3"],
+    );
+
+    // 4 trajectories in 3 shards: 0 | 1 | 2, 3.
+    let entry = |d: &Path, k: usize| json(&d.join("shard.json"))["files"][k].clone();
+    let (of_2, last_of_3) = (entry(&dirs[1], 0), entry(&dirs[2], 1));
+    assert_eq!(of_2["first"], 1, "{of_2}");
+    assert_eq!(last_of_3["first"], 3, "{last_of_3}");
+
+    edit_manifest(&dirs[2], |m| {
+        m["files"].as_array_mut().unwrap().pop();
+    });
+    refused(
+        &dirs,
+        &out,
+        &[
+            "trajectory 3",
+            "trajectory-0003.npy",
+            "in no shard",
+            "rerun shard 3/3",
+        ],
+    );
+    edit_manifest(&dirs[2], |m| {
+        m["files"].as_array_mut().unwrap().push(last_of_3)
+    });
+    let o = merge(&dirs, &out);
+    assert_eq!(o.status.code(), Some(0), "restored: {}", stderr_of(&o));
+    let out = tmp.join("out-2");
+
+    edit_manifest(&dirs[2], |m| m["files"].as_array_mut().unwrap().push(of_2));
+    refused(
+        &dirs,
+        &out,
+        &["trajectory 1", "given twice", "shard 2/3", "shard 3/3"],
+    );
+    edit_manifest(&dirs[2], |m| {
+        m["files"].as_array_mut().unwrap().pop();
+    });
+
+    let other = shards(LINEAR, &tmp.join("other"), 3, &["--trajectories", "5"]);
+    refused(
+        &[dirs[0].clone(), other[1].clone(), dirs[2].clone()],
+        &out,
+        &["settings", other[1].to_str().unwrap()],
+    );
+
+    let verify = tmp.join("verify");
+    let o = common::run(&[
+        "verify",
+        "-q",
+        "-s",
+        fixture(LINEAR).to_str().unwrap(),
+        "--shard",
+        "2/3",
+        "-o",
+        verify.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
+    refused(
+        &[dirs[0].clone(), verify, dirs[2].clone()],
+        &out,
+        &["command", "`verify`", "`run`"],
+    );
+}
+
+/// What: `run --shard` outside 1 ≤ I ≤ N is refused before anything runs.
+/// Reference: exit 2 naming the flag and the rule; nothing written.
+#[test]
+fn run_shard_flag_out_of_range_is_refused() {
+    let tmp = TempDir::new("run-shard-flag");
+    let out = tmp.join("out");
+    for bad in ["0/3", "4/3", "3", "x/y"] {
+        let mut args = run_args(LINEAR, &out, &[]);
+        args.extend(["--shard".to_string(), bad.to_string()]);
+        let o = run_in(common::manifest_dir(), &args);
+        let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&shown, &o));
+        let err = stderr_of(&o);
+        assert!(
+            err.contains("--shard") && err.contains("1 <= I <= N"),
+            "{}",
+            describe(&shown, &o)
+        );
+        assert!(!out.exists(), "a refused run wrote {}", out.display());
+    }
+}
