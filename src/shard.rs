@@ -400,12 +400,14 @@ impl ShardSet {
     }
 
     /// Opens the shards in `dirs` (shard directories, or directories of them) and checks
-    /// that they are one complete set of one command ([`ShardManifest::command`]).
+    /// that they are one complete set of one command ([`ShardManifest::command`]) whose
+    /// every file has the size and SHA-256 its manifest lists.
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the shard's manifest: not a shard; another format,
     /// command, build (also than this merge's), shard count, setting, scene or seed than
-    /// the first shard; a duplicated index (naming both directories); missing indices.
+    /// the first shard; a duplicated index (naming both directories); missing indices; a
+    /// file missing, unreadable or damaged ([`Self::read_file`]).
     pub fn open(dirs: &[PathBuf]) -> Result<ShardSet> {
         let mut shards: Vec<(PathBuf, ShardManifest)> = Vec::new();
         let mut first: Option<(PathBuf, ShardManifest)> = None;
@@ -481,7 +483,15 @@ impl ShardSet {
                 ),
             ));
         }
-        Ok(ShardSet { shards, first })
+        let set = ShardSet { shards, first };
+        // Every file against its manifest now, before the merge writes anything: a
+        // damaged shard is input (exit 2) and must leave an earlier output untouched.
+        for (k, (_, m)) in set.shards.iter().enumerate() {
+            for entry in &m.files {
+                set.read_file(k, entry)?;
+            }
+        }
+        Ok(set)
     }
 
     /// The first manifest read, whole: the command's settings and scenes (equal in every

@@ -314,6 +314,9 @@ fn run_merge_refuses_missing_duplicated_and_foreign_shards() {
     assert_eq!(o.status.code(), Some(0), "restored: {}", stderr_of(&o));
     let out = tmp.join("out-2");
 
+    // Shard 3 with a copy of shard 2's trajectory 1, listed in its manifest.
+    let rel = of_2["path"].as_str().unwrap().to_string();
+    std::fs::copy(dirs[1].join(&rel), dirs[2].join(&rel)).unwrap();
     edit_manifest(&dirs[2], |m| m["files"].as_array_mut().unwrap().push(of_2));
     refused(
         &dirs,

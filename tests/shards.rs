@@ -267,9 +267,12 @@ fn converge_in_three_shards_merges_to_the_whole_study() {
     }
 }
 
-/// The exit code and stderr of a merge that must be refused; asserts exit 2 and that
-/// stderr names every string of `names`.
+/// A merge of `dirs` into `out` that must be refused: asserts exit 2, that stderr names
+/// every string of `names`, and that the earlier report in `out` is untouched (its
+/// `summary.json` and `index.html` as they were).
 fn refused(dirs: &[&Path], out: &Path, names: &[&str]) {
+    let before = |f: &str| std::fs::read(out.join(f)).expect("an earlier report");
+    let (summary, index) = (before("summary.json"), before("index.html"));
     let o = merge(dirs, out);
     let err = stderr_of(&o);
     assert_eq!(o.status.code(), Some(2), "not refused: {err}");
@@ -277,8 +280,8 @@ fn refused(dirs: &[&Path], out: &Path, names: &[&str]) {
         assert!(err.contains(n), "the refusal does not name {n:?}: {err}");
     }
     assert!(
-        !out.join("summary.json").exists(),
-        "a refused merge wrote a report"
+        before("summary.json") == summary && before("index.html") == index,
+        "a refused merge changed the earlier report"
     );
 }
 
@@ -286,14 +289,21 @@ fn refused(dirs: &[&Path], out: &Path, names: &[&str]) {
 /// duplicated one, one of another seed, budget, shard count or scene set, a damaged
 /// record file, and a directory that is not a shard.
 /// Reference: exit 2, the message naming the shard (its directory and index) and what
-/// differs; no report written.
+/// differs; the earlier report in the output directory untouched.
 #[test]
 fn merge_refuses_missing_duplicate_foreign_and_damaged_shards() {
     let tmp = TempDir::new("shards-refused");
     let root = tmp.join("set");
     shards(&root, 3, &[]);
     let (s1, s2, s3) = (root.join("1"), root.join("2"), root.join("3"));
+    // An earlier report, which no refused merge may touch.
     let out = tmp.join("out");
+    let first = merge(&[&s1, &s2, &s3], &out);
+    assert!(
+        matches!(first.status.code(), Some(0 | 1)),
+        "{}",
+        stderr_of(&first)
+    );
 
     refused(&[&s1, &s3], &out, &["missing shard 2/3"]);
 
