@@ -12,7 +12,8 @@
 
 mod common;
 
-use common::{TempDir, all_files, describe, fixture, json, stderr_of, stdout_of};
+use common::shards::{assert_same_outputs, merge, shards_of, without};
+use common::{TempDir, all_files, describe, fixture, json, stderr_of};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -56,66 +57,17 @@ fn whole(scene: &str, out: &Path, extra: &[&str]) {
     assert_eq!(o.status.code(), Some(0), "{}", describe(&shown, &o));
 }
 
-/// Shards `1/n … n/n` of `run` of `scene`, run concurrently in processes of their own
-/// into `<root>/<i>`; asserts exit 0, a manifest and the closing line of each. Returns
-/// the shard directories.
+/// Shards `1/n … n/n` of `run` of `scene` with `extra` flags, run concurrently in
+/// processes of their own into `<root>/<i>` ([`shards_of`]). Returns the shard directories.
 fn shards(scene: &str, root: &Path, n: usize, extra: &[&str]) -> Vec<PathBuf> {
-    let children: Vec<_> = (1..=n)
-        .map(|i| {
-            let out = root.join(i.to_string());
-            let shard = format!("{i}/{n}");
-            let mut args = run_args(scene, &out, extra);
-            args.extend(["--shard".to_string(), shard.clone()]);
-            let child = common::command()
-                .args(&args)
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::piped())
-                .spawn()
-                .expect("start a shard");
-            (shard, out, child)
-        })
-        .collect();
-    children
-        .into_iter()
-        .map(|(shard, out, child)| {
-            let o = child.wait_with_output().expect("run a shard");
-            assert_eq!(o.status.code(), Some(0), "shard {shard}: {}", stderr_of(&o));
-            assert!(
-                out.join("shard.json").is_file(),
-                "shard {shard}: no manifest"
-            );
-            assert!(
-                stdout_of(&o).starts_with(&format!("shard {shard}: ")),
-                "shard {shard}'s closing line: {}",
-                stdout_of(&o)
-            );
-            out
-        })
-        .collect()
-}
-
-/// `merge` of `dirs` into `out`.
-fn merge(dirs: &[PathBuf], out: &Path) -> Output {
-    let mut args = vec!["merge".to_string(), "-q".to_string()];
-    args.extend(dirs.iter().map(|d| d.display().to_string()));
-    args.extend(["-o".to_string(), out.display().to_string()]);
-    run_in(common::manifest_dir(), &args)
-}
-
-/// `v` without the object keys `drop`, at any depth.
-fn without(v: &serde_json::Value, drop: &[&str]) -> serde_json::Value {
-    match v {
-        serde_json::Value::Object(m) => serde_json::Value::Object(
-            m.iter()
-                .filter(|(k, _)| !drop.contains(&k.as_str()))
-                .map(|(k, v)| (k.clone(), without(v, drop)))
-                .collect(),
-        ),
-        serde_json::Value::Array(a) => {
-            serde_json::Value::Array(a.iter().map(|v| without(v, drop)).collect())
-        }
-        other => other.clone(),
-    }
+    let mut args = vec![
+        "run".to_string(),
+        "-q".to_string(),
+        "-s".to_string(),
+        fixture(scene).display().to_string(),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    shards_of(root, n, &args)
 }
 
 /// The keys that differ between two whole runs of the same work, per JSON file: in
@@ -134,24 +86,7 @@ fn volatile(file: &str) -> &'static [&'static str] {
 /// file byte-identical, `data.json` and `manifest.json` equal as JSON without their
 /// volatile keys ([`volatile`]). Returns the files.
 fn assert_same_run(a: &Path, b: &Path) -> Vec<String> {
-    let files = all_files(a);
-    assert_eq!(files, all_files(b), "different files");
-    for f in &files {
-        let (fa, fb) = (a.join(f), b.join(f));
-        if f == "data.json" || f == "manifest.json" {
-            assert_eq!(
-                without(&json(&fa), volatile(f)),
-                without(&json(&fb), volatile(f)),
-                "{f} differs beyond the run id and provenance"
-            );
-        } else {
-            assert!(
-                std::fs::read(&fa).unwrap() == std::fs::read(&fb).unwrap(),
-                "{f} differs"
-            );
-        }
-    }
-    files
+    assert_same_outputs(a, b, volatile)
 }
 
 /// `check` of `scene` on `<root>/data` into `<root>/check`, run in `root` (so that the

@@ -10,8 +10,9 @@
 
 mod common;
 
-use common::{TempDir, all_files, describe, fixture, json, run, stderr_of};
-use std::path::Path;
+use common::shards::{assert_same_outputs, merge, shards_of};
+use common::{TempDir, all_files, describe, fixture, run, stderr_of};
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 const LINEAR: &str = "tests/scenes/good/tiny-linear.toml";
@@ -40,99 +41,24 @@ fn verify(out: &Path, extra: &[&str]) -> Output {
     o
 }
 
+/// The strings of `args`.
+fn strings(args: &[&str]) -> Vec<String> {
+    args.iter().map(|s| s.to_string()).collect()
+}
+
 /// Runs shards `1/n … n/n` of both fixtures' verification concurrently, each in a
 /// process of its own, into `<root>/<i>`, with `extra` flags.
-fn shards(root: &Path, n: usize, extra: &[&str]) {
+fn shards(root: &Path, n: usize, extra: &[&str]) -> Vec<PathBuf> {
     let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
     let mut args = vec!["verify", "-q", "-s", lin.to_str().unwrap()];
     args.extend(["-s", comp.to_str().unwrap()]);
     args.extend_from_slice(extra);
-    shards_of(root, n, &args);
+    shards_of(root, n, &strings(&args))
 }
 
-/// Runs `args` with `--shard i/n -o <root>/<i>` for i = 1 … n concurrently, each in a
-/// process of its own; asserts that each exits 0 and writes its manifest.
-fn shards_of(root: &Path, n: usize, args: &[&str]) {
-    let children: Vec<_> = (1..=n)
-        .map(|i| {
-            let out = root.join(i.to_string());
-            let shard = format!("{i}/{n}");
-            let mut c = common::command();
-            c.args(args).args(["--shard", &shard, "-o"]).arg(&out);
-            (out, shard, c.spawn().expect("start a shard"))
-        })
-        .collect();
-    for (out, shard, child) in children {
-        let o = child.wait_with_output().expect("run a shard");
-        assert_eq!(o.status.code(), Some(0), "shard {shard}: {}", stderr_of(&o));
-        assert!(
-            out.join("shard.json").is_file(),
-            "shard {shard} wrote no manifest"
-        );
-    }
-}
-
-/// `merge` of `dirs` into `out`.
-fn merge(dirs: &[&Path], out: &Path) -> Output {
-    let mut args = vec!["merge".to_string()];
-    args.extend(dirs.iter().map(|d| d.display().to_string()));
-    args.extend(["-o".to_string(), out.display().to_string()]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    run(&args)
-}
-
-/// `v` without the fields that differ between two runs of the same work: wall times,
-/// run id and provenance (start time, command line).
-fn without_volatile(v: &serde_json::Value) -> serde_json::Value {
-    match v {
-        serde_json::Value::Object(m) => serde_json::Value::Object(
-            m.iter()
-                .filter(|(k, _)| !matches!(k.as_str(), "wall_seconds" | "run_id" | "provenance"))
-                .map(|(k, v)| (k.clone(), without_volatile(v)))
-                .collect(),
-        ),
-        serde_json::Value::Array(a) => {
-            serde_json::Value::Array(a.iter().map(without_volatile).collect())
-        }
-        other => other.clone(),
-    }
-}
-
-/// `html` without its volatile parts: the provenance block and every number of seconds
-/// (`6.17 s`: the wall times).
-fn html_without_volatile(html: &str) -> String {
-    let html = match (
-        html.find("<details class=\"provenance\""),
-        html.rfind("</details>"),
-    ) {
-        (Some(a), Some(b)) if b > a => format!("{}PROVENANCE{}", &html[..a], &html[b..]),
-        _ => html.to_string(),
-    };
-    // Drop every run of digits and dots directly followed by " s" and a non-letter.
-    let chars: Vec<char> = html.chars().collect();
-    let mut out = String::with_capacity(html.len());
-    let mut i = 0;
-    while i < chars.len() {
-        if chars[i].is_ascii_digit() {
-            let mut j = i;
-            while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
-                j += 1;
-            }
-            let seconds = chars.get(j) == Some(&' ')
-                && chars.get(j + 1) == Some(&'s')
-                && !chars.get(j + 2).is_some_and(|c| c.is_alphanumeric());
-            if seconds {
-                out.push('T');
-            } else {
-                out.extend(&chars[i..j]);
-            }
-            i = j;
-        } else {
-            out.push(chars[i]);
-            i += 1;
-        }
-    }
-    out
+/// The keys of a JSON output that differ between two runs of the same work.
+fn volatile(_file: &str) -> &'static [&'static str] {
+    &["wall_seconds", "run_id", "provenance"]
 }
 
 /// What: both fixtures verified in one process, and as 3 shards run concurrently in
@@ -153,60 +79,12 @@ fn three_shards_merge_to_the_whole_run_byte_for_byte() {
     let m = merge(&[&root], &merged);
     assert_eq!(m.status.code(), w.status.code(), "{}", stderr_of(&m));
 
-    let files = same_outputs(&whole, &merged);
+    let files = assert_same_outputs(&whole, &merged, volatile);
     assert!(
         files.iter().any(|f| f.ends_with("force-strain.csv"))
             && files.iter().any(|f| f.ends_with("-two-time.csv")),
         "the fixtures wrote no force-strain or two-time table: {files:?}"
     );
-}
-
-/// Every run id in the JSON files of `dir`.
-fn run_ids(dir: &Path) -> Vec<String> {
-    all_files(dir)
-        .iter()
-        .filter(|f| f.ends_with(".json"))
-        .filter_map(|f| json(&dir.join(f))["run_id"].as_str().map(str::to_string))
-        .collect()
-}
-
-/// Asserts that `merged` holds the outputs of `whole`: the same files, every one
-/// byte-identical except that JSON files are compared as JSON without wall times, run
-/// ids and provenance, and HTML files without run ids, the provenance block and wall
-/// times; returns the files.
-fn same_outputs(whole: &Path, merged: &Path) -> Vec<String> {
-    let files = all_files(whole);
-    assert_eq!(files, all_files(merged), "different files");
-    let (ids_a, ids_b) = (run_ids(whole), run_ids(merged));
-    let html = |p: &Path, ids: &[String]| {
-        let mut text = std::fs::read_to_string(p).unwrap();
-        for id in ids {
-            text = text.replace(id.as_str(), "RUN-ID");
-        }
-        html_without_volatile(&text)
-    };
-    for f in &files {
-        let (a, b) = (whole.join(f), merged.join(f));
-        if f.ends_with(".json") {
-            assert_eq!(
-                without_volatile(&json(&a)),
-                without_volatile(&json(&b)),
-                "{f} differs"
-            );
-        } else if f.ends_with(".html") {
-            assert_eq!(
-                html(&a, &ids_a),
-                html(&b, &ids_b),
-                "{f} differs beyond wall times, run id and provenance"
-            );
-        } else {
-            assert!(
-                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
-                "{f} differs between the whole run and the merged shards"
-            );
-        }
-    }
-    files
 }
 
 /// What: convergence studies (a compression one over elements, a linear one over dt)
@@ -254,11 +132,11 @@ fn converge_in_three_shards_merges_to_the_whole_study() {
         let o = run(&args);
         assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
         let root = tmp.join(&format!("shards-{k}"));
-        shards_of(&root, 3, study);
+        shards_of(&root, 3, &strings(study));
         let merged = tmp.join(&format!("merged-{k}"));
         let m = merge(&[&root], &merged);
         assert_eq!(m.status.code(), Some(0), "{}", stderr_of(&m));
-        let files = same_outputs(&whole, &merged);
+        let files = assert_same_outputs(&whole, &merged, volatile);
         assert!(
             files
                 .iter()

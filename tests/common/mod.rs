@@ -4,6 +4,7 @@
 //! - [`seeds`]: every fixed seed of the suite, as named constants in one place;
 //! - [`schema`]: the JSON Schema of `summary.json` and a validator of its subset;
 //! - [`svg`]: the texts and elements of the SVG figures the program writes;
+//! - [`shards`]: a command run as shards, merged, and compared with the whole run;
 //! - [`filament`]: the filament parameter sets the tests are written for;
 //! - paths into the crate ([`manifest_dir`], [`fixture`], [`scene`]);
 //! - [`TempDir`], a unique temporary directory removed on drop, and [`write_scene`];
@@ -24,6 +25,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 pub mod filament;
 pub mod schema;
 pub mod seeds;
+pub mod shards;
 pub mod svg;
 
 /// The `langevin-fem` binary built for these tests.
