@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs verify-array.sbatch and merge.sbatch as Slurm would, without Slurm: each array
-# task in turn with SLURM_ARRAY_TASK_ID / _COUNT / _MIN set, then the merge. For testing
+# task in turn with SLURM_ARRAY_TASK_ID / _COUNT set, then the merge. For testing
 # the scripts (`make fig2-shards` does) and for a dry run before submitting.
 #
 #   examples/slurm/emulate.sh N
@@ -10,7 +10,7 @@ set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
 n=${1:?usage: emulate.sh N}
-export SLURM_ARRAY_TASK_COUNT=$n SLURM_ARRAY_TASK_MIN=1 SLURM_CPUS_PER_TASK=${SLURM_CPUS_PER_TASK:-1}
+export SLURM_ARRAY_TASK_COUNT=$n SLURM_CPUS_PER_TASK=${SLURM_CPUS_PER_TASK:-1}
 rm -rf "${SHARDS_DIR:-shards}"
 for i in $(seq 1 "$n"); do
     SLURM_ARRAY_TASK_ID=$i bash "$here/verify-array.sbatch" >/dev/null

@@ -17,6 +17,7 @@ shift
 case $n in '' | *[!0-9]*) echo "N must be a positive integer, got '$n'" >&2; exit 2 ;; esac
 [ "$n" -ge 1 ] || { echo "N must be >= 1" >&2; exit 2; }
 
+export SHARDS=$n
 export LANGEVIN_FEM=${LANGEVIN_FEM:-langevin-fem}
 export SHARDS_DIR=${SHARDS_DIR:-$PWD/shards}
 export REPORT_DIR=${REPORT_DIR:-$PWD/reports}
@@ -32,4 +33,5 @@ array=${array%%;*}
 # shellcheck disable=SC2086
 merge=$(sbatch --parsable ${SBATCH_EXTRA:-} --dependency="afterok:$array" --kill-on-invalid-dep=yes \
     --export=ALL "$here/merge.sbatch")
+merge=${merge%%;*}
 echo "array job $array ($n shards into $SHARDS_DIR), merge job $merge (report in $REPORT_DIR)"
