@@ -104,6 +104,16 @@ pub struct WorkProjection {
 }
 
 impl WorkProjection {
+    /// This projection with every part's steps times `fraction` (the share of one shard
+    /// of the trajectories, [`crate::shard`]); the samples held at once are unchanged.
+    pub fn scaled(mut self, fraction: f64) -> WorkProjection {
+        for part in &mut self.parts {
+            part.work.trajectory_steps *= fraction;
+            part.work.dof_steps *= fraction;
+        }
+        self
+    }
+
     /// Total trajectory steps.
     pub fn trajectory_steps(&self) -> f64 {
         self.parts.iter().map(|p| p.work.trajectory_steps).sum()

@@ -277,3 +277,36 @@ fn shard_flag_out_of_range_is_refused() {
         );
     }
 }
+
+/// What: the work cap of a shard is its share of the projected work: the tiny linear
+/// scene projects 182400 DOF-steps; `--max-work 1e4` refuses it whole (exit 2, naming
+/// the cap) and admits its shard 1/100 (about 1824 DOF-steps).
+/// Reference: `WorkProjection::scaled` by 1/N.
+#[test]
+fn a_shard_is_capped_by_its_share_of_the_work() {
+    let tmp = TempDir::new("shard-cap");
+    let lin = fixture(LINEAR);
+    let base = [
+        "verify",
+        "-q",
+        "-s",
+        lin.to_str().unwrap(),
+        "--max-work",
+        "1e4",
+    ];
+    let out = tmp.join_str("whole");
+    let mut args = base.to_vec();
+    args.extend(["-o", &out]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    assert!(
+        stderr_of(&o).contains("--max-work"),
+        "{}",
+        describe(&args, &o)
+    );
+    let out = tmp.join_str("shard");
+    let mut args = base.to_vec();
+    args.extend(["--shard", "1/100", "-o", &out]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+}

@@ -254,15 +254,6 @@ impl Job {
         }
     }
 
-    /// Checks the projected work (this shard's share of it) against the caps.
-    fn check_work(&self, mut work: WorkProjection) -> Result<()> {
-        for part in &mut work.parts {
-            part.work.trajectory_steps *= self.shard.fraction();
-            part.work.dof_steps *= self.shard.fraction();
-        }
-        self.limits.check(&work)
-    }
-
     /// Starts the output: the report directory with its provenance, or the shard.
     fn begin(&self) -> Result<Sink> {
         let provenance = Provenance::begin(&[&self.scene]);
@@ -445,22 +436,15 @@ fn linear_what(job: &Job) -> String {
 fn run_linear(job: &Job) -> Result<i32> {
     let scene = &job.scene;
     let (runs, plans) = prepare_linear(job)?;
-    let work = projection(job, &plans);
-    job.check_work(work.clone())?;
+    // This shard's share of the work.
+    let work = projection(job, &plans).scaled(job.shard.fraction());
+    job.limits.check(&work)?;
     let mut sink = job.begin()?;
-    let bar = Progress::new(
-        job.verbosity.progress(),
-        work.dof_steps() * job.shard.fraction(),
-        "DOF-steps",
-    );
+    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
     let mut data_runs = Vec::new();
     for (((&k, run), plan), part) in job.chosen.iter().zip(&runs).zip(&plans).zip(&work.parts) {
         let label = format!("{}/{}", scene.name, scene.runs[k].name);
-        bar.begin_run(
-            &scene.name,
-            &label,
-            part.work.dof_steps * job.shard.fraction(),
-        );
+        bar.begin_run(&scene.name, &label, part.work.dof_steps);
         data_runs.push(write_linear_run(job, &mut sink, k, run, plan, &bar)?);
     }
     bar.finish();
@@ -628,22 +612,15 @@ fn compression_what(job: &Job) -> String {
 fn run_compression(job: &Job) -> Result<i32> {
     let scene = &job.scene;
     let runs = prepare_compression(job)?;
-    let work = compression_projection(job);
-    job.check_work(work.clone())?;
+    // This shard's share of the work.
+    let work = compression_projection(job).scaled(job.shard.fraction());
+    job.limits.check(&work)?;
     let mut sink = job.begin()?;
-    let bar = Progress::new(
-        job.verbosity.progress(),
-        work.dof_steps() * job.shard.fraction(),
-        "DOF-steps",
-    );
+    let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
     let mut data_runs = Vec::new();
     for ((&k, run), part) in job.chosen.iter().zip(&runs).zip(&work.parts) {
         let label = format!("{}/{}", scene.name, scene.runs[k].name);
-        bar.begin_run(
-            &scene.name,
-            &label,
-            part.work.dof_steps * job.shard.fraction(),
-        );
+        bar.begin_run(&scene.name, &label, part.work.dof_steps);
         data_runs.extend(write_compression_run(job, &mut sink, k, run, &bar)?);
     }
     bar.finish();

@@ -1102,8 +1102,8 @@ fn linear_study(
     let spec = &scene.runs[run];
     let over = opts.over;
     let values = linear_values(scene, run, opts)?;
-    opts.limits
-        .check(&projected_work(scene, run, opts, ensemble, &values, None))?;
+    let work = projected_work(scene, run, opts, ensemble, &values, None);
+    opts.limits.check(&work.scaled(source.fraction()))?;
     let names = observable_names();
     let limit_dt = match over {
         Over::Dt => Some(semi_discrete_limit(scene, spec)?),

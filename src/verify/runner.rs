@@ -135,8 +135,8 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     // The total work and memory, from the scene files alone, before anything is prepared.
     let mut work = projected_work(scenes, opts.budget);
     if let Ensembles::Merge(_) = opts.ensembles {
-        // Nothing is simulated: the progress is the reading of the shards.
-        work.parts.clear();
+        // Nothing is simulated, but the records held at once are the whole run's.
+        work = work.scaled(0.0);
     }
     opts.limits.check(&work)?;
     let prepared = prepare_all(scenes, opts.budget)?;

@@ -76,11 +76,7 @@ pub fn write_shard(
 ) -> Result<ShardManifest> {
     let scenes = &opts.scenes;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
-    let mut work = projected_work(scenes, opts.budget);
-    for part in &mut work.parts {
-        part.work.trajectory_steps *= shard.fraction();
-        part.work.dof_steps *= shard.fraction();
-    }
+    let work = projected_work(scenes, opts.budget).scaled(shard.fraction());
     opts.limits.check(&work)?;
     let prepared = prepare_all(scenes, opts.budget)?;
     let described = scenes

@@ -364,7 +364,7 @@ pub(super) fn study(
     let spec = &scene.runs[run];
     let (strains, values) = strains_and_values(scene, run, opts)?;
     let work = super::projected_work(scene, run, opts, ensemble, &values, Some(&strains));
-    opts.limits.check(&work)?;
+    opts.limits.check(&work.scaled(source.fraction()))?;
     // Everything that can be refused is checked before any simulation.
     let prepared = values
         .iter()

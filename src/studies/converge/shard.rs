@@ -240,6 +240,16 @@ impl Source<'_> {
         )
     }
 
+    /// The fraction of the trajectories this source simulates: 1/N for a shard, 1 for a
+    /// whole study, 0 for a merge.
+    pub(super) fn fraction(&self) -> f64 {
+        match self {
+            Source::Simulate => 1.0,
+            Source::Shard(w) => w.shard().fraction(),
+            Source::Merge(_) => 0.0,
+        }
+    }
+
     /// Finishes a shard's manifest, if this is a shard.
     ///
     /// # Errors
