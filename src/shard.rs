@@ -383,9 +383,21 @@ impl ShardSet {
     /// Reads a manifest.
     fn read_manifest(dir: &Path) -> Result<ShardManifest> {
         let path = dir.join(SHARD_MANIFEST);
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| refuse(dir, "-", format!("cannot be read as text: {e}")))?;
         let m: ShardManifest = serde_json::from_str(&text)
             .map_err(|e| refuse(dir, "-", format!("not a shard manifest: {e}")))?;
+        let s = m.shard;
+        if s.index < 1 || s.index > s.count || s.count > MAX_SHARDS {
+            return Err(refuse(
+                dir,
+                "shard",
+                format!(
+                    "shard {}/{}: 1 <= I <= N <= {MAX_SHARDS} is required",
+                    s.index, s.count
+                ),
+            ));
+        }
         if m.format != SHARD_FORMAT || m.format_version != SHARD_FORMAT_VERSION {
             return Err(refuse(
                 dir,
@@ -596,16 +608,17 @@ impl ShardSet {
                 })?;
             let bytes = self.read_file(k, entry)?;
             if let Some((prev, _)) = out.last() {
-                if entry.first != prev.first + prev.count {
+                let next = prev.first.checked_add(prev.count);
+                if next != Some(entry.first) {
                     return Err(refuse(
                         dir,
                         &key,
                         format!(
                             "trajectories {}..{} do not follow the previous shard's {}..{}",
                             entry.first,
-                            entry.first + entry.count,
+                            entry.first.saturating_add(entry.count),
                             prev.first,
-                            prev.first + prev.count
+                            prev.first.saturating_add(prev.count)
                         ),
                     ));
                 }
@@ -728,5 +741,55 @@ mod tests {
             assert!(e.contains("1 <= I <= N"), "{bad}: {e}");
         }
         assert_eq!(Shard { index: 3, count: 7 }.to_string(), "3/7");
+    }
+
+    /// Hand-edited or foreign manifests are refused as input (exit 2) naming the
+    /// manifest, never a panic: an index outside 1..=N, a count of 0, not JSON, not text.
+    #[test]
+    fn bad_manifests_are_refused_as_input() {
+        let scene = crate::scene::builtin::find("hinged-linear-2d")
+            .expect("built-in scene")
+            .load()
+            .expect("loads");
+        let root =
+            std::env::temp_dir().join(format!("langevin-fem-bad-manifests-{}", std::process::id()));
+        let dir = root.join("1");
+        let writer = ShardWriter::begin(
+            &dir,
+            "verify",
+            Shard::WHOLE,
+            serde_json::json!({}),
+            vec![ShardScene::of(&scene, "")],
+            Provenance::begin(&[&scene]),
+        )
+        .unwrap();
+        writer.finish().unwrap();
+        assert!(ShardSet::open(std::slice::from_ref(&dir)).is_ok());
+        let path = dir.join(SHARD_MANIFEST);
+        let good: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let with_shard = |index: usize, count: usize| {
+            let mut m = good.clone();
+            m["shard"] = serde_json::json!({"index": index, "count": count});
+            serde_json::to_vec(&m).unwrap()
+        };
+        let cases: [(&str, Vec<u8>, &str); 5] = [
+            ("index 0", with_shard(0, 3), "1 <= I <= N"),
+            ("index above count", with_shard(4, 3), "1 <= I <= N"),
+            ("count 0", with_shard(1, 0), "1 <= I <= N"),
+            ("not JSON", b"{ not json".to_vec(), "not a shard manifest"),
+            ("not text", vec![0xff, 0xfe, 0x00], "cannot be read as text"),
+        ];
+        for (what, bytes, expect) in cases {
+            std::fs::write(&path, bytes).unwrap();
+            let err = ShardSet::open(std::slice::from_ref(&dir)).unwrap_err();
+            assert_eq!(err.exit_code(), 2, "{what}: {err}");
+            let text = err.to_string();
+            assert!(
+                text.contains(expect) && text.contains(SHARD_MANIFEST),
+                "{what}: {text}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&root);
     }
 }
