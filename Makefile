@@ -119,8 +119,9 @@ fig2: build
 # Fig. 2 split into SHARDS shards (issue #15): run concurrently on this machine
 # (examples/slurm/parallel.sh: GNU parallel, or xargs -P without it) and as the Slurm
 # job array of examples/slurm/ run in turn without Slurm (emulate.sh: the array tasks,
-# then the merge job), each merged; both force-strain.csv tables and fig2.svg must equal
-# the single run's byte for byte. A few seconds; part of `make test` (CI).
+# shards 2..N with shard 1's plans, --plan-from, then the merge job), each merged; both
+# force-strain.csv tables and fig2.svg must equal the single run's byte for byte. A few
+# seconds; part of `make test` (CI).
 SHARDS    ?= 4
 SHARD_OUT ?= target/fig2-shards
 fig2-shards: build
@@ -128,7 +129,8 @@ fig2-shards: build
 	$(BIN) verify -q $(FIG2_ARGS) --out $(SHARD_OUT)/single
 	LANGEVIN_FEM=$(BIN) examples/slurm/parallel.sh $(SHARDS) $(SHARD_OUT)/parallel $(FIG2_ARGS)
 	LANGEVIN_FEM=$(CURDIR)/$(BIN) SHARDS_DIR=$(SHARD_OUT)/array/shards REPORT_DIR=$(SHARD_OUT)/array/report \
-		VERIFY_ARGS="-q $(FIG2_ARGS)" examples/slurm/emulate.sh $(SHARDS) >/dev/null
+		PLAN_FROM=$(CURDIR)/$(SHARD_OUT)/array/shards/1 VERIFY_ARGS="-q $(FIG2_ARGS)" \
+		examples/slurm/emulate.sh $(SHARDS) >/dev/null
 	for f in compression-2d/force-strain.csv compression-3d/force-strain.csv fig2.svg; do \
 		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/parallel/report/$$f && \
 		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/array/report/$$f || exit 1; \

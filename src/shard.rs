@@ -191,6 +191,43 @@ pub struct ShardManifest {
     pub provenance: serde_json::Value,
 }
 
+impl ShardManifest {
+    /// The manifest of the shard in `dir`, checked: its format, its shard `I/N`, and that
+    /// this build wrote it.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming the manifest: unreadable, not a manifest, another
+    /// format or build, an index outside `1..=N`.
+    pub fn read(dir: &Path) -> Result<ShardManifest> {
+        let m = ShardSet::read_manifest(dir)?;
+        if m.build != VERSION_LINE {
+            return Err(refuse(
+                dir,
+                "build",
+                format!(
+                    "written by langevin-fem {}, but this is {VERSION_LINE}: use the build that ran the shards",
+                    m.build
+                ),
+            ));
+        }
+        Ok(m)
+    }
+
+    /// Checks that this manifest (of the shard in `dir`) belongs to the set of `other`
+    /// (in `other_dir`): the same command, shard count, settings, scenes and seeds.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming this manifest and what differs.
+    pub fn check_same_set(
+        &self,
+        dir: &Path,
+        other: &ShardManifest,
+        other_dir: &Path,
+    ) -> Result<()> {
+        same_set(dir, self, other_dir, other)
+    }
+}
+
 /// A shard being written: record files first, the manifest last ([`ShardWriter::finish`]).
 #[derive(Debug)]
 pub struct ShardWriter {
@@ -238,6 +275,11 @@ impl ShardWriter {
     /// This shard.
     pub fn shard(&self) -> Shard {
         self.manifest.shard
+    }
+
+    /// The manifest so far (its files: those written yet).
+    pub fn manifest(&self) -> &ShardManifest {
+        &self.manifest
     }
 
     /// Writes one run's records (`bytes`, trajectories `range`) atomically as
@@ -426,17 +468,7 @@ impl ShardSet {
         // Index → position in `shards`: duplicates and gaps in O(N log N).
         let mut seen: std::collections::BTreeMap<usize, usize> = Default::default();
         for dir in Self::expand(dirs)? {
-            let mut m = Self::read_manifest(&dir)?;
-            if m.build != VERSION_LINE {
-                return Err(refuse(
-                    &dir,
-                    "build",
-                    format!(
-                        "written by langevin-fem {}, but this is {VERSION_LINE}: merge with the build that ran the shards",
-                        m.build
-                    ),
-                ));
-            }
+            let mut m = ShardManifest::read(&dir)?;
             match &first {
                 Some((first_dir, first)) => same_set(&dir, &m, first_dir, first)?,
                 None => first = Some((dir.clone(), m.clone())),

@@ -310,3 +310,59 @@ fn a_shard_is_capped_by_its_share_of_the_work() {
     let o = run(&args);
     assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
 }
+
+/// What: shard 1 of both fixtures run first, then shards 2 and 3 with `--plan-from` it
+/// (the compression fixture's budget is by target precision with a step search: they
+/// take shard 1's plans instead of running the search and the pilot), merged; and
+/// `--plan-from` a shard of another seed.
+/// Reference: the whole run's outputs (as in `three_shards_merge_to_the_whole_run_byte_for_byte`);
+/// the refusal names the seed (exit 2).
+#[test]
+fn shards_with_plans_from_shard_one_merge_to_the_whole_run() {
+    let tmp = TempDir::new("plan-from");
+    let whole = tmp.join("whole");
+    verify(&whole, &[]);
+    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let base = [
+        "verify",
+        "-q",
+        "-s",
+        lin.to_str().unwrap(),
+        "-s",
+        comp.to_str().unwrap(),
+    ];
+    let root = tmp.join("shards");
+    let shard = |i: usize, extra: &[&str]| {
+        let out = root.join(i.to_string()).display().to_string();
+        let n = format!("{i}/3");
+        let mut args = base.to_vec();
+        args.extend(["--shard", &n, "-o", &out]);
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        (o, args.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+    };
+    let first = root.join("1").display().to_string();
+    for i in 1..=3 {
+        let extra: &[&str] = if i == 1 {
+            &[]
+        } else {
+            &["--plan-from", &first]
+        };
+        let (o, args) = shard(i, extra);
+        let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_eq!(o.status.code(), Some(0), "{}", describe(&shown, &o));
+    }
+    let merged = tmp.join("merged");
+    let m = merge(&[&root], &merged);
+    assert!(matches!(m.status.code(), Some(0 | 1)), "{}", stderr_of(&m));
+    assert_same_outputs(&whole, &merged, volatile);
+
+    let (o, args) = shard(2, &["--plan-from", &first, "--seed", "7"]);
+    let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&shown, &o));
+    assert!(
+        stderr_of(&o).contains("seed 7") && stderr_of(&o).contains(&first),
+        "{}",
+        describe(&shown, &o)
+    );
+}

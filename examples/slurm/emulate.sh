@@ -12,6 +12,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 n=${1:?usage: emulate.sh N}
 export SLURM_ARRAY_TASK_COUNT=$n SLURM_CPUS_PER_TASK=${SLURM_CPUS_PER_TASK:-1}
 rm -rf "${SHARDS_DIR:-shards}"
+# With PLAN_FROM set, as submit.sh with PLAN_FIRST=1: shard 1 first, then the others.
 for i in $(seq 1 "$n"); do
     SLURM_ARRAY_TASK_ID=$i bash "$here/verify-array.sbatch" >/dev/null
 done

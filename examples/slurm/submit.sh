@@ -9,6 +9,9 @@
 # (default ./shards, one sub-directory per task), the report to $REPORT_DIR (./reports);
 # LANGEVIN_FEM names the binary (default: langevin-fem on PATH). Add sbatch options
 # (partition, account) in SBATCH_EXTRA, e.g. SBATCH_EXTRA="--partition=short".
+# PLAN_FIRST=1 runs shard 1 first and the others after it with its plans (--plan-from):
+# worth it for a budget by target precision (Fig. 2 full), whose step search and pilot
+# every shard would otherwise repeat.
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -28,8 +31,17 @@ rm -rf "$SHARDS_DIR"
 mkdir -p "$SHARDS_DIR"
 
 # shellcheck disable=SC2086 # SBATCH_EXTRA is a list of options
-array=$(sbatch --parsable ${SBATCH_EXTRA:-} --array="1-$n" --export=ALL "$here/verify-array.sbatch")
-array=${array%%;*}
+if [ "${PLAN_FIRST:-0}" = 1 ] && [ "$n" -gt 1 ]; then
+    first=$(sbatch --parsable ${SBATCH_EXTRA:-} --array=1 --export=ALL "$here/verify-array.sbatch")
+    first=${first%%;*}
+    # shellcheck disable=SC2086
+    array=$(PLAN_FROM="$SHARDS_DIR/1" sbatch --parsable ${SBATCH_EXTRA:-} --array="2-$n" \
+        --dependency="afterok:$first" --kill-on-invalid-dep=yes --export=ALL "$here/verify-array.sbatch")
+    array="$first:${array%%;*}"
+else
+    array=$(sbatch --parsable ${SBATCH_EXTRA:-} --array="1-$n" --export=ALL "$here/verify-array.sbatch")
+    array=${array%%;*}
+fi
 # shellcheck disable=SC2086
 merge=$(sbatch --parsable ${SBATCH_EXTRA:-} --dependency="afterok:$array" --kill-on-invalid-dep=yes \
     --export=ALL "$here/merge.sbatch")

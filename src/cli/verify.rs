@@ -56,6 +56,11 @@ pub struct VerifyArgs {
     /// report of the whole run, byte for byte (see README "Running on a cluster").
     #[arg(long, value_name = "I/N")]
     shard: Option<Shard>,
+    /// With --shard: take the plans of a budget by target precision (step search and
+    /// pilot) from this finished shard of the same set instead of computing them again
+    /// (submit that shard first; README "Running on a cluster").
+    #[arg(long, value_name = "SHARD_DIR", requires = "shard")]
+    plan_from: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
     #[command(flatten)]
@@ -113,7 +118,7 @@ pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
         ensembles: Ensembles::Simulate,
     };
     if let Some(shard) = args.shard {
-        let manifest = write_shard(&opts, shard, &seed_notes)?;
+        let manifest = write_shard(&opts, shard, &seed_notes, args.plan_from.as_deref())?;
         println!(
             "shard {shard}: {} record file(s) in {}; when every shard of {} is done: langevin-fem merge <the {} shard directories> -o <report dir>",
             manifest.files.len(),

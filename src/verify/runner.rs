@@ -593,7 +593,7 @@ fn run_compression(
     let e = run.spec.ensemble(opts.budget);
     let (records, plan) = match &opts.ensembles {
         Ensembles::Simulate => {
-            simulate_compression(scene, k, run, &e, opts.budget, bar, Shard::WHOLE)?
+            simulate_compression(scene, k, run, &e, opts.budget, bar, (Shard::WHOLE, None))?
         }
         Ensembles::Merge(set) => super::shard::merged_compression(set, scene, run, &e)?,
     };
@@ -625,8 +625,9 @@ fn run_compression(
 
 /// Simulates shard `shard`'s share of the trajectories of compression run `k` at
 /// ensemble `e` (every trajectory for [`Shard::WHOLE`]); returns the records per strain
-/// and, for a budget by target precision, its plan (step search and pilot, run in full
-/// whatever the shard: the plan depends on the scene alone).
+/// and, for a budget by target precision, its plan: `known` (another shard's, `verify
+/// --plan-from`), else its step search and pilot run here in full, whatever the shard
+/// (the plan depends on the scene alone).
 ///
 /// # Errors
 /// As [`simulate_error`] and [`targeted_plan`].
@@ -637,7 +638,7 @@ pub(super) fn simulate_compression(
     e: &Ensemble,
     budget: Budget,
     bar: &Progress,
-    shard: Shard,
+    (shard, known): (Shard, Option<TargetedPlan>),
 ) -> Result<(Vec<Vec<ForceRecord>>, Option<TargetedPlan>)> {
     let tick = tick_work(bar, run, e);
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
@@ -650,7 +651,10 @@ pub(super) fn simulate_compression(
             (steps, None)
         }
         Some(target) => {
-            let plan = targeted_plan(scene, k, run, e, target, budget, bar)?;
+            let plan = match known {
+                Some(plan) => plan,
+                None => targeted_plan(scene, k, run, e, target, budget, bar)?,
+            };
             (plan.main_steps.clone(), Some(plan))
         }
     };

@@ -27,6 +27,7 @@ use crate::scene::records::{decode_force, decode_linear, encode_force, encode_li
 use crate::scene::{Ensemble, Scene};
 use crate::shard::{Shard, ShardManifest, ShardScene, ShardSet, ShardWriter};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// The name of the command in a verification shard's manifest.
 pub const COMMAND: &str = "verify";
@@ -64,15 +65,19 @@ pub fn settings_of(set: &ShardSet) -> Result<(crate::scene::Budget, f64)> {
 
 /// Runs shard `shard` of the verification `opts` (see the [module docs](self)) into
 /// `opts.out`; `seed_notes` are the reports' notes on each scene's seed, kept for the
-/// merge. Returns the manifest written.
+/// merge. With `plan_from`, a finished shard of the same set, a budget by target
+/// precision takes that shard's plans instead of running its step search and pilot
+/// again (`verify --plan-from`). Returns the manifest written.
 ///
 /// # Errors
 /// As [`super::run_verification`] before and while it simulates (input: exit 2; a run
-/// failure: exit 3); I/O errors writing the shard.
+/// failure: exit 3); `plan_from` not a shard of the same set, or without a run's plan
+/// (exit 2); I/O errors writing the shard.
 pub fn write_shard(
     opts: &VerifyOptions,
     shard: Shard,
     seed_notes: &[String],
+    plan_from: Option<&Path>,
 ) -> Result<ShardManifest> {
     let scenes = &opts.scenes;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
@@ -92,6 +97,13 @@ pub fn write_shard(
         described,
         provenance,
     )?;
+    let plans = plan_from
+        .map(|dir| -> Result<(PathBuf, ShardManifest)> {
+            let m = ShardManifest::read(dir)?;
+            writer.manifest().check_same_set(&opts.out, &m, dir)?;
+            Ok((dir.to_path_buf(), m))
+        })
+        .transpose()?;
     let bar = Progress::new(opts.progress, work.dof_steps(), "DOF-steps");
     for (scene, prepared) in scenes.iter().zip(&prepared) {
         match prepared {
@@ -108,7 +120,7 @@ pub fn write_shard(
             Prepared::Compression(_, oracle, runs) if oracle.passed() => {
                 for_compression_runs(scene, runs, |k, run| {
                     begin_run(&bar, scene, k, opts.budget);
-                    write_compression(opts, scene, k, run, &bar, &mut writer)
+                    write_compression(opts, (scene, k, run), plans.as_ref(), &bar, &mut writer)
                 })?;
             }
             Prepared::Compression(..) => {}
@@ -137,19 +149,37 @@ fn write_linear(
     )
 }
 
-/// Simulates and writes the writer's share of compression run `k`, with its plan;
-/// returns the steps its step search chose, if any (for the Δt-halving pair).
+/// Simulates and writes the writer's share of compression run `k`, with its plan (that
+/// of the shard `plans`, if given); returns the steps its step search chose, if any (for
+/// the Δt-halving pair).
 fn write_compression(
     opts: &VerifyOptions,
-    scene: &Scene,
-    k: usize,
-    run: &CompressionRun,
+    (scene, k, run): (&Scene, usize, &CompressionRun),
+    plans: Option<&(PathBuf, ShardManifest)>,
     bar: &Progress,
     writer: &mut ShardWriter,
 ) -> Result<Option<Vec<f64>>> {
     let e = run.spec.ensemble(opts.budget);
+    let known = match (plans, e.precision_target()) {
+        (Some((dir, m)), Some(target)) => {
+            let entry = m
+                .files
+                .iter()
+                .find(|f| f.scene == scene.name && f.run == run.spec.name);
+            let refuse = |message: String| Error::Scene {
+                file: dir.join(crate::shard::SHARD_MANIFEST),
+                key: format!("files[{}/{}]", scene.name, run.spec.name),
+                message: format!("--plan-from: {message}"),
+            };
+            let common = entry
+                .map(|f| &f.common)
+                .ok_or_else(|| refuse("no plan of this run".to_string()))?;
+            Some(decode_plan(common, target, run.points()).map_err(refuse)?)
+        }
+        _ => None,
+    };
     let (records, plan) =
-        simulate_compression(scene, k, run, &e, opts.budget, bar, writer.shard())?;
+        simulate_compression(scene, k, run, &e, opts.budget, bar, (writer.shard(), known))?;
     let common = match &plan {
         Some(p) => serde_json::to_value(PlanBits::of(p))
             .map_err(|e| Error::io(&opts.out, std::io::Error::other(e)))?,
@@ -255,31 +285,38 @@ pub(super) fn merged_compression(
             format!("the shards hold {n} trajectories at a strain, the budget {want}"),
         ));
     }
-    let plan = match (e.precision_target(), &files[0].0.common) {
-        (None, _) => None,
-        (Some(target), common) => {
-            let bits: PlanBits = serde_json::from_value(common.clone())
-                .map_err(|err| incomplete(set, scene, name, format!("no readable plan: {err}")))?;
-            let plan = bits.plan(target);
-            let n = run.points();
-            let lengths = [
-                plan.pilot_std_error.len(),
-                plan.main_tau1.len(),
-                plan.main_steps.len(),
-                plan.search.as_ref().map_or(n, Vec::len),
-            ];
-            if lengths.iter().any(|&l| l != n) {
-                return Err(incomplete(
-                    set,
-                    scene,
-                    name,
-                    format!("a plan with {lengths:?} values, not one per strain ({n})"),
-                ));
-            }
-            Some(plan)
-        }
+    let plan = match e.precision_target() {
+        None => None,
+        Some(target) => Some(
+            decode_plan(&files[0].0.common, target, run.points())
+                .map_err(|m| incomplete(set, scene, name, m))?,
+        ),
     };
     Ok((records, plan))
+}
+
+/// The plan a shard manifest lists for a run of `points` strains (a file's `common`),
+/// checked to have one value per strain; the error says what is wrong.
+fn decode_plan(
+    common: &serde_json::Value,
+    target: crate::scene::PrecisionTarget,
+    points: usize,
+) -> std::result::Result<TargetedPlan, String> {
+    let bits: PlanBits =
+        serde_json::from_value(common.clone()).map_err(|e| format!("no readable plan: {e}"))?;
+    let plan = bits.plan(target);
+    let lengths = [
+        plan.pilot_std_error.len(),
+        plan.main_tau1.len(),
+        plan.main_steps.len(),
+        plan.search.as_ref().map_or(points, Vec::len),
+    ];
+    if lengths.iter().any(|&l| l != points) {
+        return Err(format!(
+            "a plan with {lengths:?} values, not one per strain ({points})"
+        ));
+    }
+    Ok(plan)
 }
 
 /// A [`TargetedPlan`] in JSON with every float as its bits (exact), for the manifest.
