@@ -18,25 +18,24 @@ use std::process::Output;
 const LINEAR: &str = "tests/scenes/good/tiny-linear.toml";
 const COMPRESSION: &str = "tests/scenes/good/tiny-compression.toml";
 
+/// `verify -q` of both fixtures with `extra` flags, as arguments.
+fn verify_args(extra: &[&str]) -> Vec<String> {
+    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let mut args = strings(&["verify", "-q", "-s", lin.to_str().unwrap()]);
+    args.extend(strings(&["-s", comp.to_str().unwrap()]));
+    args.extend(strings(extra));
+    args
+}
+
 /// `verify` of both fixtures into `out` with `extra` flags; asserts exit 0 or 1.
 fn verify(out: &Path, extra: &[&str]) -> Output {
-    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
-    let mut args = vec![
-        "verify",
-        "-q",
-        "-s",
-        lin.to_str().unwrap(),
-        "-s",
-        comp.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let o = run(&args);
+    let args = verify_args(&[extra, &["-o", out.to_str().unwrap()]].concat());
+    let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = run(&shown);
     assert!(
         matches!(o.status.code(), Some(0 | 1)),
         "{}",
-        describe(&args, &o)
+        describe(&shown, &o)
     );
     o
 }
@@ -49,11 +48,7 @@ fn strings(args: &[&str]) -> Vec<String> {
 /// Runs shards `1/n … n/n` of both fixtures' verification concurrently, each in a
 /// process of its own, into `<root>/<i>`, with `extra` flags.
 fn shards(root: &Path, n: usize, extra: &[&str]) -> Vec<PathBuf> {
-    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
-    let mut args = vec!["verify", "-q", "-s", lin.to_str().unwrap()];
-    args.extend(["-s", comp.to_str().unwrap()]);
-    args.extend_from_slice(extra);
-    shards_of(root, n, &strings(&args))
+    shards_of(root, n, &verify_args(extra))
 }
 
 /// The keys of a JSON output that differ between two runs of the same work.
@@ -322,24 +317,13 @@ fn shards_with_plans_from_shard_one_merge_to_the_whole_run() {
     let tmp = TempDir::new("plan-from");
     let whole = tmp.join("whole");
     verify(&whole, &[]);
-    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
-    let base = [
-        "verify",
-        "-q",
-        "-s",
-        lin.to_str().unwrap(),
-        "-s",
-        comp.to_str().unwrap(),
-    ];
     let root = tmp.join("shards");
     let shard = |i: usize, extra: &[&str]| {
         let out = root.join(i.to_string()).display().to_string();
         let n = format!("{i}/3");
-        let mut args = base.to_vec();
-        args.extend(["--shard", &n, "-o", &out]);
-        args.extend_from_slice(extra);
-        let o = run(&args);
-        (o, args.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+        let args = verify_args(&[&["--shard", &n, "-o", &out], extra].concat());
+        let shown: Vec<&str> = args.iter().map(String::as_str).collect();
+        (run(&shown), args)
     };
     let first = root.join("1").display().to_string();
     for i in 1..=3 {
