@@ -25,6 +25,8 @@ Examples:
   langevin-fem converge -s hinged-linear-2d --over dt --run crank-nicolson -b standard
   langevin-fem converge -s compression-2d --over elements --values 5,10,20 --strain-ratios 0 \\
       --trajectories 16 --duration-tau1 200 -o reports/convergence
+  langevin-fem converge -s hinged-linear-2d --over dt --shard 1/2 -o cv/1   (and 2/2), then:
+  langevin-fem merge cv/1 cv/2 -o reports/convergence
 
 The fitted orders go to stdout, progress to stderr; the exit code is 3 if every value failed.";
 
