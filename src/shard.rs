@@ -376,13 +376,20 @@ pub struct ShardSet {
     first: ShardManifest,
 }
 
-/// Refusal of a shard set (exit 2): names the manifest, the key and what is wrong.
-fn refuse(dir: &Path, key: &str, message: String) -> Error {
+/// Refusal of the shard in `dir` (exit 2): names its manifest, the key and what is
+/// wrong. Every refusal of a shard or a shard set is one of these.
+pub fn refuse(dir: &Path, key: &str, message: String) -> Error {
     Error::Scene {
         file: dir.join(SHARD_MANIFEST),
         key: key.to_string(),
         message,
     }
+}
+
+/// The manifest key of the files of run `run` of scene `scene` (`files[<scene>/<run>]`),
+/// as refusals name them.
+pub fn files_key(scene: &str, run: &str) -> String {
+    format!("files[{scene}/{run}]")
 }
 
 impl ShardSet {
@@ -538,6 +545,12 @@ impl ShardSet {
         Ok(set)
     }
 
+    /// A refusal of this set (exit 2) naming the first shard's manifest ([`refuse`]): its
+    /// settings or scenes (equal in every shard) or what the shards together hold.
+    pub fn refuse(&self, key: &str, message: String) -> Error {
+        refuse(&self.shards[0].0, key, message)
+    }
+
     /// The first manifest read, whole: the command's settings and scenes (equal in every
     /// shard of the set).
     pub fn manifest(&self) -> &ShardManifest {
@@ -564,7 +577,7 @@ impl ShardSet {
     /// directory, a file unreadable, of another size or hash.
     pub fn read_file(&self, k: usize, entry: &ShardFile) -> Result<Vec<u8>> {
         let (dir, m) = &self.shards[k];
-        let key = format!("files[{}/{}]", entry.scene, entry.run);
+        let key = files_key(&entry.scene, &entry.run);
         let rel = Path::new(&entry.path);
         if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
             return Err(refuse(
@@ -623,7 +636,7 @@ impl ShardSet {
     pub fn read(&self, scene: &str, run: &str) -> Result<Vec<(ShardFile, Vec<u8>)>> {
         let mut out: Vec<(ShardFile, Vec<u8>)> = Vec::new();
         for (k, (dir, m)) in self.shards.iter().enumerate() {
-            let key = format!("files[{scene}/{run}]");
+            let key = files_key(scene, run);
             let entry = m
                 .files
                 .iter()

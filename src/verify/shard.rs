@@ -25,7 +25,7 @@ use crate::scene::compression::{CompressionRun, ForceRecord, StepChoice};
 use crate::scene::linear::{LinearRun, TrajectoryRecord};
 use crate::scene::records::{decode_force, decode_linear, encode_force, encode_linear};
 use crate::scene::{Ensemble, Scene};
-use crate::shard::{Shard, ShardManifest, ShardScene, ShardSet, ShardWriter};
+use crate::shard::{Shard, ShardManifest, ShardScene, ShardSet, ShardWriter, files_key, refuse};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -55,11 +55,10 @@ pub fn settings_of(set: &ShardSet) -> Result<(crate::scene::Budget, f64)> {
     let alpha = s["alpha"].as_f64();
     match (budget, alpha) {
         (Some(b), Some(a)) => Ok((b, a)),
-        _ => Err(Error::Scene {
-            file: set.shards[0].0.join(crate::shard::SHARD_MANIFEST),
-            key: "settings".to_string(),
-            message: format!("{s}: a budget name and a number alpha are required"),
-        }),
+        _ => Err(set.refuse(
+            "settings",
+            format!("{s}: a budget name and a number alpha are required"),
+        )),
     }
 }
 
@@ -166,10 +165,12 @@ fn write_compression(
                 .files
                 .iter()
                 .find(|f| f.scene == scene.name && f.run == run.spec.name);
-            let refuse = |message: String| Error::Scene {
-                file: dir.join(crate::shard::SHARD_MANIFEST),
-                key: format!("files[{}/{}]", scene.name, run.spec.name),
-                message: format!("--plan-from: {message}"),
+            let refuse = |message: String| {
+                refuse(
+                    dir,
+                    &files_key(&scene.name, &run.spec.name),
+                    format!("--plan-from: {message}"),
+                )
             };
             let common = entry
                 .map(|f| &f.common)
@@ -198,11 +199,7 @@ fn write_compression(
 
 /// The refusal of a merge whose shards do not hold what run `run` of `scene` needs.
 fn incomplete(set: &ShardSet, scene: &Scene, run: &str, message: String) -> Error {
-    Error::Scene {
-        file: set.shards[0].0.join(crate::shard::SHARD_MANIFEST),
-        key: format!("files[{}/{run}]", scene.name),
-        message,
-    }
+    set.refuse(&files_key(&scene.name, run), message)
 }
 
 /// The records of linear run `run` of `scene` from every shard, in trajectory order:

@@ -17,7 +17,7 @@ use super::{
 };
 use langevin_fem::error::{Error, Result};
 use langevin_fem::output::io::write_atomic;
-use langevin_fem::shard::{SHARD_MANIFEST, Shard, ShardFile, ShardSet};
+use langevin_fem::shard::{Shard, ShardFile, ShardSet, files_key, refuse};
 use langevin_fem::work::WorkLimits;
 use std::path::Path;
 
@@ -28,15 +28,6 @@ type Expected = (String, Vec<String>);
 /// Where each file of one run comes from: the shard (0-based, in shard order) and its
 /// manifest entry, in trajectory order.
 type Sources<'a> = Vec<(usize, &'a ShardFile)>;
-
-/// Refusal of a shard set (exit 2): names the shard's manifest, the key and what is wrong.
-fn refuse(dir: &Path, key: &str, message: String) -> Error {
-    Error::Scene {
-        file: dir.join(SHARD_MANIFEST),
-        key: key.to_string(),
-        message,
-    }
-}
 
 /// Merges the shards of one `run` into `out` (see the [module docs](self)); exit code 0.
 ///
@@ -172,7 +163,7 @@ fn refuse_foreign(set: &ShardSet, scene: &str, expected: &[Expected]) -> Result<
             let keys: Vec<&str> = expected.iter().map(|(key, _)| key.as_str()).collect();
             return Err(refuse(
                 dir,
-                &format!("files[{}/{}]", f.scene, f.run),
+                &files_key(&f.scene, &f.run),
                 format!(
                     "{} is of {}/{}, which this run does not write (its runs: {scene}/{{{}}}): not a shard of this run",
                     f.path,
@@ -199,7 +190,7 @@ fn cover<'a>(
     key: &'a str,
     files: &[String],
 ) -> Result<Sources<'a>> {
-    let what = format!("files[{scene}/{key}]");
+    let what = files_key(scene, key);
     let total = files.len() as u64;
     let mut slots: Vec<Option<(usize, &ShardFile)>> = vec![None; files.len()];
     for (k, f) in set.files(scene, key) {
@@ -257,7 +248,7 @@ fn missing(set: &ShardSet, scene: &str, key: &str, files: &[String], j: u64) -> 
         .map_or(&set.shards[0].0, |(d, _)| d);
     refuse(
         dir,
-        &format!("files[{scene}/{key}]"),
+        &files_key(scene, key),
         format!(
             "trajectory {j} of {scene}/{key} ({}) is in no shard, but it is shard {owner}'s share of 0..{total}: rerun shard {owner}",
             files[j as usize]

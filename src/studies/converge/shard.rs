@@ -16,7 +16,7 @@ use crate::scene::compression::ForceRecord;
 use crate::scene::linear::TrajectoryRecord;
 use crate::scene::records::{decode_force, decode_linear, encode_force, encode_linear};
 use crate::scene::{Budget, Ensemble, Scene};
-use crate::shard::{SHARD_MANIFEST, Shard, ShardSet, ShardWriter};
+use crate::shard::{Shard, ShardSet, ShardWriter, files_key};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -75,10 +75,11 @@ impl ConvergeSettings {
     /// # Errors
     /// [`Error::Scene`] naming the first manifest if they do not parse.
     pub fn of_set(set: &ShardSet) -> Result<ConvergeSettings> {
-        serde_json::from_value(set.manifest().settings.clone()).map_err(|e| Error::Scene {
-            file: set.shards[0].0.join(SHARD_MANIFEST),
-            key: "settings".to_string(),
-            message: format!("not the settings of a convergence study: {e}"),
+        serde_json::from_value(set.manifest().settings.clone()).map_err(|e| {
+            set.refuse(
+                "settings",
+                format!("not the settings of a convergence study: {e}"),
+            )
         })
     }
 
@@ -286,11 +287,7 @@ fn read_value(set: &ShardSet, scene: &Scene, key: &str) -> Result<Vec<Part>> {
 
 /// Refuses a merge whose shards do not hold value `key` as the study needs it (exit 2).
 fn refuse(set: &ShardSet, scene: &Scene, key: &str, message: String) -> Error {
-    Error::Scene {
-        file: set.shards[0].0.join(SHARD_MANIFEST),
-        key: format!("files[{}/{key}]", scene.name),
-        message,
-    }
+    set.refuse(&files_key(&scene.name, key), message)
 }
 
 /// Refuses `got` records where the study needs `want`.
