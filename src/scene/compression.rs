@@ -501,32 +501,16 @@ impl CompressionRun {
         })
     }
 
-    /// Simulates `trajectories` trajectories of `sampled_steps` steps at every strain, in
-    /// parallel (rayon over strain × trajectory). Trajectory `j` at strain `i` uses the
-    /// stream `trajectory_rng(seed(i), j)`, so the result does not depend on the thread
-    /// count. `tick` is called after each trajectory (progress). Returns the records per
-    /// strain.
+    /// Simulates `trajectories` trajectories at every strain, `sampled_steps[i]` sampled
+    /// steps at strain `i` (the main stage of a budget by target precision gives each
+    /// strain its own), in parallel (rayon over strain × trajectory). Trajectory `j` at
+    /// strain `i` uses the stream `trajectory_rng(seed(i), j)`, so the result does not
+    /// depend on the thread count. `tick` is called after each trajectory (progress).
+    /// Returns the records per strain.
     ///
     /// # Errors
-    /// As [`Self::simulate`]: the first diverged trajectory (in index order).
-    pub fn simulate_ensemble(
-        &self,
-        seed: impl Fn(usize) -> u64 + Sync,
-        trajectories: usize,
-        sampled_steps: u64,
-        tick: impl Fn() + Sync,
-    ) -> Result<Vec<Vec<ForceRecord>>> {
-        let steps = vec![sampled_steps; self.points()];
-        self.simulate_ensemble_per_point(seed, trajectories, &steps, tick)
-    }
-
-    /// [`Self::simulate_ensemble`] with its own number of sampled steps at each strain
-    /// (`sampled_steps[i]` at strain `i`): the main stage of a budget by target
-    /// precision. Same streams as [`Self::simulate_ensemble`].
-    ///
-    /// # Errors
-    /// As [`Self::simulate`]; [`Error::InvalidParameter`] if `sampled_steps` does not have
-    /// one entry per strain.
+    /// As [`Self::simulate`]: the first diverged trajectory (in index order);
+    /// [`Error::InvalidParameter`] if `sampled_steps` does not have one entry per strain.
     pub fn simulate_ensemble_per_point(
         &self,
         seed: impl Fn(usize) -> u64 + Sync,

@@ -46,10 +46,9 @@ use crate::output::{AxisUnits, Figure, Provenance, ReportRun, Series, SeriesStyl
 use crate::params::physical::units_note;
 use crate::progress::{Progress, ProgressOptions};
 use crate::rng::derive_seed;
-use crate::scene::compression::ForceRecord;
 use crate::scene::compression::{
-    CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, PROBE_STEPS,
-    StepChoice, force_estimates_diagnosed, targeted_duration,
+    CompressionRun, CompressionTheoryTable, DURATION_SAFETY, ForceEstimates, ForceRecord,
+    PROBE_STEPS, StepChoice, force_estimates_diagnosed, targeted_duration,
 };
 use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
 use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scene};
