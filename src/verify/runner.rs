@@ -352,15 +352,22 @@ fn prepare(scene: &Scene) -> Result<Prepared> {
     Ok(Prepared::Compression(theory, oracle, runs))
 }
 
-/// Starts run `k` of `scene` on `bar`: labelled `scene/run`, of its projected work at
-/// `budget` ([`Scene::projected_work`]).
-pub(super) fn begin_run(bar: &Progress, scene: &Scene, k: usize, budget: Budget) {
-    let work = scene
+/// Starts run `k` of `scene` on `bar`: labelled `scene/run`, of the `share` of its
+/// projected work at `budget` that this process does (1 for a whole run, 1/N for a
+/// shard).
+pub(super) fn begin_run(bar: &Progress, scene: &Scene, k: usize, budget: Budget, share: f64) {
+    let run = scene.runs.get(k).map_or("?", |r| r.name.as_str());
+    let work = run_projected_work(scene, k, budget) * share;
+    bar.begin_run(&scene.name, &format!("{}/{run}", scene.name), work);
+}
+
+/// The projected work (DOF-steps) of run `k` of `scene` at `budget`, whole
+/// ([`Scene::projected_work`]).
+fn run_projected_work(scene: &Scene, k: usize, budget: Budget) -> f64 {
+    scene
         .projected_work(budget)
         .get(k)
-        .map_or(0.0, |p| p.work.dof_steps);
-    let run = scene.runs.get(k).map_or("?", |r| r.name.as_str());
-    bar.begin_run(&scene.name, &format!("{}/{run}", scene.name), work);
+        .map_or(0.0, |p| p.work.dof_steps)
 }
 
 /// What a scene produces, each list in the order of `summary.json`, and the report run
@@ -460,7 +467,7 @@ fn run_compression_scene(
     // Each run's points in the scene's force–strain figure.
     let mut points: Vec<Series> = Vec::new();
     for_compression_runs(scene, runs, |k, run| {
-        begin_run(bar, scene, k, opts.budget);
+        begin_run(bar, scene, k, opts.budget, 1.0);
         let (est, slope, steps) = run_compression(scene, theory, k, run, opts, bar, &mut outputs)?;
         if let Some((s, x, i)) = slope
             && largest_slope.as_ref().is_none_or(|l| s > l.1.0)
@@ -639,7 +646,7 @@ pub(super) fn simulate_compression(
     bar: &Progress,
     (shard, known): (Shard, Option<TargetedPlan>),
 ) -> Result<(Vec<Vec<ForceRecord>>, Option<TargetedPlan>)> {
-    let tick = tick_work(bar, run, e);
+    let tick = tick_work(scene, k, budget, run, e);
     let seed = |i: usize| derive_seed(scene.seed, &format!("{}/{i}", run.spec.name));
     let range = shard.range(e.trajectories.max(1) as u64);
     let (steps, plan) = match e.precision_target() {
@@ -679,12 +686,13 @@ fn adapted_run(
         .transpose()
 }
 
-/// The work of one trajectory at one strain of compression run `run` at ensemble `e`, for
-/// the progress: the run's projected work shared equally among its trajectories (times
-/// two stages, pilot and main, for a budget by target precision).
-fn tick_work(bar: &Progress, run: &CompressionRun, e: &Ensemble) -> f64 {
+/// The work of one trajectory at one strain of compression run `k` of `scene` at
+/// ensemble `e`, for the progress: the run's whole projected work shared equally among
+/// its trajectories (times two stages, pilot and main, for a budget by target
+/// precision), whichever share of them this process simulates.
+fn tick_work(scene: &Scene, k: usize, budget: Budget, run: &CompressionRun, e: &Ensemble) -> f64 {
     let stages = if e.precision_target().is_some() { 2 } else { 1 };
-    bar.run_work() / (stages * run.points() * e.trajectories.max(1)) as f64
+    run_projected_work(scene, k, budget) / (stages * run.points() * e.trajectories.max(1)) as f64
 }
 
 /// The pilot of a budget by target precision and the main-stage durations it chose.
@@ -720,7 +728,7 @@ fn targeted_plan(
 ) -> Result<TargetedPlan> {
     let tau1 = scene.filament.tau1();
     let name = &run.spec.name;
-    let tick = tick_work(bar, run, e);
+    let tick = tick_work(scene, k, budget, run, e);
     let (search, adapted) = match target.step_search {
         None => (None, None),
         Some(search) => {
@@ -1057,7 +1065,7 @@ fn run_scene(
         ModelKind::Spectral | ModelKind::Compression => None,
     };
     for (k, (run, oracle)) in runs.iter().zip(oracles).enumerate() {
-        begin_run(bar, scene, k, opts.budget);
+        begin_run(bar, scene, k, opts.budget, 1.0);
         outputs.checks.extend(oracle.checks.iter().cloned());
         outputs.notes.extend(oracle.notes.iter().cloned());
         if !oracle.passed() {

@@ -111,14 +111,14 @@ pub fn write_shard(
                     // As in a whole run: a run whose references fail the oracle is not
                     // simulated.
                     if oracles[k].passed() {
-                        begin_run(&bar, scene, k, opts.budget);
+                        begin_run(&bar, scene, k, opts.budget, shard.fraction());
                         write_linear(opts, scene, k, run, &bar, &mut writer)?;
                     }
                 }
             }
             Prepared::Compression(_, oracle, runs) if oracle.passed() => {
                 for_compression_runs(scene, runs, |k, run| {
-                    begin_run(&bar, scene, k, opts.budget);
+                    begin_run(&bar, scene, k, opts.budget, shard.fraction());
                     write_compression(opts, (scene, k, run), plans.as_ref(), &bar, &mut writer)
                 })?;
             }
