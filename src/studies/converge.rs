@@ -1120,10 +1120,7 @@ fn linear_study(
     for ((s, lr), &v) in prepared.iter().zip(&values) {
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
-        let seed = derive_seed(
-            s.seed,
-            &format!("{}/converge/{}={v}", spec.name, over.name()),
-        );
+        let seed = derive_seed(s.seed, &seed_label(&spec.name, over, v));
         let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
         let outcome = source.linear((scene, &spec.name, over, v), &ensemble, |first, count| {
             lr.simulate_ensemble(seed, first, count, steps, |_| {})
@@ -1200,6 +1197,12 @@ fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Ve
 
 /// An estimate and its standard error.
 type Estimate = (f64, f64);
+
+/// The label of the streams of value `v` of a study of run `run` (`<run>/converge/<over>=<v>`;
+/// a compression study appends `/<strain>`), from which the seeds derive.
+fn seed_label(run: &str, over: Over, v: f64) -> String {
+    format!("{run}/converge/{}={v}", over.name())
+}
 
 /// The rows of one value: one per observable, from its estimates and exact references.
 fn value_rows(names: &[String], refp: &PointReference, est: &[Estimate]) -> Vec<Row> {

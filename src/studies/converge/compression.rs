@@ -551,7 +551,7 @@ fn value_records(
     source: &mut Source<'_>,
 ) -> Result<Outcome<Vec<Vec<ForceRecord>>>> {
     let steps = vec![cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1()); cr.points()];
-    let label = format!("{run_name}/converge/{}={v}", over.name());
+    let label = super::seed_label(run_name, over, v);
     source.force(
         (scene, run_name, over, v),
         &ensemble,
