@@ -237,11 +237,10 @@ pub struct ShardWriter {
 }
 
 impl ShardWriter {
-    /// Starts shard `shard` of `command` in `dir`, removing an earlier manifest there
-    /// first (so that an interrupted shard is never taken for a finished one).
+    /// Starts shard `shard` of `command` in `dir` ([`Self::new`], then [`Self::start`]).
     ///
     /// # Errors
-    /// [`Error::Io`] if the earlier manifest cannot be removed.
+    /// [`Error::Io`] if an earlier manifest cannot be removed.
     pub fn begin(
         dir: &Path,
         command: &str,
@@ -250,12 +249,34 @@ impl ShardWriter {
         scenes: Vec<ShardScene>,
         provenance: Provenance,
     ) -> Result<ShardWriter> {
-        let old = dir.join(SHARD_MANIFEST);
+        Self::new(dir, command, shard, settings, scenes, provenance).start()
+    }
+
+    /// Removes an earlier manifest in the shard's directory, so that an interrupted
+    /// shard is never taken for a finished one; called before anything is written (after
+    /// any check of the input, which leaves an earlier shard untouched).
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the earlier manifest cannot be removed.
+    pub fn start(self) -> Result<ShardWriter> {
+        let old = self.dir.join(SHARD_MANIFEST);
         match std::fs::remove_file(&old) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&old, e)),
-            _ => {}
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(&old, e)),
+            _ => Ok(self),
         }
-        Ok(ShardWriter {
+    }
+
+    /// Shard `shard` of `command` in `dir`, not started: nothing is touched on disk until
+    /// [`Self::start`].
+    pub fn new(
+        dir: &Path,
+        command: &str,
+        shard: Shard,
+        settings: serde_json::Value,
+        scenes: Vec<ShardScene>,
+        provenance: Provenance,
+    ) -> ShardWriter {
+        ShardWriter {
             dir: dir.to_path_buf(),
             manifest: ShardManifest {
                 format: SHARD_FORMAT.to_string(),
@@ -269,7 +290,7 @@ impl ShardWriter {
                 provenance: serde_json::Value::Null,
             },
             provenance,
-        })
+        }
     }
 
     /// This shard.

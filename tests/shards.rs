@@ -341,6 +341,9 @@ fn shards_with_plans_from_shard_one_merge_to_the_whole_run() {
     assert!(matches!(m.status.code(), Some(0 | 1)), "{}", stderr_of(&m));
     assert_same_outputs(&whole, &merged, volatile);
 
+    // Refused as input before the earlier shard 2 in the same directory is touched.
+    let manifest = root.join("2").join("shard.json");
+    let before = std::fs::read(&manifest).expect("shard 2's manifest");
     let (o, args) = shard(2, &["--plan-from", &first, "--seed", "7"]);
     let shown: Vec<&str> = args.iter().map(String::as_str).collect();
     assert_eq!(o.status.code(), Some(2), "{}", describe(&shown, &o));
@@ -348,5 +351,9 @@ fn shards_with_plans_from_shard_one_merge_to_the_whole_run() {
         stderr_of(&o).contains("seed 7") && stderr_of(&o).contains(&first),
         "{}",
         describe(&shown, &o)
+    );
+    assert!(
+        std::fs::read(&manifest).ok() == Some(before),
+        "a refused --plan-from changed the earlier shard's manifest"
     );
 }

@@ -88,14 +88,16 @@ pub fn write_shard(
         .zip(seed_notes)
         .map(|(s, n)| ShardScene::of(s, n))
         .collect();
-    let mut writer = ShardWriter::begin(
+    let writer = ShardWriter::new(
         &opts.out,
         COMMAND,
         shard,
         settings(opts),
         described,
         provenance,
-    )?;
+    );
+    // The shard of --plan-from is input: checked before the earlier shard in opts.out is
+    // touched.
     let plans = plan_from
         .map(|dir| -> Result<(PathBuf, ShardManifest)> {
             let m = ShardManifest::read(dir)?;
@@ -103,6 +105,7 @@ pub fn write_shard(
             Ok((dir.to_path_buf(), m))
         })
         .transpose()?;
+    let mut writer = writer.start()?;
     let bar = Progress::new(opts.progress, work.dof_steps(), "DOF-steps");
     for (scene, prepared) in scenes.iter().zip(&prepared) {
         match prepared {
