@@ -9,8 +9,9 @@
 //!
 //! 1. Foundation: [`params`], [`rng`], [`error`] (physical parameters, deterministic
 //!    randomness, errors), [`output`] (domain-free SVG figures and atomic file writers),
-//!    [`work`] (the caps on a command's projected total work and memory) and
-//!    [`progress`] (progress on stderr, weighted by that work).
+//!    [`input`] (domain-free reading of the files a user gives: regular files only,
+//!    capped before they are read), [`work`] (the caps on a command's projected total
+//!    work and memory) and [`progress`] (progress on stderr, weighted by that work).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
 //!    (2)–(4)).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
@@ -60,6 +61,7 @@ pub mod error;
 #[cfg(any(test, feature = "faults"))]
 pub mod fault;
 pub mod fem;
+pub mod input;
 pub mod output;
 pub mod params;
 pub mod progress;

@@ -1,0 +1,236 @@
+//! Domain-free input: every file a command reads as data (a data directory's sidecar and
+//! trajectory files, shard manifests and records, a `--plan-from` shard) is opened here,
+//! so that a damaged or hostile file is refused as input (exit 2) and never blocks, never
+//! sizes an allocation by a number it claims, and is never written to.
+//!
+//! - Only **regular files** are read. A file is opened without blocking
+//!   (`O_NONBLOCK` on Linux, so that opening a FIFO returns at once) and its type is then
+//!   taken from the open handle: a FIFO, socket, device or directory is refused, naming
+//!   the path. A symbolic link is followed (reading through it harms nothing); what it
+//!   points to must be a regular file.
+//! - Every read is **capped** before it starts: the caller states the largest size it
+//!   accepts, and a larger file is refused with its size and the cap, never read.
+//! - **Text** is UTF-8; a UTF-8 byte-order mark (as some Windows editors and Excel write)
+//!   is accepted and dropped ([`read_text`]).
+//!
+//! Errors are [`Error::Scene`] naming the file, the key that led to it (e.g.
+//! `runs[0].files[3]`) and what is wrong, so the message says what to fix.
+
+use std::fs::{File, OpenOptions};
+use std::io::Read;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// The largest metadata file (a sidecar, a shard manifest) read whole: 256 MiB.
+pub const MAX_METADATA_BYTES: u64 = 256 << 20;
+
+/// The error of input file `path` at `key`: `message` says what is wrong and what is
+/// allowed.
+pub fn refused(path: &Path, key: &str, message: impl Into<String>) -> Error {
+    Error::Scene {
+        file: path.to_path_buf(),
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+/// Opens `path` for reading as a regular file (see the [module docs](self)); returns the
+/// handle and the file's size in bytes. `key` names what led to the file in the
+/// messages.
+///
+/// # Errors
+/// [`Error::Scene`] naming `path` and `key` if it does not exist, cannot be opened or is
+/// not a regular file (a directory, FIFO, socket or device).
+pub fn open_regular(path: &Path, key: &str) -> Result<(File, u64)> {
+    let mut options = OpenOptions::new();
+    options.read(true);
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // O_NONBLOCK: opening a FIFO without a writer returns at once instead of blocking.
+        options.custom_flags(0o4000);
+    }
+    let file = options
+        .open(path)
+        .map_err(|e| refused(path, key, format!("cannot be opened: {e}")))?;
+    let meta = file
+        .metadata()
+        .map_err(|e| refused(path, key, format!("cannot be read: {e}")))?;
+    if !meta.is_file() {
+        return Err(refused(
+            path,
+            key,
+            format!(
+                "must be a regular file, but it is {}",
+                kind_of(&meta.file_type())
+            ),
+        ));
+    }
+    Ok((file, meta.len()))
+}
+
+/// What a file type is, in words.
+fn kind_of(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_block_device() || t.is_char_device() {
+            return "a device";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_symlink() {
+        "a symbolic link"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// Reads the regular file `path` whole, refusing it unread if it is larger than
+/// `max_bytes` (`key` names what led to it).
+///
+/// # Errors
+/// As [`open_regular`]; [`Error::Scene`] if the file is larger than `max_bytes` or a read
+/// fails.
+pub fn read_bytes(path: &Path, key: &str, max_bytes: u64) -> Result<Vec<u8>> {
+    let (file, len) = open_regular(path, key)?;
+    if len > max_bytes {
+        return Err(refused(
+            path,
+            key,
+            format!(
+                "is {len} bytes, more than the {max_bytes} bytes this file may hold ({})",
+                human_bytes(max_bytes)
+            ),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    // `take`: a file that grows while it is read still stops at the cap.
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| refused(path, key, format!("cannot be read: {e}")))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(refused(
+            path,
+            key,
+            format!("grew beyond {max_bytes} bytes while it was read"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// Reads the regular file `path` whole as UTF-8 text (a leading byte-order mark
+/// dropped), refusing it unread above `max_bytes`.
+///
+/// # Errors
+/// As [`read_bytes`]; [`Error::Scene`] if the bytes are not UTF-8 (naming the offset).
+pub fn read_text(path: &Path, key: &str, max_bytes: u64) -> Result<String> {
+    let bytes = read_bytes(path, key, max_bytes)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        refused(
+            path,
+            key,
+            format!(
+                "must be UTF-8 text, but byte {} is not ({e})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
+/// `bytes` in words: `4.0 GiB`, `256 MiB`, `12 kiB`, `100 bytes`.
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("kiB", 1 << 10)];
+    for (unit, size) in UNITS {
+        if bytes >= size {
+            let v = bytes as f64 / size as f64;
+            return if v.fract() == 0.0 {
+                format!("{v:.0} {unit}")
+            } else {
+                format!("{v:.1} {unit}")
+            };
+        }
+    }
+    format!("{bytes} bytes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(tag: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("lfem-input-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// Regular files are read (a byte-order mark dropped from text); directories,
+    /// missing files and files above the cap are refused naming the path and the key.
+    #[test]
+    fn reads_regular_files_and_refuses_the_rest() {
+        let d = dir("regular");
+        let f = d.join("a.json");
+        std::fs::write(&f, "\u{feff}{}").unwrap();
+        assert_eq!(read_text(&f, "k", 100).unwrap(), "{}");
+        assert_eq!(read_bytes(&f, "k", 5).unwrap().len(), 5);
+        let e = read_bytes(&f, "runs[0]", 4).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        let text = e.to_string();
+        assert!(text.contains("a.json") && text.contains("runs[0]") && text.contains("5 bytes"));
+        let e = read_bytes(&d, "k", 100).unwrap_err().to_string();
+        assert!(e.contains("a directory"), "{e}");
+        let e = read_bytes(&d.join("missing"), "k", 100).unwrap_err();
+        assert_eq!(e.exit_code(), 2, "{e}");
+        std::fs::write(&f, [0x66, 0xff, 0x66]).unwrap();
+        let e = read_text(&f, "k", 100).unwrap_err().to_string();
+        assert!(e.contains("UTF-8") && e.contains("byte 1"), "{e}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A FIFO is refused at once (opening does not wait for a writer), and a symbolic
+    /// link to a regular file is followed.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn fifos_are_refused_without_blocking_and_links_followed() {
+        let d = dir("fifo");
+        let fifo = d.join("data.json");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success());
+        if made {
+            let start = std::time::Instant::now();
+            let e = read_text(&fifo, "-", 100).unwrap_err().to_string();
+            assert!(e.contains("FIFO"), "{e}");
+            assert!(start.elapsed().as_secs() < 5);
+        }
+        let target = d.join("t.csv");
+        std::fs::write(&target, "t\n0\n").unwrap();
+        let link = d.join("l.csv");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        assert_eq!(read_text(&link, "-", 100).unwrap(), "t\n0\n");
+        let dev = read_bytes(Path::new("/dev/zero"), "-", 100).unwrap_err();
+        assert!(dev.to_string().contains("device"), "{dev}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn bytes_in_words() {
+        assert_eq!(human_bytes(100), "100 bytes");
+        assert_eq!(human_bytes(256 << 20), "256 MiB");
+        assert_eq!(human_bytes(3 << 29), "1.5 GiB");
+    }
+}
