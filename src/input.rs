@@ -150,6 +150,52 @@ pub fn read_text(path: &Path, key: &str, max_bytes: u64) -> Result<String> {
     })
 }
 
+/// Refuses an output directory `out` (`--out`) that is the input directory `input`
+/// (given by `input_flag`, e.g. `--data`) or holds it: the command would write its output
+/// among its own input data (issue #25). An output directory inside the input directory
+/// is allowed: nothing of the input is touched then.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--out`, both directories and the flag.
+pub fn refuse_input_in_output(out: &Path, input: &Path, input_flag: &str) -> Result<()> {
+    let (o, i) = (resolved(out), resolved(input));
+    if i.starts_with(&o) {
+        let relation = if i == o { "is" } else { "holds" };
+        return Err(Error::invalid(
+            "--out",
+            out.display(),
+            format!(
+                "a directory apart from the input: it {relation} the input directory {} given by {input_flag}, whose files the output would mix with or replace; choose another output directory",
+                input.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `path` made absolute with its existing part's symbolic links resolved (the rest, not
+/// yet created, appended as given).
+fn resolved(path: &Path) -> std::path::PathBuf {
+    let mut missing = Vec::new();
+    let mut p = path.to_path_buf();
+    loop {
+        if let Ok(c) = p.canonicalize() {
+            return missing.iter().rev().fold(c, |acc, m| acc.join(m));
+        }
+        match (p.file_name().map(|n| n.to_os_string()), p.parent()) {
+            (Some(name), Some(parent)) => {
+                missing.push(name);
+                p = if parent.as_os_str().is_empty() {
+                    std::path::PathBuf::from(".")
+                } else {
+                    parent.to_path_buf()
+                };
+            }
+            _ => return path.to_path_buf(),
+        }
+    }
+}
+
 /// `bytes` in words: `4.0 GiB`, `256 MiB`, `12 kiB`, `100 bytes`.
 pub fn human_bytes(bytes: u64) -> String {
     const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("kiB", 1 << 10)];
@@ -224,6 +270,22 @@ mod tests {
         assert_eq!(read_text(&link, "-", 100).unwrap(), "t\n0\n");
         let dev = read_bytes(Path::new("/dev/zero"), "-", 100).unwrap_err();
         assert!(dev.to_string().contains("device"), "{dev}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// The output may not be the input directory or hold it; inside it is fine.
+    #[test]
+    fn output_apart_from_input() {
+        let d = dir("overlap");
+        let data = d.join("data");
+        std::fs::create_dir_all(&data).unwrap();
+        for out in [data.clone(), d.clone(), data.join("..")] {
+            let e = refuse_input_in_output(&out, &data, "--data").unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            assert!(e.to_string().contains("--data"), "{e}");
+        }
+        refuse_input_in_output(&data.join("report"), &data, "--data").unwrap();
+        refuse_input_in_output(&d.join("report/new"), &data, "--data").unwrap();
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -24,7 +24,9 @@
 //! from the wall times, run id and provenance.
 
 use crate::error::{Error, Result};
+use crate::output::Staging;
 use crate::output::io::write_json;
+use crate::output::manifest::{OutputKind, refuse_occupied};
 use crate::output::provenance::{Provenance, SceneProvenance, VERSION_LINE};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -34,7 +36,7 @@ use std::path::{Component, Path, PathBuf};
 use std::str::FromStr;
 
 /// File name of a shard's manifest, written last.
-pub const SHARD_MANIFEST: &str = "shard.json";
+pub const SHARD_MANIFEST: &str = crate::output::manifest::SHARD_FILE;
 /// The `format` field of a shard manifest.
 pub const SHARD_FORMAT: &str = "langevin-fem shard";
 /// The version of the shard format (bumped when a reader of the old one would misread).
@@ -234,13 +236,16 @@ pub struct ShardWriter {
     dir: PathBuf,
     manifest: ShardManifest,
     provenance: Provenance,
+    /// Where the shard's files wait until [`Self::finish`] ([`crate::output::staging`]);
+    /// `None` before [`Self::start`].
+    staging: Option<Staging>,
 }
 
 impl ShardWriter {
     /// Starts shard `shard` of `command` in `dir` ([`Self::new`], then [`Self::start`]).
     ///
     /// # Errors
-    /// [`Error::Io`] if an earlier manifest cannot be removed.
+    /// As [`Self::start`].
     pub fn begin(
         dir: &Path,
         command: &str,
@@ -252,18 +257,22 @@ impl ShardWriter {
         Self::new(dir, command, shard, settings, scenes, provenance).start()
     }
 
-    /// Removes an earlier manifest in the shard's directory, so that an interrupted
-    /// shard is never taken for a finished one; called before anything is written (after
-    /// any check of the input, which leaves an earlier shard untouched).
+    /// Checks that the shard's directory holds nothing but an earlier shard of the same
+    /// command ([`refuse_occupied`]) and opens the staging directory where its files wait
+    /// until [`Self::finish`]; called after any check of the input. An earlier shard in
+    /// the directory stays as it was (complete, with its manifest) until the new one has
+    /// written everything: a refusal or failure before that leaves it untouched.
     ///
     /// # Errors
-    /// [`Error::Io`] if the earlier manifest cannot be removed.
-    pub fn start(self) -> Result<ShardWriter> {
-        let old = self.dir.join(SHARD_MANIFEST);
-        match std::fs::remove_file(&old) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(&old, e)),
-            _ => Ok(self),
-        }
+    /// [`Error::InvalidParameter`] naming `--out` if the directory holds another command's
+    /// output; [`Error::Io`] if the staging directory cannot be created.
+    pub fn start(mut self) -> Result<ShardWriter> {
+        let kind = OutputKind::Shard {
+            command: &self.manifest.command,
+        };
+        refuse_occupied(&self.dir, kind)?;
+        self.staging = Some(Staging::new(&self.dir)?);
+        Ok(self)
     }
 
     /// Shard `shard` of `command` in `dir`, not started: nothing is touched on disk until
@@ -290,6 +299,7 @@ impl ShardWriter {
                 provenance: serde_json::Value::Null,
             },
             provenance,
+            staging: None,
         }
     }
 
@@ -304,7 +314,8 @@ impl ShardWriter {
     }
 
     /// Writes one run's records (`bytes`, trajectories `range`) atomically as
-    /// `records/<scene>/<run>.<ext>` and lists it, with `common`.
+    /// `records/<scene>/<run>.<ext>` (staged until [`Self::finish`]) and lists it, with
+    /// `common`.
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be written.
@@ -316,9 +327,30 @@ impl ShardWriter {
         common: serde_json::Value,
     ) -> Result<()> {
         let rel = format!("{RECORDS_DIR}/{scene}/{run}.{ext}");
-        crate::output::io::write_atomic(&self.dir.join(&rel), bytes)?;
+        crate::output::io::write_atomic(&self.staged(&rel)?, bytes)?;
         self.list((scene, run), &rel, bytes, range, common);
         Ok(())
+    }
+
+    /// Where to write the shard's file `rel` (a plain relative path) while the shard goes
+    /// on: in its staging directory, moved into place by [`Self::finish`].
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the writer was not started or `rel` is not a plain relative path.
+    pub fn staged(&self, rel: &str) -> Result<PathBuf> {
+        let invalid = |why: &str| {
+            Error::io(
+                self.dir.join(rel),
+                std::io::Error::new(std::io::ErrorKind::InvalidInput, why.to_string()),
+            )
+        };
+        let staging = self
+            .staging
+            .as_ref()
+            .ok_or_else(|| invalid("the shard writer was not started"))?;
+        crate::output::manifest::safe_relative(rel)
+            .ok_or_else(|| invalid("not a plain relative path"))?;
+        Ok(staging.path(rel))
     }
 
     /// Lists the file `rel` with content `bytes` in the manifest.
@@ -347,8 +379,8 @@ impl ShardWriter {
         &self.dir
     }
 
-    /// Lists a file already written (atomically) under the shard directory at `rel`:
-    /// one run's trajectories `range`, with `common`; its size and SHA-256 are read back.
+    /// Lists a file already written (atomically) at [`Self::staged`]`(rel)`: one run's
+    /// trajectories `range`, with `common`; its size and SHA-256 are read back.
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be read.
@@ -359,20 +391,30 @@ impl ShardWriter {
         range: Range<u64>,
         common: serde_json::Value,
     ) -> Result<()> {
-        let path = self.dir.join(rel);
+        let path = self.staged(rel)?;
         let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
         self.list((scene, run), rel, &bytes, range, common);
         Ok(())
     }
 
-    /// Writes the manifest (atomically, last) and returns it.
+    /// Finishes the shard: removes an earlier manifest (so that a shard killed from here
+    /// on is never taken for a finished one), moves the files into place and writes the
+    /// manifest (atomically, last); returns it.
     ///
     /// # Errors
-    /// [`Error::Io`] if it cannot be written.
+    /// [`Error::Io`] if a file cannot be moved or written.
     pub fn finish(mut self) -> Result<ShardManifest> {
         self.provenance.finish();
         self.manifest.provenance = serde_json::to_value(&self.provenance)
             .map_err(|e| Error::io(self.dir.join(SHARD_MANIFEST), e.into()))?;
+        let old = self.dir.join(SHARD_MANIFEST);
+        match std::fs::remove_file(&old) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&old, e)),
+            _ => {}
+        }
+        if let Some(staging) = &mut self.staging {
+            staging.publish(self.manifest.files.iter().map(|f| f.path.as_str()))?;
+        }
         write_json(&self.dir.join(SHARD_MANIFEST), &self.manifest)?;
         Ok(self.manifest)
     }
@@ -395,6 +437,22 @@ pub struct ShardSet {
     pub shards: Vec<(PathBuf, ShardManifest)>,
     /// The first manifest read, whole.
     first: ShardManifest,
+    /// The largest total of record bytes held at once (one run's records from every
+    /// shard), and so the largest record file: the memory cap (`--max-memory-gib`).
+    max_bytes: u64,
+}
+
+/// One record file of a shard set as read: its manifest entry, its bytes, and where it
+/// comes from in words (`<shard dir>/<path> (shard I/N)`), for the messages of its
+/// decoder.
+#[derive(Debug, Clone)]
+pub struct ShardRecord {
+    /// The manifest entry.
+    pub file: ShardFile,
+    /// The content, checked against the entry's size and SHA-256.
+    pub bytes: Vec<u8>,
+    /// The file's path and shard, in words.
+    pub source: String,
 }
 
 /// Refusal of the shard in `dir` (exit 2): names its manifest, the key and what is
@@ -453,8 +511,15 @@ impl ShardSet {
     /// Reads a manifest.
     fn read_manifest(dir: &Path) -> Result<ShardManifest> {
         let path = dir.join(SHARD_MANIFEST);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| refuse(dir, "-", format!("cannot be read as text: {e}")))?;
+        let text =
+            crate::input::read_text(&path, "-", crate::input::MAX_METADATA_BYTES).map_err(|e| {
+                match e {
+                    Error::Scene { message, .. } => {
+                        refuse(dir, "-", format!("cannot be read as text: {message}"))
+                    }
+                    other => other,
+                }
+            })?;
         let m: ShardManifest = serde_json::from_str(&text)
             .map_err(|e| refuse(dir, "-", format!("not a shard manifest: {e}")))?;
         let s = m.shard;
@@ -490,7 +555,7 @@ impl ShardSet {
     /// command, build (also than this merge's), shard count, setting, scene or seed than
     /// the first shard; a duplicated index (naming both directories); missing indices; a
     /// file missing, unreadable or damaged ([`Self::read_file`]).
-    pub fn open(dirs: &[PathBuf]) -> Result<ShardSet> {
+    pub fn open(dirs: &[PathBuf], max_bytes: u64) -> Result<ShardSet> {
         let mut shards: Vec<(PathBuf, ShardManifest)> = Vec::new();
         let mut first: Option<(PathBuf, ShardManifest)> = None;
         // Index → position in `shards`: duplicates and gaps in O(N log N).
@@ -499,7 +564,10 @@ impl ShardSet {
             let mut m = ShardManifest::read(&dir)?;
             match &first {
                 Some((first_dir, first)) => same_set(&dir, &m, first_dir, first)?,
-                None => first = Some((dir.clone(), m.clone())),
+                None => {
+                    check_scene_hashes(&dir, &m)?;
+                    first = Some((dir.clone(), m.clone()));
+                }
             }
             if let Some(&k) = seen.get(&m.shard.index) {
                 return Err(refuse(
@@ -555,7 +623,11 @@ impl ShardSet {
                 ),
             ));
         }
-        let set = ShardSet { shards, first };
+        let set = ShardSet {
+            shards,
+            first,
+            max_bytes,
+        };
         // Every file against its manifest now, before the merge writes anything: a
         // damaged shard is input (exit 2) and must leave an earlier output untouched.
         for (k, (_, m)) in set.shards.iter().enumerate() {
@@ -570,6 +642,32 @@ impl ShardSet {
     /// settings or scenes (equal in every shard) or what the shards together hold.
     pub fn refuse(&self, key: &str, message: String) -> Error {
         refuse(&self.shards[0].0, key, message)
+    }
+
+    /// `e`, raised by the command's own check of the settings the shards ran with (an
+    /// [`Error::InvalidParameter`] naming a flag, e.g. `--trajectories`), as a refusal
+    /// of this set naming the first manifest's `settings` (exit 2): the flags were checked
+    /// when the shards ran, so a value out of range here is a damaged or edited manifest.
+    /// Other errors are returned as they are.
+    pub fn settings_error(&self, e: Error) -> Error {
+        match e {
+            Error::InvalidParameter {
+                name,
+                value,
+                allowed,
+            } if name.starts_with("--") => self.refuse(
+                "settings",
+                format!(
+                    "the shards ran with {name} = {value}, but {name} must be {allowed}: a damaged or edited manifest; rerun the shards"
+                ),
+            ),
+            other => other,
+        }
+    }
+
+    /// The largest total of record bytes the merge may hold at once (the memory cap).
+    pub fn max_bytes(&self) -> u64 {
+        self.max_bytes
     }
 
     /// The first manifest read, whole: the command's settings and scenes (equal in every
@@ -611,8 +709,29 @@ impl ShardSet {
             ));
         }
         let path = dir.join(rel);
-        let bytes = std::fs::read(&path)
-            .map_err(|e| refuse(dir, &key, format!("cannot read {}: {e}", path.display())))?;
+        if entry.bytes > self.max_bytes {
+            return Err(refuse(
+                dir,
+                &key,
+                format!(
+                    "{} is listed with {} bytes, more than the memory cap of {} (--max-memory-gib): a damaged manifest, or raise the cap",
+                    entry.path,
+                    entry.bytes,
+                    crate::input::human_bytes(self.max_bytes)
+                ),
+            ));
+        }
+        // Read at most one byte more than listed: a longer file is damaged, never read
+        // whole.
+        let bytes =
+            crate::input::read_bytes(&path, &key, entry.bytes.saturating_add(1)).map_err(|e| {
+                match e {
+                    Error::Scene { message, .. } => {
+                        refuse(dir, &key, format!("{}: {message}", path.display()))
+                    }
+                    other => other,
+                }
+            })?;
         if bytes.len() as u64 != entry.bytes || sha256_hex(&bytes) != entry.sha256 {
             return Err(refuse(
                 dir,
@@ -647,15 +766,16 @@ impl ShardSet {
     }
 
     /// Every shard's one record file of run `run` of scene `scene`, in shard order (hence
-    /// in trajectory order), each with its manifest entry, checked for contiguous ranges,
-    /// size and SHA-256.
+    /// in trajectory order), each with its manifest entry and source, checked for
+    /// contiguous ranges, size and SHA-256, their total within the memory cap.
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the shard: a file not listed, unreadable, of
     /// another size or hash; ranges that do not follow one another; a `common` value
-    /// that differs from the first shard's.
-    pub fn read(&self, scene: &str, run: &str) -> Result<Vec<(ShardFile, Vec<u8>)>> {
-        let mut out: Vec<(ShardFile, Vec<u8>)> = Vec::new();
+    /// that differs from the first shard's; more bytes in all than the memory cap.
+    pub fn read(&self, scene: &str, run: &str) -> Result<Vec<ShardRecord>> {
+        let mut out: Vec<ShardRecord> = Vec::new();
+        let mut total: u64 = 0;
         for (k, (dir, m)) in self.shards.iter().enumerate() {
             let key = files_key(scene, run);
             let entry = m
@@ -672,8 +792,20 @@ impl ShardSet {
                         ),
                     )
                 })?;
+            total = total.saturating_add(entry.bytes);
+            if total > self.max_bytes {
+                return Err(refuse(
+                    dir,
+                    &key,
+                    format!(
+                        "the shards' records of run {run} of scene {scene} come to more than the memory cap of {} (--max-memory-gib) by shard {}: raise the cap, or check the manifests' sizes",
+                        crate::input::human_bytes(self.max_bytes),
+                        m.shard
+                    ),
+                ));
+            }
             let bytes = self.read_file(k, entry)?;
-            if let Some((prev, _)) = out.last() {
+            if let Some(ShardRecord { file: prev, .. }) = out.last() {
                 let next = prev.first.checked_add(prev.count);
                 if next != Some(entry.first) {
                     return Err(refuse(
@@ -688,7 +820,7 @@ impl ShardSet {
                         ),
                     ));
                 }
-                if entry.common != out[0].0.common {
+                if entry.common != out[0].file.common {
                     return Err(refuse(
                         dir,
                         &key,
@@ -699,10 +831,33 @@ impl ShardSet {
                     ));
                 }
             }
-            out.push((entry.clone(), bytes));
+            out.push(ShardRecord {
+                file: entry.clone(),
+                bytes,
+                source: format!("{} (shard {})", dir.join(&entry.path).display(), m.shard),
+            });
         }
         Ok(out)
     }
+}
+
+/// Checks that every scene text of manifest `m` (in `dir`) has the SHA-256 the manifest
+/// lists: a text edited by hand is refused, never merged and judged.
+fn check_scene_hashes(dir: &Path, m: &ShardManifest) -> Result<()> {
+    for (k, scene) in m.scenes.iter().enumerate() {
+        let hash = SceneProvenance::hash(&scene.text);
+        if hash != scene.sha256 {
+            return Err(refuse(
+                dir,
+                &format!("scenes[{k}].text"),
+                format!(
+                    "the text of scene {} has SHA-256 {hash}, but the manifest lists {}: edited after the shard ran; rerun the shards",
+                    scene.name, scene.sha256
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks that shard `m` (in `dir`) belongs to the set of `first` (in `first_dir`).
@@ -830,7 +985,7 @@ mod tests {
         )
         .unwrap();
         writer.finish().unwrap();
-        assert!(ShardSet::open(std::slice::from_ref(&dir)).is_ok());
+        assert!(ShardSet::open(std::slice::from_ref(&dir), 1 << 30).is_ok());
         let path = dir.join(SHARD_MANIFEST);
         let good: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
@@ -848,7 +1003,7 @@ mod tests {
         ];
         for (what, bytes, expect) in cases {
             std::fs::write(&path, bytes).unwrap();
-            let err = ShardSet::open(std::slice::from_ref(&dir)).unwrap_err();
+            let err = ShardSet::open(std::slice::from_ref(&dir), 1 << 30).unwrap_err();
             assert_eq!(err.exit_code(), 2, "{what}: {err}");
             let text = err.to_string();
             assert!(

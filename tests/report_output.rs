@@ -450,14 +450,14 @@ fn complete_run(dir: &Path, files: &[&str]) -> String {
     id
 }
 
-/// What: a rerun first invalidates the earlier report (journal replaced by an incomplete
-/// one naming the new run and the earlier files, then `summary.json` and `index.html`
-/// removed), and at its end removes the earlier run's files it did not write (a dropped
-/// scene, its then empty folder too), keeps every file it never wrote (a user's file, a
-/// `convergence/` folder), and lists exactly the files of the directory that are its own.
-/// Tolerance: exact (file sets).
+/// What: a rerun leaves the earlier report byte for byte as it was while it runs (its
+/// files wait in a staging directory, issue #25), and at its end swaps: the earlier
+/// run's files it did not write are removed (a dropped scene, its then empty folder
+/// too), every file it never wrote is kept (a user's file, a `convergence/` folder), and
+/// the journal lists exactly the files of the directory that are its own.
+/// Tolerance: exact (file sets and bytes).
 #[test]
-fn a_rerun_invalidates_the_old_report_first_and_removes_dropped_files() {
+fn a_rerun_leaves_the_old_report_until_it_finishes_and_removes_dropped_files() {
     let tmp = TempDir::new("report-run");
     let dir = tmp.path();
     let first = complete_run(dir, &["a/x.csv", "b/y.csv", "b/y.svg", "fig2.svg"]);
@@ -466,34 +466,21 @@ fn a_rerun_invalidates_the_old_report_first_and_removes_dropped_files() {
     fs::write(dir.join("convergence/index.html"), b"other command").unwrap();
     let j = journal(dir);
     assert!(j.complete && j.run_id == first && j.superseded.is_empty());
+    let before = tree_bytes(dir);
 
     let run = ReportRun::begin(dir, "verify", "manifest.json", &ENTRIES).expect("begin");
-    assert!(!dir.join("summary.json").exists() && !dir.join("index.html").exists());
-    let j = journal(dir);
-    assert!(!j.complete && j.run_id == run.run_id() && j.run_id != first);
-    assert!(j.files.is_empty());
-    assert_eq!(
-        j.superseded,
-        [
-            "a/x.csv",
-            "b/y.csv",
-            "b/y.svg",
-            "fig2.svg",
-            "index.html",
-            "summary.json"
-        ]
-    );
     run.write(&dir.join("a/x.csv"), b"new").expect("write");
     run.write(&dir.join("a/z.csv"), b"new").expect("write");
-    // Write-ahead: the new file is in the journal on disk before the run finishes.
-    assert_eq!(journal(dir).files, ["a/x.csv", "a/z.csv"]);
+    assert_eq!(tree_bytes(dir), before, "the earlier report is untouched");
     let id = run.run_id();
+    assert_ne!(id, first);
     let files = run.files();
     run.finish(&[("summary.json", b"s"), ("index.html", b"i")])
         .expect("finish");
 
     assert!(!dir.join("b").exists(), "dropped scene's folder removed");
     assert!(!dir.join("fig2.svg").exists());
+    assert_eq!(fs::read(dir.join("a/x.csv")).unwrap(), b"new");
     assert_eq!(
         all_files(dir),
         [
@@ -521,36 +508,50 @@ fn a_rerun_invalidates_the_old_report_first_and_removes_dropped_files() {
     );
 }
 
-/// What: a run killed after writing (journal incomplete, no entry point) leaves no file
-/// the journal does not name; the next run carries the files of both earlier runs and
-/// removes those it does not write. A journal entry pointing outside the directory is
-/// never followed, and a write outside the directory is refused.
-/// Tolerance: exact (file sets).
+/// Every file under `dir` with its bytes, but those of a run's staging directory (where
+/// its files wait, unseen, until it finishes).
+fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    all_files(dir)
+        .into_iter()
+        .filter(|f| !f.starts_with(".langevin-fem-staging."))
+        .map(|f| {
+            let bytes = fs::read(dir.join(&f)).unwrap();
+            (f, bytes)
+        })
+        .collect()
+}
+
+/// What: a run killed or failing before it finishes leaves the earlier report byte for
+/// byte (nothing but its staging directory was written, and that is dropped); a run
+/// killed during the swap at its end (an incomplete journal naming its files and the
+/// earlier ones) is cleaned up by the next, which removes the files it does not write.
+/// A journal entry pointing outside the directory is never followed, and a write outside
+/// the directory is refused.
+/// Tolerance: exact (file sets and bytes).
 #[test]
-fn an_interrupted_run_is_cleaned_up_by_the_next_and_nothing_outside_is_touched() {
+fn an_interrupted_run_leaves_the_earlier_report_and_nothing_outside_is_touched() {
     let tmp = TempDir::new("report-killed");
     let dir = tmp.path().join("out");
     complete_run(&dir, &["a/x.csv"]);
+    let before = tree_bytes(&dir);
     let killed = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
     killed
         .write(&dir.join("c/new.csv"), b"half a run")
         .expect("write");
-    drop(killed); // as if killed: no finish
-    let j = journal(&dir);
-    assert!(!j.complete);
-    assert!(!dir.join("summary.json").exists());
-    let named: Vec<&String> = j.files.iter().chain(&j.superseded).collect();
-    for f in all_files(&dir) {
-        assert!(
-            f == "manifest.json" || named.contains(&&f),
-            "{f} not attributable"
-        );
-    }
+    drop(killed); // as if it failed: no finish
+    assert_eq!(tree_bytes(&dir), before, "the earlier report is untouched");
+    assert_eq!(all_files(&dir).len(), before.len(), "no staging left");
 
-    // A tampered journal naming a file outside the directory.
+    // Killed during the swap: an incomplete journal naming a file of its own.
+    fs::create_dir_all(dir.join("c")).unwrap();
+    fs::write(dir.join("c/new.csv"), b"half a swap").unwrap();
+    let mut j = journal(&dir);
+    j.complete = false;
+    j.superseded = j.files.clone();
+    j.files = vec!["c/new.csv".to_string()];
+    // ... and tampered, naming a file outside the directory.
     let outside = tmp.path().join("outside.txt");
     fs::write(&outside, b"keep").unwrap();
-    let mut j = journal(&dir);
     j.superseded.push("../outside.txt".to_string());
     fs::write(
         dir.join("manifest.json"),

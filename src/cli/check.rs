@@ -61,6 +61,7 @@ pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
             "a directory holding data.json and the trajectory files it lists",
         ));
     }
+    langevin_fem::input::refuse_input_in_output(&args.out, &args.data, "--data")?;
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha)?;
     write_report(report, &summary)?;

@@ -86,6 +86,13 @@ pub struct ConvergeArgs {
     pub(super) sim: super::SimArgs,
 }
 
+impl ConvergeArgs {
+    /// Whether `--shard` was given (the output is then a shard, not a report).
+    pub(super) fn is_shard(&self) -> bool {
+        self.shard.is_some()
+    }
+}
+
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 enum OverArg {
     Elements,
@@ -138,8 +145,23 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
         limits: WorkLimits::default(),
         merge: Some(Arc::new(set)),
     };
-    settings.apply(&mut opts)?;
-    finish(&run_convergence(&opts)?, out)
+    settings.apply(&mut opts).map_err(|e| match e {
+        Error::InvalidParameter {
+            name,
+            value,
+            allowed,
+        } => set_of(&opts).refuse("settings", format!("{name} must be {allowed}, got {value}")),
+        other => other,
+    })?;
+    let summary = run_convergence(&opts).map_err(|e| set_of(&opts).settings_error(e))?;
+    finish(&summary, out)
+}
+
+/// The shard set a merge's options read.
+fn set_of(opts: &ConvergeOptions) -> &ShardSet {
+    opts.merge
+        .as_deref()
+        .expect("a merge's options hold its shard set")
 }
 
 /// Writes the index of `out`, prints the study; exit code 3 if every value failed.

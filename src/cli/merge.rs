@@ -26,10 +26,12 @@ Examples:
   langevin-fem converge -s compression-2d --over elements --shard 1/2 -o cv/1   (and 2/2)
   langevin-fem merge cv/1 cv/2 -o reports/convergence      the whole study and its index
   langevin-fem run -s hinged-linear-2d --shard 1/2 -o traj/1                     (and 2/2)
-  langevin-fem merge traj/1 traj/2 -o traj                 the whole run's trajectories
+  langevin-fem merge traj/1 traj/2 -o trajectories         the whole run's trajectories
 
 Refused (exit 2, naming the shard): a missing or duplicated shard, shards of other scenes,
-seeds, budgets, settings or builds, a damaged record file. The exit code is otherwise the
+seeds, budgets, settings or builds, a damaged record file; an output directory that is or
+holds a shard, or holds another command's output. A refused or failed merge leaves an
+earlier output in --out as it was. The exit code is otherwise the
 command's: for verify 0 if every check passed, 1 if one failed.";
 
 /// Command-line arguments of `langevin-fem merge`.
@@ -44,6 +46,10 @@ pub struct MergeArgs {
     /// figures; converge: the study's set and index; run: the trajectories and data.json).
     #[arg(short, long, default_value = "reports")]
     pub(super) out: PathBuf,
+    /// Cap on the record bytes held at once (one run's records from every shard, and so
+    /// any one record file), in GiB: a larger set is refused (exit 2) before it is read.
+    #[arg(long, value_name = "GIB", default_value = "4", allow_negative_numbers = true, value_parser = super::parse_max_memory_gib)]
+    max_memory_gib: f64,
 }
 
 /// Opens the shard set, checks it, and writes the whole command's output to `--out`.
@@ -53,7 +59,10 @@ pub struct MergeArgs {
 /// ([`ShardSet::open`]); as `verify` otherwise.
 pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
-    let set = ShardSet::open(&args.shards)?;
+    for dir in &args.shards {
+        langevin_fem::input::refuse_input_in_output(&args.out, dir, "merge DIR")?;
+    }
+    let set = ShardSet::open(&args.shards, gib_bytes(args.max_memory_gib))?;
     match set.manifest().command.as_str() {
         COMMAND => merge_verify(set, &args, verbosity, start),
         CONVERGE => super::converge::merge(set, &args.out, verbosity),
@@ -66,6 +75,11 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     }
 }
 
+/// `gib` GiB in bytes (saturating).
+fn gib_bytes(gib: f64) -> u64 {
+    (gib * (1u64 << 30) as f64).min(u64::MAX as f64) as u64
+}
+
 /// `merge` of a verification's shards.
 fn merge_verify(
     set: ShardSet,
@@ -74,6 +88,13 @@ fn merge_verify(
     start: Instant,
 ) -> Result<i32> {
     let (budget, alpha) = settings_of(&set)?;
+    if !(alpha.is_finite() && alpha > 0.0 && alpha < 0.5) {
+        return Err(set.settings_error(langevin_fem::Error::invalid(
+            "--alpha",
+            alpha,
+            "in (0, 0.5)",
+        )));
+    }
     let (scenes, seed_notes): (Vec<_>, Vec<_>) = set.scenes()?.into_iter().unzip();
     if verbosity.shows_progress() {
         eprintln!(
@@ -90,7 +111,10 @@ fn merge_verify(
         alpha,
         // Nothing is simulated: no progress bar over DOF-steps.
         progress: ProgressOptions::HIDDEN,
-        limits: WorkLimits::default(),
+        limits: WorkLimits {
+            max_memory_gib: args.max_memory_gib,
+            ..WorkLimits::default()
+        },
         ensembles: Ensembles::Merge(Arc::new(set)),
     })?;
     super::verify::finish(summary, report, seed_notes, &args.out, verbosity, start)

@@ -18,6 +18,7 @@ mod work_precision;
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
+use langevin_fem::output::manifest::{OutputKind, refuse_occupied};
 use langevin_fem::progress::ProgressOptions;
 use langevin_fem::scene::Scene;
 use langevin_fem::work::WorkLimits;
@@ -152,47 +153,47 @@ pub fn run() -> Result<i32> {
     match cli.command {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, shard_or(args.is_shard(), "verify", false))?;
             args.sim.start()?;
             verify::run(args, v)
         }
         Command::Calibrate(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, report("calibrate", false))?;
             args.start()?;
             calibrate::run(args, v)
         }
         Command::Converge(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, shard_or(args.is_shard(), "converge", true))?;
             args.sim.start()?;
             converge::run(args, v)
         }
         Command::Stability(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, report("stability", true))?;
             args.sim.start()?;
             stability::run(args, v)
         }
         Command::WorkPrecision(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, report("work-precision", true))?;
             args.sim.start()?;
             work_precision::run(args, v)
         }
         Command::Run(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, shard_or(args.is_shard(), "run", false))?;
             run::run(args, v)
         }
         Command::Merge(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, None)?;
             merge::run(args, v)
         }
         Command::Check(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, report("check", false))?;
             check::run(args, v)
         }
         Command::List(args) => list::run(args),
         Command::Scene(args) => scene::run(args),
         #[cfg(feature = "faults")]
         Command::Power(args) => {
-            check_out_dir(&args.out)?;
+            check_out_dir(&args.out, None)?;
             power::run(args, v)
         }
         Command::Completions { shell } => {
@@ -212,13 +213,30 @@ pub fn run() -> Result<i32> {
     }
 }
 
+/// A report run of `command` (in the studies' shared folder if `shared`).
+fn report(command: &str, shared: bool) -> Option<OutputKind<'_>> {
+    Some(OutputKind::Report { command, shared })
+}
+
+/// A shard of `command` if `shard`, else its report run ([`report`]).
+fn shard_or(shard: bool, command: &str, shared: bool) -> Option<OutputKind<'_>> {
+    if shard {
+        Some(OutputKind::Shard { command })
+    } else {
+        report(command, shared)
+    }
+}
+
 /// `--out` must be, or be creatable as, a writable directory: checked before anything
 /// runs, so an unwritable location fails at once (exit 2, naming `--out`) instead of after
 /// the whole simulation. Nothing is created here: the nearest existing ancestor (or `out`
-/// itself) must be a directory that accepts a file (probed and removed at once). The
-/// temporary files that interrupted runs left in an existing `out` are removed
+/// itself) must be a directory that accepts a file (probed and removed at once). An
+/// existing `out` must hold no other command's output or data that the command (`kind`,
+/// if known before the inputs are read) would replace or remove
+/// ([`langevin_fem::output::manifest::refuse_occupied`]). The temporary files and staging
+/// directories that interrupted runs left in an existing `out` are removed
 /// ([`langevin_fem::output::remove_stale_temporaries`]).
-fn check_out_dir(out: &Path) -> Result<()> {
+fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<()> {
     let fail = |why: String| {
         Error::invalid(
             "--out",
@@ -237,6 +255,9 @@ fn check_out_dir(out: &Path) -> Result<()> {
     };
     if !existing.is_dir() {
         return Err(fail(format!("{} is not a directory", existing.display())));
+    }
+    if let Some(kind) = kind {
+        refuse_occupied(out, kind)?;
     }
     let probe = existing.join(format!(".langevin-fem-write-test.{}", std::process::id()));
     std::fs::write(&probe, b"")

@@ -92,6 +92,13 @@ pub struct RunArgs {
     limits: super::LimitArgs,
 }
 
+impl RunArgs {
+    /// Whether `--shard` was given (the output is then a shard, not a report).
+    pub(super) fn is_shard(&self) -> bool {
+        self.shard.is_some()
+    }
+}
+
 /// The file format of the trajectories.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -149,12 +156,13 @@ enum Sink {
 }
 
 impl Sink {
-    /// Lists the file `rel` (relative to the output directory `out`) in the journal of a
-    /// whole run before it is written.
-    fn record(&self, out: &Path, rel: &str) -> Result<()> {
+    /// Where to write the file `rel` (relative to the output directory `out`) while the
+    /// job goes on: in the staging directory of the whole run (listed in its journal) or
+    /// of the shard, moved into place when the job finishes.
+    fn record(&self, out: &Path, rel: &str) -> Result<PathBuf> {
         match self {
-            Sink::Whole(_, report) => report.record(&out.join(rel)).map(|_| ()),
-            Sink::Shard(_) => Ok(()),
+            Sink::Whole(_, report) => report.staged(&out.join(rel)),
+            Sink::Shard(writer) => writer.staged(rel),
         }
     }
 
@@ -469,15 +477,16 @@ fn write_linear_run(
     let files: Vec<String> = (0..count)
         .map(|j| linear_file(&spec.name, j, job.ext()))
         .collect();
-    for j in range.clone() {
-        sink.record(out, &files[j as usize])?;
-    }
+    let paths = range
+        .clone()
+        .map(|j| sink.record(out, &files[j as usize]))
+        .collect::<Result<Vec<_>>>()?;
     let seed = derive_seed(scene.seed, &spec.name);
     run.write_ensemble(
         seed,
         range.clone(),
         plan,
-        |j| out.join(&files[j as usize]),
+        |j| paths[(j - range.start) as usize].clone(),
         |n| bar.advance(n as f64 * per_trajectory),
     )
     .map_err(|e| scene.run_error(k, "dt_tau1", e))?;
@@ -688,8 +697,7 @@ fn write_compression_run(
         let (dts, burn_in) = (run.sample_dt_at(i), run.burn_in_at(i));
         for (j, rec) in (range.start..).zip(at_strain) {
             let rel = compression_file(&spec.name, i, j, job.ext());
-            let path = job.out.join(&rel);
-            sink.record(&job.out, &rel)?;
+            let path = sink.record(&job.out, &rel)?;
             let mut file = TrajectoryFile::create(&path, &columns, rec.force_ratio.len() as u64)?;
             for (r, fr) in rec.force_ratio.iter().enumerate() {
                 let force = fr * run.euler_load;

@@ -67,6 +67,13 @@ pub struct VerifyArgs {
     pub(super) sim: super::SimArgs,
 }
 
+impl VerifyArgs {
+    /// Whether `--shard` was given (the output is then a shard, not a report).
+    pub(super) fn is_shard(&self) -> bool {
+        self.shard.is_some()
+    }
+}
+
 /// A statistics budget on the command line.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub(super) enum BudgetArg {
@@ -93,6 +100,9 @@ pub fn run(args: VerifyArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
+    }
+    if let Some(dir) = &args.plan_from {
+        langevin_fem::input::refuse_input_in_output(&args.out, dir, "--plan-from")?;
     }
     let budget = args.budget.budget();
     let mut scenes = load_scenes(&args.scenes, args.scene_dir.as_deref())?;

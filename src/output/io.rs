@@ -126,7 +126,8 @@ impl Drop for AtomicFile {
 
 /// Removes the temporary files that interrupted runs left in `dir` and its
 /// subdirectories (two levels down): files named like those of [`write_atomic`],
-/// `.<name>.tmp.<pid>.<n>`, whose process is gone (on Linux: no `/proc/<pid>`; elsewhere:
+/// `.<name>.tmp.<pid>.<n>`, and staging directories ([`super::staging`],
+/// `.langevin-fem-staging.<pid>.<n>`, each counted as one), whose process is gone (on Linux: no `/proc/<pid>`; elsewhere:
 /// older than a day). Files of this process and of running processes are kept. Returns
 /// the number removed; errors are ignored (best effort, like the files themselves).
 pub fn remove_stale_temporaries(dir: &Path) -> usize {
@@ -139,7 +140,12 @@ pub fn remove_stale_temporaries(dir: &Path) -> usize {
             let Ok(kind) = entry.file_type() else {
                 continue;
             };
-            if kind.is_dir() && depth > 0 {
+            let name = entry.file_name();
+            if kind.is_dir() && super::staging::is_stale_staging(&name.to_string_lossy()) {
+                if fs::remove_dir_all(&path).is_ok() {
+                    *removed += 1;
+                }
+            } else if kind.is_dir() && depth > 0 {
                 walk(&path, depth - 1, removed);
             } else if kind.is_file() && is_stale_temporary(&path) && fs::remove_file(&path).is_ok()
             {

@@ -6,26 +6,33 @@
 //! A report directory has a *journal* (`manifest.json` for `verify`), a JSON
 //! [`Manifest`]: the run id, whether the run completed, the files it wrote and the files
 //! of earlier runs not yet removed. Its *entry points* (`summary.json`, `index.html`) are
-//! what a reader opens first. [`ReportRun`] keeps them consistent:
+//! what a reader opens first. [`ReportRun`] keeps them consistent, and an earlier report
+//! untouched until the new run has succeeded (issue #25):
 //!
-//! 1. [`ReportRun::begin`] removes the entry points, then replaces the journal,
-//!    atomically, by one naming the new run as incomplete and carrying every file the
-//!    earlier journal listed (`superseded`). An entry point on disk therefore always
-//!    carries the run id of the journal beside it, no entry point describes a file of
-//!    this run before it is complete, and no file of an earlier run is forgotten.
-//! 2. [`ReportRun::write`] (and the CSV, JSON and SVG forms) lists a file in the journal
-//!    *before* writing it (write-ahead), so a run killed at any moment leaves no file the
-//!    journal does not name; every file is written atomically ([`write_atomic`]).
-//! 3. [`ReportRun::finish`] removes the superseded files this run did not write (dropped
-//!    scenes): only files named in our own journal, only below the directory, never
-//!    directories that are not empty. Then it completes the journal and writes the entry
-//!    points last, each atomically.
+//! 1. [`ReportRun::begin`] refuses a directory that holds another command's output or
+//!    data ([`refuse_occupied`]: nothing the user gave is ever replaced or removed),
+//!    reads the earlier journal and opens a staging directory ([`super::staging`]).
+//!    Nothing in the directory changes while the run goes on.
+//! 2. [`ReportRun::write`] (and the CSV, JSON and SVG forms, and [`ReportRun::staged`]
+//!    for files streamed by the caller) lists a file and writes it, atomically
+//!    ([`write_atomic`]), into the staging directory. A run that is refused or fails at
+//!    any point before it finishes is dropped with its staging directory: the earlier
+//!    report is exactly as it was.
+//! 3. [`ReportRun::finish`] swaps: it removes the earlier entry points, replaces the
+//!    journal by one naming the new run as incomplete with its files and every file the
+//!    earlier journal listed (`superseded`), moves the staged files into place, removes
+//!    the superseded files this run did not write (dropped scenes: only files named in
+//!    our own journal, only below the directory, never directories that are not empty),
+//!    completes the journal and writes the entry points last, each atomically. An entry
+//!    point on disk therefore always carries the run id of the journal beside it, and a
+//!    run killed during the swap leaves an incomplete journal naming every file, which the
+//!    next run removes or replaces.
 //!
 //! A directory shared by runs of several kinds (the studies' `reports/convergence/`) has
 //! one journal per output set (e.g. `<stem>.manifest.json`). A run's entry points are
-//! then its own summary and the directory's shared index: [`ReportRun::begin`] removes
-//! both, [`ReportRun::complete`] writes the summary *before* marking the journal complete
-//! (a complete journal always has its summary), and the caller rebuilds the index from
+//! then its own summary and the directory's shared index: the swap removes both,
+//! [`ReportRun::complete`] writes the summary *before* marking the journal complete (a
+//! complete journal always has its summary), and the caller rebuilds the index from
 //! every complete journal afterwards. Runs sharing a directory write disjoint file names
 //! (the shared index apart): a rerun removes the files its own earlier journal named, and
 //! never reads another journal.
@@ -37,8 +44,8 @@
 //! columns with their units and meanings ([`Manifest::columns`], from the column
 //! dictionary [`super::columns`]).
 //!
-//! The temporary files of killed writers are removed by the next run
-//! ([`super::remove_stale_temporaries`]). Files the journal never named (e.g. the
+//! The temporary files and staging directories of killed writers are removed by the next
+//! run ([`super::remove_stale_temporaries`]). Files the journal never named (e.g. the
 //! `convergence/` folder of other commands) are left alone.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -54,6 +61,7 @@ use super::columns::{TableSchema, table_schema};
 use super::figure::Figure;
 use super::io::{csv_text, json_text, write_atomic};
 use super::provenance::{Provenance, ProvenanceRef};
+use super::staging::Staging;
 use crate::error::{Error, Result};
 
 /// The journal of a report run (see the [module docs](self)).
@@ -145,28 +153,36 @@ pub struct ReportRun {
     journal: String,
     /// File names of the entry points in `dir`, in the order [`Self::finish`] writes them.
     entry_points: Vec<String>,
-    /// The journal as it is on disk, apart from files already recorded there under
-    /// `superseded` and rewritten since.
+    /// The journal of this run as [`Self::finish`] will write it: the files written so
+    /// far (in staging) and the earlier run's files (`superseded`).
     state: Mutex<Manifest>,
+    /// Where the files wait until the run finishes.
+    staging: Staging,
 }
 
 impl ReportRun {
     /// Starts run `command` in `dir` (created if missing), with its journal `journal` and
-    /// entry points `entry_points` (file names in `dir`): reads the earlier journal, if
-    /// any, removes the entry points and then writes the new journal (incomplete, the
-    /// earlier files as `superseded`). An unreadable earlier journal is treated as absent
-    /// (its files are then never removed: they cannot be attributed).
+    /// entry points `entry_points` (file names in `dir`): checks that `dir` holds no
+    /// other command's output ([`refuse_occupied`]), reads the earlier journal, if any,
+    /// and opens the staging directory where the run's files wait
+    /// ([`super::staging`]). Nothing of the earlier report is touched before
+    /// [`Self::finish`] (or [`Self::complete`]).
     ///
     /// # Errors
-    /// [`Error::Io`] naming the directory, the journal or an entry point that cannot be
-    /// created, written or removed.
+    /// [`Error::InvalidParameter`] naming `--out` if `dir` holds another command's output
+    /// or data; [`Error::Io`] naming the directory that cannot be created.
     pub fn begin(dir: &Path, command: &str, journal: &str, entry_points: &[&str]) -> Result<Self> {
-        fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let kind = OutputKind::Report {
+            command,
+            shared: journal != MANIFEST_FILE,
+        };
+        refuse_occupied(dir, kind)?;
         let earlier = read_manifest(&dir.join(journal));
         let superseded: BTreeSet<String> = earlier
             .map(|m| m.files.into_iter().chain(m.superseded).collect())
             .unwrap_or_default();
-        let run = ReportRun {
+        let staging = Staging::new(dir)?;
+        Ok(ReportRun {
             dir: dir.to_path_buf(),
             journal: journal.to_string(),
             entry_points: entry_points.iter().map(|s| (*s).to_string()).collect(),
@@ -182,18 +198,8 @@ impl ReportRun {
                 provenance: None,
                 columns: BTreeMap::new(),
             }),
-        };
-        // Entry points first: an entry point on disk always names the run of the journal
-        // beside it (killed in between, the earlier journal stays, without its entry
-        // points: nothing describes a file wrongly).
-        for name in &run.entry_points {
-            let path = dir.join(name);
-            if fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
-                fs::remove_file(&path).map_err(|e| Error::io(&path, e))?;
-            }
-        }
-        run.persist(&run.lock())?;
-        Ok(run)
+            staging,
+        })
     }
 
     /// The run id.
@@ -201,15 +207,15 @@ impl ReportRun {
         self.lock().run_id.clone()
     }
 
-    /// Records what produced the run in its journal (written at once; the wall time is
-    /// added when the run finishes).
+    /// Records what produced the run, for its journal (the wall time is added when the
+    /// run finishes).
     ///
     /// # Errors
-    /// [`Error::Io`] naming the journal if it cannot be written.
+    /// None at present (the journal is written when the run finishes); kept fallible for
+    /// callers that persist it.
     pub fn set_provenance(&self, provenance: Provenance) -> Result<()> {
-        let mut state = self.lock();
-        state.provenance = Some(provenance);
-        self.persist(&state)
+        self.lock().provenance = Some(provenance);
+        Ok(())
     }
 
     /// The reference to the run's provenance for an entry point (the journal's file name
@@ -241,12 +247,11 @@ impl ReportRun {
         all.into_iter().collect()
     }
 
-    /// Writes `bytes` to `path` (below the directory) atomically, after listing it in the
-    /// journal.
+    /// Writes `bytes` as the file `path` (below the directory) of this run: atomically,
+    /// into the staging directory, moved into place when the run finishes.
     ///
     /// # Errors
-    /// [`Error::Io`] naming `path` if it is not below the directory or cannot be written,
-    /// or naming the journal if that cannot be updated.
+    /// [`Error::Io`] naming `path` if it is not below the directory or cannot be written.
     /// A CSV file's columns are recorded in the journal with their units
     /// ([`Manifest::columns`]).
     pub fn write(&self, path: &Path, bytes: &[u8]) -> Result<()> {
@@ -258,9 +263,9 @@ impl ReportRun {
             let text = String::from_utf8_lossy(bytes);
             let header = text.lines().next().unwrap_or("");
             let schema = table_schema(&rel, header);
-            self.lock().columns.insert(rel, schema);
+            self.lock().columns.insert(rel.clone(), schema);
         }
-        write_atomic(path, bytes)
+        write_atomic(&self.staging.path(&rel), bytes)
     }
 
     /// [`crate::output::write_csv`] through [`Self::write`].
@@ -290,23 +295,25 @@ impl ReportRun {
         self.write(path, svg.as_bytes())
     }
 
-    /// Finishes the run: removes the superseded files it did not write, completes the
-    /// journal, then writes `entries` — (entry point, content), in order — atomically.
-    /// Every entry point given to [`Self::begin`] should be among `entries`.
+    /// Finishes the run: publishes its files, removes the superseded files it did not
+    /// write, completes the journal, then writes `entries` — (entry point, content), in
+    /// order — atomically. Every entry point given to [`Self::begin`] should be among
+    /// `entries`.
     ///
     /// # Errors
-    /// [`Error::Io`] naming a file that cannot be removed or written; an entry that is not
-    /// an entry point of the run ([`Error::Io`], nothing written).
+    /// [`Error::Io`] naming a file that cannot be moved, removed or written; an entry that
+    /// is not an entry point of the run ([`Error::Io`], nothing written).
     pub fn finish(self, entries: &[(&str, &[u8])]) -> Result<()> {
         self.close(&[], entries)
     }
 
     /// Completes the run in a directory shared with other runs, each with its own
-    /// journal: removes the superseded files it did not write, writes `entries` — its own
-    /// entry points, in order, atomically — and then marks the journal complete. So a
-    /// complete journal always has its entries on disk. The entry points that describe
-    /// the whole directory (an index of every complete journal there) are not among
-    /// `entries`: the caller rebuilds them from the journals once this returns.
+    /// journal: publishes its files, removes the superseded files it did not write,
+    /// writes `entries` — its own entry points, in order, atomically — and then marks the
+    /// journal complete. So a complete journal always has its entries on disk. The entry
+    /// points that describe the whole directory (an index of every complete journal
+    /// there) are not among `entries`: the caller rebuilds them from the journals once
+    /// this returns.
     ///
     /// # Errors
     /// As [`Self::finish`].
@@ -314,9 +321,11 @@ impl ReportRun {
         self.close(entries, &[])
     }
 
-    /// Removes the superseded files this run did not write, writes `before`, marks the
-    /// journal complete and writes `after` (entry points, each atomically).
-    fn close(self, before: &[(&str, &[u8])], after: &[(&str, &[u8])]) -> Result<()> {
+    /// The swap at the end of a run: removes the earlier entry points, writes the journal
+    /// (incomplete, naming this run's files and the earlier ones), moves the staged files
+    /// into place, removes the superseded files this run did not write, writes `before`,
+    /// marks the journal complete and writes `after` (entry points, each atomically).
+    fn close(mut self, before: &[(&str, &[u8])], after: &[(&str, &[u8])]) -> Result<()> {
         if let Some((name, _)) = before
             .iter()
             .chain(after)
@@ -331,16 +340,30 @@ impl ReportRun {
                 ),
             ));
         }
+        // Entry points first: an entry point on disk always names the run of the journal
+        // beside it (killed in between, the earlier journal stays, without its entry
+        // points: nothing describes a file wrongly).
+        for name in &self.entry_points {
+            let path = self.dir.join(name);
+            if fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
+                fs::remove_file(&path).map_err(|e| Error::io(&path, e))?;
+            }
+        }
         let files = self.files();
-        let stale: Vec<String> = {
-            let state = self.lock();
-            state
+        let (written, stale) = {
+            let mut state = self.lock();
+            let written = state.files.clone();
+            state.files = files.clone();
+            let stale: Vec<String> = state
                 .superseded
                 .iter()
                 .filter(|f| files.binary_search(f).is_err())
                 .cloned()
-                .collect()
+                .collect();
+            self.persist(&state)?;
+            (written, stale)
         };
+        self.staging.publish(written.iter().map(String::as_str))?;
         for rel in &stale {
             self.remove_superseded(rel)?;
         }
@@ -351,7 +374,6 @@ impl ReportRun {
             let mut state = self.lock();
             state.complete = true;
             state.columns.retain(|f, _| files.binary_search(f).is_ok());
-            state.files = files;
             state.superseded.clear();
             if let Some(p) = &mut state.provenance {
                 p.finish();
@@ -364,14 +386,11 @@ impl ReportRun {
         Ok(())
     }
 
-    /// Lists `path` (below the directory) in the journal, on disk first if the journal
-    /// does not yet name it, and returns its path relative to the directory: called
-    /// before a file the caller streams itself (e.g. with [`crate::output::AtomicFile`])
-    /// is created.
+    /// Lists `path` (below the directory) among the run's files and returns its path
+    /// relative to the directory.
     ///
     /// # Errors
-    /// [`Error::Io`] naming `path` if it is not below the directory, or the journal if
-    /// that cannot be updated.
+    /// [`Error::Io`] naming `path` if it is not below the directory.
     pub fn record(&self, path: &Path) -> Result<String> {
         let rel = path
             .strip_prefix(&self.dir)
@@ -393,13 +412,20 @@ impl ReportRun {
             })?;
         let mut state = self.lock();
         if let Err(i) = state.files.binary_search(&rel) {
-            let on_disk = state.superseded.binary_search(&rel).is_ok();
             state.files.insert(i, rel.clone());
-            if !on_disk {
-                self.persist(&state)?;
-            }
         }
         Ok(rel)
+    }
+
+    /// Lists `path` (below the directory) among the run's files ([`Self::record`]) and
+    /// returns where to write it while the run goes on (in the staging directory): for a
+    /// file the caller streams itself (e.g. with [`crate::output::AtomicFile`]).
+    ///
+    /// # Errors
+    /// As [`Self::record`].
+    pub fn staged(&self, path: &Path) -> Result<PathBuf> {
+        let rel = self.record(path)?;
+        Ok(self.staging.path(&rel))
     }
 
     /// Removes the superseded file `rel` (a regular file, if present) and then its parent
@@ -437,6 +463,140 @@ impl ReportRun {
             .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
+
+/// The journal of a directory that one command owns (`verify`, `check`, `run`,
+/// `calibrate`); the studies' shared folder has one journal per output set,
+/// `<stem>.manifest.json`.
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// The manifest of a shard's directory (as [`crate::shard::SHARD_MANIFEST`]).
+pub const SHARD_FILE: &str = "shard.json";
+/// The sidecar of a trajectory data directory (as [`crate::data::SIDECAR`]).
+pub const DATA_FILE: &str = "data.json";
+/// The entry points a directory of one command may hold only beside its journal.
+const ENTRY_FILES: [&str; 2] = ["summary.json", "index.html"];
+
+/// What a command is about to write into an output directory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputKind<'a> {
+    /// A report run of `command`: the directory's own (`shared: false`, journal
+    /// `manifest.json`), or one output set of the studies' shared folder (`shared: true`,
+    /// journal `<stem>.manifest.json`).
+    Report {
+        /// The command.
+        command: &'a str,
+        /// Whether the directory is the studies' shared folder.
+        shared: bool,
+    },
+    /// A shard of `command` (`shard.json` and its files).
+    Shard {
+        /// The command.
+        command: &'a str,
+    },
+}
+
+/// Refuses to write `kind` into `dir` if `dir` holds another command's output or data
+/// that the write would replace or remove (issue #25: nothing the user gave is ever
+/// deleted or overwritten). Only the top level of `dir` is read: its journals, a shard
+/// manifest, a trajectory sidecar and entry points without a journal. Allowed: an empty
+/// or missing directory, the same command's earlier output (which the run replaces, as
+/// its journal says), another study's output set in the studies' shared folder, and any
+/// sub-directory (never touched unless a journal of the same command names its files).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--out`, the directory, what it holds (the file
+/// and the command that wrote it) and what to do.
+pub fn refuse_occupied(dir: &Path, kind: OutputKind<'_>) -> Result<()> {
+    let (me, what) = match kind {
+        OutputKind::Report { command, .. } => (command, "the output"),
+        OutputKind::Shard { command } => (command, "a shard"),
+    };
+    let Some(held) = occupant(dir, kind) else {
+        return Ok(());
+    };
+    Err(Error::invalid(
+        "--out",
+        dir.display(),
+        format!(
+            "a directory for {what} of `{me}` alone, but it holds {held}, which `{me}` would replace or remove; choose another output directory (or remove that one yourself if it is no longer needed)"
+        ),
+    ))
+}
+
+/// What of another command (or of nobody's) `dir` holds that `kind` must not touch, in
+/// words naming the file; `None` if `kind` may write there.
+fn occupant(dir: &Path, kind: OutputKind<'_>) -> Option<String> {
+    let names: Vec<String> = fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    let has = |n: &str| names.iter().any(|x| x == n);
+    let studies: Vec<&String> = names
+        .iter()
+        .filter(|n| n.len() > JOURNAL_SUFFIX.len() && n.ends_with(JOURNAL_SUFFIX))
+        .collect();
+    let command_of = |file: &str| -> Option<String> {
+        let bytes = fs::read(dir.join(file)).ok()?;
+        let v: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
+        v.get("command")?.as_str().map(str::to_string)
+    };
+    let journal = has(MANIFEST_FILE).then(|| command_of(MANIFEST_FILE));
+    let describe = |file: &str, command: Option<String>| match command {
+        Some(c) if c == "run" => format!("trajectory data written by `run` ({file})"),
+        Some(c) => format!("the output of `{c}` ({file})"),
+        None => format!("{file}, which no langevin-fem run wrote"),
+    };
+    if has(SHARD_FILE) {
+        let c = command_of(SHARD_FILE);
+        return match (kind, &c) {
+            (OutputKind::Shard { command }, Some(c)) if c == command => None,
+            _ => Some(match c {
+                Some(c) => format!("a shard of `{c}` ({SHARD_FILE})"),
+                None => format!("{SHARD_FILE}, which no langevin-fem shard wrote"),
+            }),
+        };
+    }
+    match kind {
+        OutputKind::Shard { .. } => {
+            if let Some(c) = journal {
+                return Some(describe(MANIFEST_FILE, c));
+            }
+            if let Some(s) = studies.first() {
+                return Some(format!("the convergence studies' reports ({s})"));
+            }
+            has(DATA_FILE).then(|| format!("trajectory data ({DATA_FILE})"))
+        }
+        OutputKind::Report { command, shared } => {
+            if shared {
+                if let Some(c) = journal {
+                    return Some(describe(MANIFEST_FILE, c));
+                }
+                if has(DATA_FILE) {
+                    return Some(format!("trajectory data ({DATA_FILE})"));
+                }
+                return (studies.is_empty() && has("index.html"))
+                    .then(|| "index.html, which no langevin-fem study wrote".to_string());
+            }
+            if let Some(s) = studies.first() {
+                return Some(format!("the convergence studies' reports ({s})"));
+            }
+            match journal {
+                Some(Some(c)) if c == command => None,
+                Some(c) => Some(describe(MANIFEST_FILE, c)),
+                None if has(DATA_FILE) => Some(format!(
+                    "trajectory data ({DATA_FILE}) that no langevin-fem run described"
+                )),
+                None => ENTRY_FILES
+                    .iter()
+                    .find(|f| has(f))
+                    .map(|f| format!("{f}, which no langevin-fem report run wrote")),
+            }
+        }
+    }
+}
+
+/// How a study journal's file name ends (as [`crate::studies::output::JOURNAL_SUFFIX`]).
+const JOURNAL_SUFFIX: &str = ".manifest.json";
 
 #[cfg(test)]
 mod tests {
@@ -491,12 +651,21 @@ mod tests {
         assert!(dir.join("s.json").exists() && !dir.join("index.html").exists());
         fs::write(dir.join("index.html"), b"index").unwrap(); // the caller's index
 
+        let before = snapshot(&dir);
         let rerun = ReportRun::begin(&dir, "s", "s.manifest.json", &entries).expect("begin");
-        assert!(!dir.join("s.json").exists() && !dir.join("index.html").exists());
         rerun.write(&dir.join("a.csv"), b"a2").expect("write");
+        assert_eq!(
+            snapshot(&dir),
+            before,
+            "nothing changes while a run goes on"
+        );
         let bad = rerun.complete(&[("a.csv", b"x")]);
         assert!(bad.is_err(), "only entry points are entries");
-        assert_eq!(fs::read(dir.join("a.csv")).unwrap(), b"a2");
+        assert_eq!(
+            snapshot(&dir),
+            before,
+            "a failed run leaves the earlier report"
+        );
 
         let rerun = ReportRun::begin(&dir, "s", "s.manifest.json", &entries).expect("begin");
         rerun.write(&dir.join("a.csv"), b"a3").expect("write");
@@ -506,6 +675,95 @@ mod tests {
             assert!(dir.join(kept).exists(), "{kept}");
         }
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Every file under `dir` (relative path, bytes), sorted.
+    fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+        fn walk(root: &Path, d: &Path, out: &mut Vec<(String, Vec<u8>)>) {
+            for e in fs::read_dir(d).unwrap().flatten() {
+                let p = e.path();
+                let staging = e
+                    .file_name()
+                    .to_string_lossy()
+                    .starts_with(".langevin-fem-staging.");
+                if staging {
+                    continue;
+                } else if p.is_dir() {
+                    walk(root, &p, out);
+                } else {
+                    let rel = p.strip_prefix(root).unwrap().display().to_string();
+                    out.push((rel, fs::read(&p).unwrap()));
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(dir, dir, &mut out);
+        out.sort();
+        out
+    }
+
+    /// A report run refuses a directory holding another command's output or data, or
+    /// entry points no journal describes; it accepts its own earlier output, an empty
+    /// directory and, in the studies' folder, the other studies' output sets. A refused
+    /// or dropped run leaves the directory byte for byte as it was.
+    #[test]
+    fn occupied_directories_are_refused_and_left_as_they_were() {
+        let root = std::env::temp_dir().join(format!("lfem-occupied-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&root);
+        let data = root.join("data");
+        let run = ReportRun::begin(&data, "run", MANIFEST_FILE, &[DATA_FILE]).expect("begin");
+        run.write(&data.join("r/t.npy"), b"npy").expect("write");
+        run.finish(&[(DATA_FILE, b"{}")]).expect("finish");
+        let before = snapshot(&data);
+        for command in ["check", "verify"] {
+            let e = ReportRun::begin(&data, command, MANIFEST_FILE, &ENTRY_FILES).unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            let text = e.to_string();
+            assert!(text.contains("--out") && text.contains("`run`"), "{text}");
+        }
+        let shared = OutputKind::Report {
+            command: "converge",
+            shared: true,
+        };
+        assert!(refuse_occupied(&data, shared).is_err());
+        let shard = OutputKind::Shard { command: "run" };
+        assert!(refuse_occupied(&data, shard).is_err());
+        assert_eq!(snapshot(&data), before);
+        // The same command replaces its own output; a dropped run changes nothing.
+        let again = ReportRun::begin(&data, "run", MANIFEST_FILE, &[DATA_FILE]).expect("begin");
+        again.write(&data.join("r/t.npy"), b"other").expect("write");
+        drop(again);
+        assert_eq!(snapshot(&data), before);
+        // Foreign data and stray entry points.
+        let foreign = root.join("foreign");
+        fs::create_dir_all(&foreign).unwrap();
+        fs::write(foreign.join(DATA_FILE), b"{}").unwrap();
+        assert!(ReportRun::begin(&foreign, "run", MANIFEST_FILE, &[DATA_FILE]).is_err());
+        fs::remove_file(foreign.join(DATA_FILE)).unwrap();
+        fs::write(foreign.join("index.html"), b"mine").unwrap();
+        let e = ReportRun::begin(&foreign, "verify", MANIFEST_FILE, &ENTRY_FILES).unwrap_err();
+        assert!(e.to_string().contains("index.html"), "{e}");
+        fs::write(foreign.join(MANIFEST_FILE), b"not json").unwrap();
+        let e = ReportRun::begin(&foreign, "verify", MANIFEST_FILE, &ENTRY_FILES).unwrap_err();
+        assert!(e.to_string().contains("no langevin-fem run wrote"), "{e}");
+        assert_eq!(fs::read(foreign.join("index.html")).unwrap(), b"mine");
+        // An empty directory, and a study beside another study.
+        let studies = root.join("studies");
+        let a = ReportRun::begin(
+            &studies,
+            "stability",
+            "a.manifest.json",
+            &["a.json", "index.html"],
+        )
+        .expect("begin");
+        a.complete(&[("a.json", b"{}")]).expect("complete");
+        refuse_occupied(&studies, shared).expect("another study's folder");
+        let kind = OutputKind::Report {
+            command: "verify",
+            shared: false,
+        };
+        assert!(refuse_occupied(&studies, kind).is_err());
+        fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]

@@ -12,6 +12,9 @@
 //!   rerun writes fewer files (old entry points removed first, dropped files removed,
 //!   entry points written last); several journals may share one directory, one per
 //!   output set (the studies' convergence folder).
+//! - [`staging`]: [`Staging`], where a run's files wait, hidden inside the output
+//!   directory, until the run has succeeded; a refusal or failure drops them and leaves
+//!   the directory as it was.
 //! - [`provenance`]: [`Provenance`], what produced an output (version and commit baked
 //!   in at build time, command line, start and wall time, threads, every scene as run
 //!   with its hash, seed and parameters with units), carried by every journal and
@@ -28,8 +31,10 @@ pub mod figure;
 pub mod io;
 pub mod manifest;
 pub mod provenance;
+pub mod staging;
 
 pub use figure::{AxisUnits, Figure, Series, SeriesColor, SeriesStyle};
 pub use io::{AtomicFile, remove_stale_temporaries, write_atomic, write_csv, write_json};
 pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};
 pub use provenance::{DescribeScene, Provenance, ProvenanceRef, SceneProvenance};
+pub use staging::Staging;

@@ -604,6 +604,42 @@ impl CompressionRun {
         self.models.len()
     }
 
+    /// What is wrong with the shapes of `records` (per strain, per trajectory) read from
+    /// elsewhere (a shard), against what this run gives its records: one list per strain,
+    /// the nodal slope sums of its mesh, no more acceptances than proposals, and the same
+    /// number of samples in every trajectory of a strain; `None` if they are this run's
+    /// shapes.
+    pub fn records_shape_error(&self, records: &[Vec<ForceRecord>]) -> Option<String> {
+        if records.len() != self.points() {
+            return Some(format!(
+                "records of {} strains, run {} has {}",
+                records.len(),
+                self.spec.name,
+                self.points()
+            ));
+        }
+        let nodes = self.models.first().map_or(0, |m| m.beam().mesh().n_nodes());
+        for (i, at) in records.iter().enumerate() {
+            let samples = at.first().map(|r| r.force_ratio.len());
+            for (j, r) in at.iter().enumerate() {
+                if r.slope_squares.len() != nodes
+                    || r.accepted > r.proposed
+                    || Some(r.force_ratio.len()) != samples
+                {
+                    return Some(format!(
+                        "trajectory {j} at strain {i}: {} samples (trajectory 0: {}), {} nodal slope sums (the mesh has {nodes} nodes), {} of {} proposals accepted",
+                        r.force_ratio.len(),
+                        samples.unwrap_or(0),
+                        r.slope_squares.len(),
+                        r.accepted,
+                        r.proposed
+                    ));
+                }
+            }
+        }
+        None
+    }
+
     /// The largest root-mean-square nodal slope |w'| (all components) of the records of
     /// one strain: `(rms slope, node x/L)`; `None` without samples. The small-slope
     /// (von Kármán) model is flagged above

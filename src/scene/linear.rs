@@ -809,6 +809,60 @@ impl LinearRun {
         }
     }
 
+    /// What is wrong with the shapes of `records` and `extra` (the two-time products of
+    /// the extra trajectories) read from elsewhere (a shard), against what this run gives
+    /// its records: the numbers of mode, profile and two-time series, the nodal slope
+    /// sums, at most [`MAX_SAMPLES`] samples a series, and the same series lengths in
+    /// every trajectory; `None` if they are this run's shapes. The checks index the
+    /// records by this run's counts: records of other shapes are refused before them.
+    pub fn records_shape_error(
+        &self,
+        records: &[TrajectoryRecord],
+        extra: &[Vec<f64>],
+    ) -> Option<String> {
+        let c = self.components;
+        let r = &self.reference;
+        let want = (
+            c * r.modes.len(),
+            c * r.profile_x.len(),
+            c * r.two_time.len(),
+            self.n_nodes(),
+        );
+        let lengths = |rec: &TrajectoryRecord| -> Vec<usize> {
+            rec.modes.iter().chain(&rec.profile).map(Vec::len).collect()
+        };
+        let first = records.first().map(lengths);
+        for (j, rec) in records.iter().enumerate() {
+            let got = (
+                rec.modes.len(),
+                rec.profile.len(),
+                rec.two_time.len(),
+                rec.slope_squares.len(),
+            );
+            if got != want {
+                return Some(format!(
+                    "trajectory {j} holds (mode series, profile series, two-time products, nodal slope sums) = {got:?}, run {} gives {want:?}",
+                    self.spec.name
+                ));
+            }
+            let l = lengths(rec);
+            if l.iter().any(|&n| n > MAX_SAMPLES) || Some(&l) != first.as_ref() {
+                return Some(format!(
+                    "trajectory {j} has series of {l:?} samples, trajectory 0 of {:?} (at most {MAX_SAMPLES} each, the same in every trajectory)",
+                    first.unwrap_or_default()
+                ));
+            }
+        }
+        extra.iter().position(|x| x.len() != want.2).map(|j| {
+            format!(
+                "two-time trajectory {j} holds {} products, run {} gives {}",
+                extra[j].len(),
+                self.spec.name,
+                want.2
+            )
+        })
+    }
+
     /// The largest root-mean-square slope |w'| over the mesh nodes, measured over the
     /// ensemble's profile samples (all components): `(rms slope, node x/L)`. `None` for
     /// the spectral model or without samples.

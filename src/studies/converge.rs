@@ -1122,9 +1122,11 @@ fn linear_study(
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
         let seed = derive_seed(s.seed, &seed_label(&spec.name, over, v));
         let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
-        let outcome = source.linear((scene, &spec.name, over, v), &ensemble, |first, count| {
-            lr.simulate_ensemble(seed, first, count, steps, |_| {})
-        })?;
+        let outcome = source.linear(
+            (scene, &spec.name, over, v),
+            (&ensemble, lr),
+            |first, count| lr.simulate_ensemble(seed, first, count, steps, |_| {}),
+        )?;
         let records = match outcome {
             shard::Outcome::Records(r) => r,
             shard::Outcome::Written => continue,

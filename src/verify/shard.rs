@@ -100,8 +100,9 @@ pub fn write_shard(
     // touched.
     let plans = plan_from
         .map(|dir| -> Result<(PathBuf, ShardManifest)> {
-            let m = ShardManifest::read(dir)?;
-            writer.manifest().check_same_set(&opts.out, &m, dir)?;
+            let m = ShardManifest::read(dir).map_err(|e| plan_from_error(dir, e))?;
+            m.check_same_set(dir, writer.manifest(), &opts.out)
+                .map_err(|e| plan_from_error(dir, e))?;
             Ok((dir.to_path_buf(), m))
         })
         .transpose()?;
@@ -130,6 +131,18 @@ pub fn write_shard(
     }
     bar.finish();
     writer.finish()
+}
+
+/// The refusal of `verify --plan-from DIR` (exit 2): names the flag and the directory
+/// given, with what is wrong (`e`: the manifest, its key and why).
+fn plan_from_error(dir: &Path, e: Error) -> Error {
+    Error::invalid(
+        "--plan-from",
+        dir.display(),
+        format!(
+            "a finished shard of the same set (the same build, settings, scenes, seeds and shard count), holding the plan of every run with a budget by target precision; {e}"
+        ),
+    )
 }
 
 /// Simulates and writes the writer's share of linear run `k`.
@@ -169,16 +182,14 @@ fn write_compression(
                 .iter()
                 .find(|f| f.scene == scene.name && f.run == run.spec.name);
             let refuse = |message: String| {
-                refuse(
-                    dir,
-                    &files_key(&scene.name, &run.spec.name),
-                    format!("--plan-from: {message}"),
-                )
+                let key = files_key(&scene.name, &run.spec.name);
+                plan_from_error(dir, refuse(dir, &key, message))
             };
             let common = entry
                 .map(|f| &f.common)
                 .ok_or_else(|| refuse("no plan of this run".to_string()))?;
-            Some(decode_plan(common, target, run.points()).map_err(refuse)?)
+            let tau1 = scene.filament.tau1();
+            Some(decode_plan(common, target, run, tau1).map_err(refuse)?)
         }
         _ => None,
     };
@@ -219,10 +230,13 @@ pub(super) fn merged_linear(
     e: &Ensemble,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let (mut records, mut extra) = (Vec::new(), Vec::new());
-    for (file, bytes) in set.read(&scene.name, &run.spec.name)? {
-        let (r, x) = decode_linear(&bytes, &file.path)?;
+    for file in set.read(&scene.name, &run.spec.name)? {
+        let (r, x) = decode_linear(&file.bytes, &file.source)?;
         records.extend(r);
         extra.extend(x);
+    }
+    if let Some(why) = run.records_shape_error(&records, &extra) {
+        return Err(incomplete(set, scene, &run.spec.name, why));
     }
     if records.len() != e.trajectories || extra.len() != e.two_time_trajectories {
         return Err(incomplete(
@@ -257,8 +271,8 @@ pub(super) fn merged_compression(
     let name = &run.spec.name;
     let files = set.read(&scene.name, name)?;
     let mut records: Vec<Vec<ForceRecord>> = vec![Vec::new(); run.points()];
-    for (file, bytes) in &files {
-        let share = decode_force(bytes, &file.path)?;
+    for file in &files {
+        let share = decode_force(&file.bytes, &file.source)?;
         if share.len() != run.points() {
             return Err(incomplete(
                 set,
@@ -266,7 +280,7 @@ pub(super) fn merged_compression(
                 name,
                 format!(
                     "{} has {} strains, the scene {}",
-                    file.path,
+                    file.source,
                     share.len(),
                     run.points()
                 ),
@@ -288,20 +302,38 @@ pub(super) fn merged_compression(
     let plan = match e.precision_target() {
         None => None,
         Some(target) => Some(
-            decode_plan(&files[0].0.common, target, run.points())
+            decode_plan(&files[0].file.common, target, run, scene.filament.tau1())
                 .map_err(|m| incomplete(set, scene, name, m))?,
         ),
     };
+    // The records' shapes: those of the run the plan's steps give.
+    let adapted = match plan.as_ref().and_then(|p| p.search.as_ref()) {
+        Some(s) => Some(run.with_steps(&s.iter().map(|c| c.dt_tau1).collect::<Vec<_>>())?),
+        None => None,
+    };
+    if let Some(why) = adapted
+        .as_ref()
+        .unwrap_or(run)
+        .records_shape_error(&records)
+    {
+        return Err(incomplete(set, scene, name, why));
+    }
     Ok((records, plan))
 }
 
-/// The plan a shard manifest lists for a run of `points` strains (a file's `common`),
-/// checked to have one value per strain; the error says what is wrong.
+/// The plan a shard manifest lists for compression run `run` (a file's `common`), checked
+/// to be one this build could have chosen for it (τ1 = `tau1`): one value per strain;
+/// every duration finite, positive and at most the target's longest; the main stage's
+/// steps those of its duration (so that the work stays the scene's projected work); the
+/// steps of a step search finite, positive and at most its largest step. The error says
+/// what is wrong.
 fn decode_plan(
     common: &serde_json::Value,
     target: crate::scene::PrecisionTarget,
-    points: usize,
+    run: &CompressionRun,
+    tau1: f64,
 ) -> std::result::Result<TargetedPlan, String> {
+    let points = run.points();
     let bits: PlanBits =
         serde_json::from_value(common.clone()).map_err(|e| format!("no readable plan: {e}"))?;
     let plan = bits.plan(target);
@@ -315,6 +347,54 @@ fn decode_plan(
         return Err(format!(
             "a plan with {lengths:?} values, not one per strain ({points})"
         ));
+    }
+    let longest = target.max_duration_tau1 * (1.0 + 1e-9);
+    let duration = |what: &str, d: f64| {
+        if d.is_finite() && d > 0.0 && d <= longest {
+            Ok(())
+        } else {
+            Err(format!(
+                "a plan whose {what} is {d} tau1, but a duration in (0, {}] tau1 (the budget's max_duration_tau1) is required",
+                target.max_duration_tau1
+            ))
+        }
+    };
+    duration("pilot duration", plan.pilot_tau1)?;
+    if let Some(se) = plan
+        .pilot_std_error
+        .iter()
+        .find(|s| !(s.is_finite() && **s >= 0.0))
+    {
+        return Err(format!(
+            "a plan with a pilot standard error of {se}: a finite number >= 0 is required"
+        ));
+    }
+    if let (Some(search), Some(rule)) = (&plan.search, target.step_search)
+        && let Some(c) = search
+            .iter()
+            .find(|c| !(c.dt_tau1.is_finite() && c.dt_tau1 > 0.0 && c.dt_tau1 <= rule.max_dt_tau1))
+    {
+        return Err(format!(
+            "a plan whose step search chose dt = {} tau1, but a step in (0, {}] tau1 (the budget's max_dt_tau1) is required",
+            c.dt_tau1, rule.max_dt_tau1
+        ));
+    }
+    let adapted = match &plan.search {
+        Some(s) => Some(
+            run.with_steps(&s.iter().map(|c| c.dt_tau1).collect::<Vec<_>>())
+                .map_err(|e| e.to_string())?,
+        ),
+        None => None,
+    };
+    let stepped = adapted.as_ref().unwrap_or(run);
+    for (i, (&d, &n)) in plan.main_tau1.iter().zip(&plan.main_steps).enumerate() {
+        duration(&format!("main-stage duration at strain {i}"), d)?;
+        let want = stepped.sampled_steps_at(i, d * tau1);
+        if n != want {
+            return Err(format!(
+                "a plan with {n} main-stage steps at strain {i}, but its duration of {d} tau1 is {want} steps"
+            ));
+        }
     }
     Ok(plan)
 }

@@ -144,8 +144,7 @@ fn copy_files(set: &ShardSet, job: &Job, expected: &[Expected]) -> Result<Sink> 
     for ((_, files), sources) in expected.iter().zip(&sources) {
         for (rel, &(k, entry)) in files.iter().zip(sources) {
             let bytes = set.read_file(k, entry)?;
-            sink.record(&job.out, rel)?;
-            write_atomic(&job.out.join(rel), &bytes)?;
+            write_atomic(&sink.record(&job.out, rel)?, &bytes)?;
         }
     }
     Ok(sink)

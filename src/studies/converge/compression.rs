@@ -552,19 +552,14 @@ fn value_records(
 ) -> Result<Outcome<Vec<Vec<ForceRecord>>>> {
     let steps = vec![cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1()); cr.points()];
     let label = super::seed_label(run_name, over, v);
-    source.force(
-        (scene, run_name, over, v),
-        &ensemble,
-        cr.points(),
-        |range| {
-            cr.simulate_share_per_point(
-                |i| derive_seed(s.seed, &format!("{label}/{i}")),
-                range,
-                &steps,
-                || {},
-            )
-        },
-    )
+    source.force((scene, run_name, over, v), (&ensemble, cr), |range| {
+        cr.simulate_share_per_point(
+            |i| derive_seed(s.seed, &format!("{label}/{i}")),
+            range,
+            &steps,
+            || {},
+        )
+    })
 }
 
 /// The note of one value: acceptance (Metropolis), correlation time of F and largest RMS

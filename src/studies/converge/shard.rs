@@ -12,8 +12,8 @@
 use super::{ConvergeOptions, FailedValue, Over};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
-use crate::scene::compression::ForceRecord;
-use crate::scene::linear::TrajectoryRecord;
+use crate::scene::compression::{CompressionRun, ForceRecord};
+use crate::scene::linear::{LinearRun, TrajectoryRecord};
 use crate::scene::records::{decode_force, decode_linear, encode_force, encode_linear};
 use crate::scene::{Budget, Ensemble, Scene};
 use crate::shard::{Shard, ShardSet, ShardWriter, files_key};
@@ -179,7 +179,7 @@ impl Source<'_> {
     pub(super) fn linear(
         &mut self,
         (scene, run, over, v): (&Scene, &str, Over, f64),
-        e: &Ensemble,
+        (e, lr): (&Ensemble, &LinearRun),
         simulate: impl FnOnce(u64, u64) -> Result<Vec<TrajectoryRecord>>,
     ) -> Result<Outcome<Vec<TrajectoryRecord>>> {
         let key = value_key(run, over, v);
@@ -194,10 +194,15 @@ impl Source<'_> {
                 for part in read_value(set, scene, &key)? {
                     match part {
                         Part::Failed(f) => return Ok(Outcome::Failed(f)),
-                        Part::Bytes(path, bytes) => all.extend(decode_linear(&bytes, &path)?.0),
+                        Part::Bytes(source, bytes) => {
+                            all.extend(decode_linear(&bytes, &source)?.0);
+                        }
                     }
                 }
                 counted(set, scene, &key, all.len(), e.trajectories)?;
+                if let Some(why) = lr.records_shape_error(&all, &[]) {
+                    return Err(refuse(set, scene, &key, why));
+                }
                 Ok(Outcome::Records(all))
             },
         )
@@ -208,10 +213,10 @@ impl Source<'_> {
     pub(super) fn force(
         &mut self,
         (scene, run, over, v): (&Scene, &str, Over, f64),
-        e: &Ensemble,
-        strains: usize,
+        (e, cr): (&Ensemble, &CompressionRun),
         simulate: impl FnOnce(Range<u64>) -> Result<Vec<Vec<ForceRecord>>>,
     ) -> Result<Outcome<Vec<Vec<ForceRecord>>>> {
+        let strains = cr.points();
         let key = value_key(run, over, v);
         let total = e.trajectories.max(1) as u64;
         self.value(
@@ -224,8 +229,8 @@ impl Source<'_> {
                 for part in read_value(set, scene, &key)? {
                     match part {
                         Part::Failed(f) => return Ok(Outcome::Failed(f)),
-                        Part::Bytes(path, bytes) => {
-                            let share = decode_force(&bytes, &path)?;
+                        Part::Bytes(source, bytes) => {
+                            let share = decode_force(&bytes, &source)?;
                             counted(set, scene, &key, share.len(), strains)?;
                             for (a, p) in all.iter_mut().zip(share) {
                                 a.extend(p);
@@ -235,6 +240,9 @@ impl Source<'_> {
                 }
                 for a in &all {
                     counted(set, scene, &key, a.len(), total as usize)?;
+                }
+                if let Some(why) = cr.records_shape_error(&all) {
+                    return Err(refuse(set, scene, &key, why));
                 }
                 Ok(Outcome::Records(all))
             },
@@ -263,7 +271,8 @@ impl Source<'_> {
     }
 }
 
-/// One shard's part of a value: its records' bytes (with the file's path) or its failure.
+/// One shard's part of a value: its records' bytes (with the file's path and shard, in
+/// words) or its failure.
 enum Part {
     Bytes(String, Vec<u8>),
     Failed(FailedValue),
@@ -273,13 +282,13 @@ enum Part {
 fn read_value(set: &ShardSet, scene: &Scene, key: &str) -> Result<Vec<Part>> {
     set.read(&scene.name, key)?
         .into_iter()
-        .map(|(file, bytes)| {
-            if file.path.ends_with(&format!(".{FAILED_EXT}")) {
-                serde_json::from_slice(&bytes)
+        .map(|r| {
+            if r.file.path.ends_with(&format!(".{FAILED_EXT}")) {
+                serde_json::from_slice(&r.bytes)
                     .map(Part::Failed)
-                    .map_err(|e| refuse(set, scene, key, format!("{}: {e}", file.path)))
+                    .map_err(|e| refuse(set, scene, key, format!("{}: {e}", r.source)))
             } else {
-                Ok(Part::Bytes(file.path, bytes))
+                Ok(Part::Bytes(r.source, r.bytes))
             }
         })
         .collect()
@@ -392,7 +401,7 @@ mod tests {
             source.finish().unwrap();
             dirs.push(dir);
         }
-        let set = ShardSet::open(&dirs).unwrap();
+        let set = ShardSet::open(&dirs, 1 << 30).unwrap();
         let parts = read_value(&set, &scene, "run/dt=1").unwrap();
         let first_failure = parts.into_iter().find_map(|p| match p {
             Part::Failed(f) => Some(f),
