@@ -223,3 +223,14 @@ pub fn strings(v: &serde_json::Value) -> Vec<String> {
         .map(|s| s.as_str().expect("string").to_string())
         .collect()
 }
+
+/// Copies the tree `from` (directories and regular files) to `to`, creating `to`.
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
+    for f in all_files(from) {
+        let target = to.join(&f);
+        std::fs::create_dir_all(target.parent().expect("a parent")).expect("create dir");
+        std::fs::copy(from.join(&f), &target)
+            .unwrap_or_else(|e| panic!("copy {f} to {}: {e}", target.display()));
+    }
+}

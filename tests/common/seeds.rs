@@ -40,3 +40,8 @@ pub const GOLDEN_SEED: u64 = 0x0060_1DE2;
 // tests/fuzz_scenes.rs
 /// The scene fuzzer's generator (ChaCha): the same 1600 mutants on every run.
 pub const SEED_SCENE_FUZZ: u64 = 0xF022_5CE4;
+
+// tests/damaged_data.rs
+/// The byte mutator of the damaged-data property test (ChaCha): the same mutants of the
+/// valid .npy, CSV, data.json and shard.json on every run.
+pub const SEED_DAMAGED_DATA: u64 = 0xDA3A_6ED0;
