@@ -150,27 +150,83 @@ pub fn read_text(path: &Path, key: &str, max_bytes: u64) -> Result<String> {
     })
 }
 
+/// Parses `text`, read from `path`, as JSON of type `T` (`what` names the kind of file in
+/// messages, e.g. `a shard manifest`). A refusal names the key where the parser stopped
+/// (`runs[0].dt_sample`, as serde_path_to_error tracks it; `-` at the top), the line and
+/// column, and what is wrong; the literals `NaN`, `Infinity` and `-Infinity` (which
+/// Python's `json.dump` writes for non-finite floats, but which are not JSON) are named
+/// as such, with how to avoid them.
+///
+/// # Errors
+/// [`Error::Scene`] naming `path` and the key.
+pub fn parse_json<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    text: &str,
+    what: &str,
+) -> Result<T> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let parsed: std::result::Result<T, _> = serde_path_to_error::deserialize(&mut de);
+    let value = parsed.map_err(|e| {
+        let key = match e.path().to_string() {
+            p if p.is_empty() || p == "." => "-".to_string(),
+            p => p,
+        };
+        let inner = e.inner();
+        let message = match non_json_literal(text, inner.line(), inner.column()) {
+            Some(literal) => format!(
+                "not {what}: {literal} at line {}, column {} is not JSON (JSON has no NaN or infinity: write finite numbers; Python's json.dump writes NaN unless given allow_nan=False, which finds them)",
+                inner.line(),
+                inner.column()
+            ),
+            None => format!("not {what}: {inner}"),
+        };
+        refused(path, &key, message)
+    })?;
+    de.end()
+        .map_err(|e| refused(path, "-", format!("not {what}: {e}")))?;
+    Ok(value)
+}
+
+/// The non-JSON literal (`NaN`, `Infinity`, `-Infinity`) that starts at or just before
+/// (`line`, `column`) of `text` (1-based, as serde_json reports them), if any.
+fn non_json_literal(text: &str, line: usize, column: usize) -> Option<&'static str> {
+    let row = text.lines().nth(line.checked_sub(1)?)?;
+    let at = column.saturating_sub(1).min(row.len());
+    let from = row.get(..=at.min(row.len().saturating_sub(1)))?;
+    // The parser stops on the literal's first character, or just after a sign.
+    let start = from.rfind([' ', ':', '[', ',', '\t']).map_or(0, |i| i + 1);
+    let rest = row.get(start..)?.trim_start();
+    ["-Infinity", "Infinity", "NaN"]
+        .into_iter()
+        .find(|l| rest.starts_with(l))
+}
+
 /// Refuses an output directory `out` (`--out`) that is the input directory `input`
-/// (given by `input_flag`, e.g. `--data`) or holds it: the command would write its output
-/// among its own input data (issue #25). An output directory inside the input directory
-/// is allowed: nothing of the input is touched then.
+/// (given by `input_flag`, e.g. `--data`), holds it or lies inside it: the command would
+/// write its output among its own input (issue #25: the input is left exactly as it was,
+/// nothing added, replaced or removed).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `--out`, both directories and the flag.
 pub fn refuse_input_in_output(out: &Path, input: &Path, input_flag: &str) -> Result<()> {
     let (o, i) = (resolved(out), resolved(input));
-    if i.starts_with(&o) {
-        let relation = if i == o { "is" } else { "holds" };
-        return Err(Error::invalid(
-            "--out",
-            out.display(),
-            format!(
-                "a directory apart from the input: it {relation} the input directory {} given by {input_flag}, whose files the output would mix with or replace; choose another output directory",
-                input.display()
-            ),
-        ));
-    }
-    Ok(())
+    let relation = if i == o {
+        "is"
+    } else if i.starts_with(&o) {
+        "holds"
+    } else if o.starts_with(&i) {
+        "lies inside"
+    } else {
+        return Ok(());
+    };
+    Err(Error::invalid(
+        "--out",
+        out.display(),
+        format!(
+            "a directory apart from the input: it {relation} the input directory {} given by {input_flag}, which is left exactly as it was; choose an output directory outside it",
+            input.display()
+        ),
+    ))
 }
 
 /// `path` made absolute with its existing part's symbolic links resolved (the rest, not
@@ -273,7 +329,7 @@ mod tests {
         std::fs::remove_dir_all(&d).unwrap();
     }
 
-    /// The output may not be the input directory or hold it; inside it is fine.
+    /// The output may not be the input directory, hold it or lie inside it.
     #[test]
     fn output_apart_from_input() {
         let d = dir("overlap");
@@ -284,9 +340,57 @@ mod tests {
             assert_eq!(e.exit_code(), 2);
             assert!(e.to_string().contains("--data"), "{e}");
         }
-        refuse_input_in_output(&data.join("report"), &data, "--data").unwrap();
+        let e = refuse_input_in_output(&data.join("report"), &data, "--data").unwrap_err();
+        assert!(e.to_string().contains("lies inside"), "{e}");
         refuse_input_in_output(&d.join("report/new"), &data, "--data").unwrap();
+        refuse_input_in_output(&d.join("data-report"), &data, "--data").unwrap();
         std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// JSON refusals name the key path, and NaN or Infinity literals as such.
+    #[test]
+    fn json_errors_name_the_key_and_non_json_literals() {
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct Run {
+            dt: f64,
+        }
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct Top {
+            runs: Vec<Run>,
+        }
+        let p = Path::new("d/data.json");
+        let ok: Top = parse_json(p, "{\"runs\": [{\"dt\": 1.5}]}", "a sidecar").unwrap();
+        assert_eq!(ok.runs.len(), 1);
+        for (text, key, says) in [
+            (
+                "{\"runs\": [{\"dt\": \"x\"}]}",
+                "runs[0].dt",
+                "invalid type",
+            ),
+            ("{\"runs\": [{\"dt\": null}]}", "runs[0].dt", "null"),
+            ("{\"runs\": [{\"dt\": NaN}]}", "runs[0].dt", "NaN at line 1"),
+            (
+                "{\"runs\": [{\"dt\": -Infinity}]}",
+                "runs[0].dt",
+                "-Infinity at line 1",
+            ),
+            (
+                "{\"runs\": [\n  {\"dt\": Infinity}]}",
+                "runs[0].dt",
+                "Infinity at line 2",
+            ),
+            ("{\"runs\": []} x", "-", "trailing"),
+        ] {
+            let e = parse_json::<Top>(p, text, "a sidecar").unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            let m = e.to_string();
+            assert!(
+                m.contains(&format!("key `{key}`")) && m.contains(says),
+                "{text}: {m}"
+            );
+        }
     }
 
     #[test]

@@ -465,6 +465,15 @@ pub fn refuse(dir: &Path, key: &str, message: String) -> Error {
     }
 }
 
+/// The manifest key of the setting that flag `flag` sets (`--duration-tau1` →
+/// `settings.duration_tau1`, `--run` → `settings.runs`).
+fn settings_key(flag: &str) -> String {
+    match flag.trim_start_matches('-') {
+        "run" => "settings.runs".to_string(),
+        f => format!("settings.{}", f.replace('-', "_")),
+    }
+}
+
 /// The manifest key of the files of run `run` of scene `scene` (`files[<scene>/<run>]`),
 /// as refusals name them.
 pub fn files_key(scene: &str, run: &str) -> String {
@@ -477,7 +486,10 @@ impl ShardSet {
     fn expand(dirs: &[PathBuf]) -> Result<Vec<PathBuf>> {
         let mut out = Vec::new();
         for dir in dirs {
-            if dir.join(SHARD_MANIFEST).is_file() {
+            // Any entry of that name (a FIFO or directory too) makes a shard directory,
+            // whose manifest is then refused for what it is, not taken for absent.
+            let has_manifest = |d: &Path| std::fs::symlink_metadata(d.join(SHARD_MANIFEST)).is_ok();
+            if has_manifest(dir) {
                 out.push(dir.clone());
                 continue;
             }
@@ -490,7 +502,7 @@ impl ShardSet {
             })?;
             let mut subs: Vec<PathBuf> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.join(SHARD_MANIFEST).is_file())
+                .filter(|p| p.is_dir() && has_manifest(p))
                 .collect();
             if subs.is_empty() {
                 return Err(refuse(
@@ -520,8 +532,7 @@ impl ShardSet {
                     other => other,
                 }
             })?;
-        let m: ShardManifest = serde_json::from_str(&text)
-            .map_err(|e| refuse(dir, "-", format!("not a shard manifest: {e}")))?;
+        let m: ShardManifest = crate::input::parse_json(&path, &text, "a shard manifest")?;
         let s = m.shard;
         if s.index < 1 || s.index > s.count || s.count > MAX_SHARDS {
             return Err(refuse(
@@ -656,7 +667,7 @@ impl ShardSet {
                 value,
                 allowed,
             } if name.starts_with("--") => self.refuse(
-                "settings",
+                &settings_key(&name),
                 format!(
                     "the shards ran with {name} = {value}, but {name} must be {allowed}: a damaged or edited manifest; rerun the shards"
                 ),
@@ -808,15 +819,22 @@ impl ShardSet {
             if let Some(ShardRecord { file: prev, .. }) = out.last() {
                 let next = prev.first.checked_add(prev.count);
                 if next != Some(entry.first) {
+                    let (prev_dir, prev_m) = &self.shards[k - 1];
                     return Err(refuse(
                         dir,
                         &key,
                         format!(
-                            "trajectories {}..{} do not follow the previous shard's {}..{}",
+                            "trajectories {}..{} (first {}, count {}) do not follow those of the previous shard {} in {}: {}..{} (first {}, count {}); one of the two manifests is damaged",
                             entry.first,
                             entry.first.saturating_add(entry.count),
+                            entry.first,
+                            entry.count,
+                            prev_m.shard,
+                            prev_dir.join(SHARD_MANIFEST).display(),
                             prev.first,
-                            prev.first.saturating_add(prev.count)
+                            prev.first.saturating_add(prev.count),
+                            prev.first,
+                            prev.count
                         ),
                     ));
                 }

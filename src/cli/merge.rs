@@ -67,10 +67,11 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
         COMMAND => merge_verify(set, &args, verbosity, start),
         CONVERGE => super::converge::merge(set, &args.out, verbosity),
         super::run::COMMAND => super::run::merge(set, &args.out, verbosity),
-        other => Err(langevin_fem::Error::invalid(
-            "merge DIR",
-            format!("shards of `{other}`"),
-            "shards of `verify`, `converge` or `run`",
+        other => Err(set.refuse(
+            "command",
+            format!(
+                "a shard of `{other}`, but merge takes shards of `verify`, `converge` or `run`"
+            ),
         )),
     }
 }

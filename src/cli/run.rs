@@ -34,6 +34,10 @@ use std::path::{Path, PathBuf};
 
 /// The name of the command in a `run` shard's manifest.
 pub const COMMAND: &str = "run";
+/// The largest `--trajectories` of `run` (and of a merged run's settings).
+const MAX_TRAJECTORIES: usize = 100_000;
+/// The largest `--every` of `run`.
+const MAX_EVERY: u64 = 1_000_000_000;
 
 /// The examples of `run --help`.
 const EXAMPLES: &str = "\
@@ -62,14 +66,14 @@ pub struct RunArgs {
     #[arg(short, long, value_enum, default_value = "quick")]
     budget: super::verify::BudgetArg,
     /// Trajectories per run (default: the budget's).
-    #[arg(long, value_name = "N", value_parser = usize_in::<1, 100_000>)]
+    #[arg(long, value_name = "N", value_parser = usize_in::<1, { MAX_TRAJECTORIES as u64 }>)]
     trajectories: Option<usize>,
     /// Sampled duration per trajectory after the burn-in, in tau1 (default: the budget's).
     #[arg(long, value_name = "TAU1", allow_negative_numbers = true)]
     duration_tau1: Option<f64>,
     /// Steps between rows (default: the cadence of the fastest checked mode, made a
     /// divisor of the two-time points' steps).
-    #[arg(long, value_name = "STEPS", value_parser = super::count_in::<1, 1_000_000_000>)]
+    #[arg(long, value_name = "STEPS", value_parser = super::count_in::<1, MAX_EVERY>)]
     every: Option<u64>,
     /// File format of the trajectories.
     #[arg(long, value_enum, default_value = "npy")]
@@ -205,6 +209,24 @@ impl Job {
         verbosity: Verbosity,
         (shard, limits): (Shard, WorkLimits),
     ) -> Result<Job> {
+        if let Some(n) = settings.trajectories
+            && !(1..=MAX_TRAJECTORIES).contains(&n)
+        {
+            return Err(Error::invalid(
+                "--trajectories",
+                n,
+                format!("an integer in [1, {MAX_TRAJECTORIES}]"),
+            ));
+        }
+        if let Some(n) = settings.every
+            && !(1..=MAX_EVERY).contains(&n)
+        {
+            return Err(Error::invalid(
+                "--every",
+                n,
+                format!("an integer in [1, {MAX_EVERY}]"),
+            ));
+        }
         if let Some(d) = settings.duration_tau1
             && !(d.is_finite() && (1.0..=1e6).contains(&d))
         {

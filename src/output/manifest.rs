@@ -542,7 +542,9 @@ fn occupant(dir: &Path, kind: OutputKind<'_>) -> Option<String> {
     };
     let journal = has(MANIFEST_FILE).then(|| command_of(MANIFEST_FILE));
     let describe = |file: &str, command: Option<String>| match command {
-        Some(c) if c == "run" => format!("trajectory data written by `run` ({file})"),
+        Some(c) if c == "run" => {
+            format!("trajectory data written by `run` ({file}, {DATA_FILE})")
+        }
         Some(c) => format!("the output of `{c}` ({file})"),
         None => format!("{file}, which no langevin-fem run wrote"),
     };

@@ -518,8 +518,15 @@ pub fn validate_values(over: Over, values: &[f64]) -> Result<()> {
                 }
             }
             Over::Dt => {
-                if !(v.is_finite() && v > 0.0 && v <= 100.0) {
-                    return Err(Error::invalid("--values", v, "dt_tau1 values in (0, 100]"));
+                // Below 1e-9 tau1 a study would take over 1e9 steps per tau1, and the
+                // slowest mode's multiplier rounds to 1 long before double precision
+                // ends: refused here, naming the flag.
+                if !(v.is_finite() && (1e-9..=100.0).contains(&v)) {
+                    return Err(Error::invalid(
+                        "--values",
+                        v,
+                        "dt_tau1 values in [1e-9, 100]",
+                    ));
                 }
             }
         }

@@ -334,65 +334,72 @@ fn decode_plan(
     tau1: f64,
 ) -> std::result::Result<TargetedPlan, String> {
     let points = run.points();
-    let bits: PlanBits =
-        serde_json::from_value(common.clone()).map_err(|e| format!("no readable plan: {e}"))?;
+    let bits: PlanBits = serde_path_to_error::deserialize(common.clone()).map_err(|e| {
+        format!(
+            "no readable plan: common.{}: {} (the plan's floats are written as their bits, u64)",
+            e.path(),
+            e.inner()
+        )
+    })?;
     let plan = bits.plan(target);
-    let lengths = [
-        plan.pilot_std_error.len(),
-        plan.main_tau1.len(),
-        plan.main_steps.len(),
-        plan.search.as_ref().map_or(points, Vec::len),
-    ];
-    if lengths.iter().any(|&l| l != points) {
-        return Err(format!(
-            "a plan with {lengths:?} values, not one per strain ({points})"
-        ));
+    for (key, len) in [
+        ("pilot_std_error", plan.pilot_std_error.len()),
+        ("main_tau1", plan.main_tau1.len()),
+        ("main_steps", plan.main_steps.len()),
+        ("search", plan.search.as_ref().map_or(points, Vec::len)),
+    ] {
+        if len != points {
+            return Err(format!(
+                "common.{key} holds {len} values, but the plan needs one per strain ({points})"
+            ));
+        }
     }
     let longest = target.max_duration_tau1 * (1.0 + 1e-9);
-    let duration = |what: &str, d: f64| {
+    let duration = |key: String, d: f64| {
         if d.is_finite() && d > 0.0 && d <= longest {
             Ok(())
         } else {
             Err(format!(
-                "a plan whose {what} is {d} tau1, but a duration in (0, {}] tau1 (the budget's max_duration_tau1) is required",
+                "common.{key} = {d} tau1, but a duration in (0, {}] tau1 (the budget's max_duration_tau1) is required",
                 target.max_duration_tau1
             ))
         }
     };
-    duration("pilot duration", plan.pilot_tau1)?;
-    if let Some(se) = plan
+    duration("pilot_tau1".into(), plan.pilot_tau1)?;
+    if let Some((i, se)) = plan
         .pilot_std_error
         .iter()
-        .find(|s| !(s.is_finite() && **s >= 0.0))
+        .enumerate()
+        .find(|(_, s)| !(s.is_finite() && **s >= 0.0))
     {
         return Err(format!(
-            "a plan with a pilot standard error of {se}: a finite number >= 0 is required"
+            "common.pilot_std_error[{i}] = {se}, but a finite standard error >= 0 is required"
         ));
     }
     if let (Some(search), Some(rule)) = (&plan.search, target.step_search)
-        && let Some(c) = search
-            .iter()
-            .find(|c| !(c.dt_tau1.is_finite() && c.dt_tau1 > 0.0 && c.dt_tau1 <= rule.max_dt_tau1))
+        && let Some((i, c)) = search.iter().enumerate().find(|(_, c)| {
+            !(c.dt_tau1.is_finite() && c.dt_tau1 > 0.0 && c.dt_tau1 <= rule.max_dt_tau1)
+        })
     {
         return Err(format!(
-            "a plan whose step search chose dt = {} tau1, but a step in (0, {}] tau1 (the budget's max_dt_tau1) is required",
+            "common.search[{i}] chose dt = {} tau1, but a step in (0, {}] tau1 (the budget's max_dt_tau1) is required",
             c.dt_tau1, rule.max_dt_tau1
         ));
     }
     let adapted = match &plan.search {
         Some(s) => Some(
             run.with_steps(&s.iter().map(|c| c.dt_tau1).collect::<Vec<_>>())
-                .map_err(|e| e.to_string())?,
+                .map_err(|e| format!("common.search: {e}"))?,
         ),
         None => None,
     };
     let stepped = adapted.as_ref().unwrap_or(run);
     for (i, (&d, &n)) in plan.main_tau1.iter().zip(&plan.main_steps).enumerate() {
-        duration(&format!("main-stage duration at strain {i}"), d)?;
+        duration(format!("main_tau1[{i}]"), d)?;
         let want = stepped.sampled_steps_at(i, d * tau1);
         if n != want {
             return Err(format!(
-                "a plan with {n} main-stage steps at strain {i}, but its duration of {d} tau1 is {want} steps"
+                "common.main_steps[{i}] = {n}, but its duration common.main_tau1[{i}] = {d} tau1 is {want} steps"
             ));
         }
     }

@@ -64,6 +64,8 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
             settings.runs.len()
         );
     }
+    // The settings were checked when the shards ran: a value the run refuses now is a
+    // damaged manifest (named as such by `settings_error`).
     let job = Job::new(
         settings,
         scene,
@@ -71,12 +73,14 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
         (out.to_path_buf(), scene_arg),
         verbosity,
         (Shard::WHOLE, WorkLimits::default()),
-    )?;
+    )
+    .map_err(|e| set.settings_error(e))?;
     if job.scene.compression.is_some() {
         merge_compression(&set, &job)
     } else {
         merge_linear(&set, &job)
     }
+    .map_err(|e| set.settings_error(e))
 }
 
 /// The merge of a linear scene's run shards.
