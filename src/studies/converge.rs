@@ -525,7 +525,7 @@ pub fn validate_values(over: Over, values: &[f64]) -> Result<()> {
                     return Err(Error::invalid(
                         "--values",
                         v,
-                        "dt_tau1 values in [1e-9, 100]",
+                        "dt_tau1 values in (0, 100], at least 1e-9",
                     ));
                 }
             }
