@@ -466,6 +466,38 @@ fn read_trajectory(
     Ok(table)
 }
 
+/// The largest magnitude of a value the checks use, in their units (deflections in the
+/// filament's length unit, modal amplitudes in the reference's, forces in F_c0): the
+/// squares, products and squared sums of a billion of them stay far from overflow.
+/// Larger finite values are no physical data (a filament is at most 1e30 long), and
+/// would make an estimator fail as if the data were too few.
+const MAX_MAGNITUDE: f64 = 1e100;
+
+/// Refuses column `col` of `table` (file `path`, key `key`) if a value of it times
+/// `factor` (the change to the checks' units) exceeds [`MAX_MAGNITUDE`], naming the
+/// column, the data row and the value.
+fn require_magnitude(
+    table: &Table,
+    (path, key): (&Path, &str),
+    col: usize,
+    factor: f64,
+) -> Result<()> {
+    let limit = MAX_MAGNITUDE / factor.abs();
+    match (0..table.rows).find(|&r| table.get(r, col).abs() > limit) {
+        None => Ok(()),
+        Some(r) => Err(refused(
+            path,
+            key,
+            format!(
+                "column {:?}, data row {}: must be at most {limit:e} in magnitude (the checks sum its squares and products, which must stay finite), got {:?}",
+                table.columns[col],
+                r + 1,
+                table.get(r, col)
+            ),
+        )),
+    }
+}
+
 /// Reads every file of data run `k` (in `dir`, each of at most `max_bytes`) into
 /// records and two-time products; refuses trajectories too short for the sparsest
 /// checked series.
@@ -542,6 +574,18 @@ fn read_record(
     // Column indices: t, w_j, (v_j), aw_n, (av_n).
     let deflection_col = |k: usize, j: usize| 1 + k * np + j;
     let mode_col = |k: usize, i: usize| 1 + c * np + k * layout.n_modes_data + i;
+    let used = layout.tt_cols.iter().flat_map(|&(x, y)| [x, y]);
+    for j in layout.profile_cols.iter().copied().chain(used) {
+        for k in 0..c {
+            require_magnitude(table, (path, key), deflection_col(k, j), 1.0)?;
+        }
+    }
+    for i in 0..nm {
+        for k in 0..c {
+            let factor = 1.0 / run.amplitude_scale[i];
+            require_magnitude(table, (path, key), mode_col(k, i), factor)?;
+        }
+    }
     let mut modes = Vec::with_capacity(c * nm);
     for k in 0..c {
         for i in 0..nm {
@@ -925,6 +969,7 @@ fn read_force_records(
         for (j, path) in data.paths(dir).iter().enumerate() {
             let key = format!("runs[{k}].files[{j}]");
             let table = read_trajectory(data, path, &key, &cols, max_bytes)?;
+            require_magnitude(&table, (path, &key), 1, 1.0 / euler_load)?;
             let first_row = first_row(data, table.get(0, 0));
             if first_row >= table.rows {
                 return Err(refused(
@@ -1144,6 +1189,50 @@ mod tests {
         refusal(
             prepare_data_check(&s, &side, &dir, 0, CAP),
             &["data row 1", "start = \"rest\"", "got t = 0.5"],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Finite values too large for the checks' sums (a deflection or a force of 1e300)
+    /// are refused naming the column, the data row and the value, before any estimator.
+    #[test]
+    fn values_too_large_for_the_checks_are_refused() {
+        let dir = temp("huge");
+        let s = scene("tiny-linear");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 600);
+        let path = dir.join(&side.runs[0].files[0]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        lines[42] = lines[42].replacen(",", ",1e300,", 1);
+        let mut cells: Vec<&str> = lines[42].split(',').collect();
+        cells.remove(2);
+        lines[42] = cells.join(",");
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "t0.csv",
+                "runs[0].files[0]",
+                "column \"w_0\", data row 42",
+                "1e300",
+            ],
+        );
+        let cs = scene("tiny-compression");
+        let side = write(&dir, &compression(), 50);
+        let path = dir.join(&side.runs[2].files[1]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match (i, l.split_once(',')) {
+                (7, Some((t, rest))) => format!("{t},-1e300,{}", rest.split_once(',').unwrap().1),
+                _ => l.to_string(),
+            })
+            .collect();
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        refusal(
+            prepare_compression_checks(&cs, &side, &dir, CAP),
+            &["runs[2].files[1]", "column \"force\", data row 7", "-1e300"],
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }
