@@ -58,9 +58,11 @@
 //!   --max-memory-gib`).
 //! - A file with no data rows; a CSV file naming a column of the format twice; a value
 //!   of a column of the format (`t`, `w_j`, `v_j`, `aw_n`, `av_n`; `t`, `force`,
-//!   `stored_length`) that is not a finite number (other CSV columns are not read); a
-//!   column `t` off the cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at
-//!   0; a `.npy` header whose shape does not match the file's size.
+//!   `stored_length`) that is not a finite number (other CSV columns are not read), or
+//!   that the checks use and is larger than 1e100 in magnitude in their units (its
+//!   squares would overflow: no physical value is near it); a column `t` off the
+//!   cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at 0; a `.npy`
+//!   header whose shape does not match the file's size.
 
 mod json;
 mod npy;
