@@ -65,12 +65,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Value> {
             return Err(refused(
                 path,
                 "-",
-                format!(
-                    "not a {} sidecar: {e} (line {}, column {})",
-                    super::FORMAT,
-                    e.line(),
-                    e.column()
-                ),
+                format!("not a {} sidecar: {e}", super::FORMAT),
             ));
         }
     };

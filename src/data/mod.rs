@@ -370,11 +370,8 @@ impl DataSidecar {
         let sidecar: DataSidecar = serde_json::from_str(&text).map_err(|e| Error::Scene {
             file: path.clone(),
             key: "-".to_string(),
-            message: format!(
-                "not a {FORMAT} sidecar: {e} (line {}, column {})",
-                e.line(),
-                e.column()
-            ),
+            // serde_json's message ends in "at line L column C".
+            message: format!("not a {FORMAT} sidecar: {e}"),
         })?;
         sidecar.validate(&path)?;
         Ok(sidecar)
