@@ -63,7 +63,7 @@ pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     }
     langevin_fem::input::refuse_input_in_output(&args.out, &args.data, "--data")?;
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
-    let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha)?;
+    let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha, 4 << 30)?;
     write_report(report, &summary)?;
     print_scenes(&summary, verbosity, false);
     if verbosity != Verbosity::Quiet {

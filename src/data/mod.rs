@@ -37,16 +37,46 @@
 //!   `dt`, or `"spectral"`), the checks compare with that discretization's exact
 //!   reference and state its expected deficit against the continuum; otherwise with the
 //!   continuum, and the producer's discretization and time-step errors are part of what
-//!   is checked.
+//!   is checked. For `fem` and `spectral`, `elements` must be in [1, 1000] (as
+//!   `mesh.elements` in scene files), `integrator` and `noise` names as in scene files,
+//!   and `dt` at most 100 τ₁ (as `dt_tau1` in scene files) and at least `dt_sample`/1e10
+//!   (at most 1e10 steps per row); for another model they are only reported.
+//!
+//! ## What is refused
+//! `check` refuses (exit 2, naming the file, the key or column and row, and the value):
+//!
+//! - JSON that is not JSON: `NaN`, `Infinity` and `-Infinity` are not JSON numbers
+//!   (Python's `json.dump` writes them unless given `allow_nan=False`): every number of
+//!   the sidecar must be finite. A UTF-8 byte-order mark is accepted.
+//! - `null` at a numeric key (`dt_sample`, `positions[j]`, `strain_ratio`,
+//!   `discretization.dt`, …): it is not a number, and an optional numeric key that is
+//!   not known is left out rather than given as `null`. `null` at an optional text key
+//!   (`discretization`, `discretization.integrator`, `discretization.noise`) means not
+//!   given, as leaving it out does.
+//! - A trajectory file that is not a regular file (a FIFO, a device, a directory), or
+//!   trajectory files whose total size exceeds what the check may read (`check
+//!   --max-memory-gib`).
+//! - A file with no data rows; a CSV file naming a column of the format twice; a value
+//!   of a column of the format (`t`, `w_j`, `v_j`, `aw_n`, `av_n`; `t`, `force`,
+//!   `stored_length`) that is not a finite number (other CSV columns are not read), or
+//!   that the checks use and is larger than 1e100 in magnitude in their units (its
+//!   squares would overflow: no physical value is near it); a column `t` off the
+//!   cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at 0; a `.npy`
+//!   header whose shape does not match the file's size.
 
+mod json;
 mod npy;
 mod table;
 
 pub use npy::{NpyWriter, read_npy};
 pub use table::{Table, TrajectoryFile, read_table};
 
+use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
+use crate::fem::noise::NoiseModel;
+use crate::input::{MAX_METADATA_BYTES, read_text};
 use crate::params::FilamentParams;
+use crate::scene::validate::MAX_ELEMENTS;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -207,6 +237,108 @@ pub struct Discretization {
     pub dt: Option<f64>,
 }
 
+/// The most integration steps per row (`dt_sample / discretization.dt`) of a modelled
+/// discretization, as scene files allow per trajectory.
+pub const MAX_STEPS_PER_ROW: f64 = 1e10;
+
+/// The largest `discretization.dt` of a modelled discretization, in τ₁ (as `dt_tau1` in
+/// scene files).
+pub const MAX_DT_TAU1: f64 = 100.0;
+
+impl Discretization {
+    /// Whether this tool models the discretization (`fem` or `spectral`): its
+    /// `elements`, `integrator`, `noise` and `dt` then size the reference `check`
+    /// builds, and are bounded.
+    pub fn is_modelled(&self) -> bool {
+        matches!(self.model.as_str(), "fem" | "spectral")
+    }
+
+    /// The integrator (default `exact-modal`), if its name is one of the scene files'.
+    pub fn integrator_kind(&self) -> Option<IntegratorKind> {
+        parse_name(self.integrator.as_deref().unwrap_or("exact-modal"))
+    }
+
+    /// The noise model (default `consistent`), if its name is one of the scene files'.
+    pub fn noise_model(&self) -> Option<NoiseModel> {
+        parse_name(self.noise.as_deref().unwrap_or("consistent"))
+    }
+
+    /// Checks the discretization of run `k` (rows every `dt_sample`, a filament of
+    /// relaxation time `tau1`): `dt` positive and finite; for a modelled one, `elements`
+    /// in [1, [`MAX_ELEMENTS`]], known integrator and noise names, and `dt` in
+    /// [`dt_sample`/[`MAX_STEPS_PER_ROW`], [`MAX_DT_TAU1`] τ₁]; on failure (key, message).
+    fn validate(
+        &self,
+        k: usize,
+        dt_sample: f64,
+        tau1: f64,
+    ) -> std::result::Result<(), (String, String)> {
+        let key = |s: &str| format!("runs[{k}].discretization.{s}");
+        if let Some(dt) = self.dt
+            && !(dt.is_finite() && dt > 0.0)
+        {
+            return Err((
+                key("dt"),
+                format!("must be a positive finite time, got {dt}"),
+            ));
+        }
+        if !self.is_modelled() {
+            return Ok(());
+        }
+        if let Some(e) = self.elements
+            && !(1..=MAX_ELEMENTS).contains(&e)
+        {
+            return Err((
+                key("elements"),
+                format!(
+                    "must be in [1, {MAX_ELEMENTS}] (as mesh.elements in scene files) for model {:?}, got {e}",
+                    self.model
+                ),
+            ));
+        }
+        if self.integrator_kind().is_none() {
+            return Err((
+                key("integrator"),
+                format!(
+                    "must be an integrator name as in scene files ({}) for model {:?}, got {:?}",
+                    IntegratorKind::list(&IntegratorKind::ALL),
+                    self.model,
+                    self.integrator.as_deref().unwrap_or_default()
+                ),
+            ));
+        }
+        if self.noise_model().is_none() {
+            return Err((
+                key("noise"),
+                format!(
+                    "must be a noise model name as in scene files ({}) for model {:?}, got {:?}",
+                    NoiseModel::ALL.map(|n| n.name()).join(" or "),
+                    self.model,
+                    self.noise.as_deref().unwrap_or_default()
+                ),
+            ));
+        }
+        if let Some(dt) = self.dt {
+            let (lo, hi) = (dt_sample / MAX_STEPS_PER_ROW, MAX_DT_TAU1 * tau1);
+            if !(lo..=hi).contains(&dt) {
+                return Err((
+                    key("dt"),
+                    format!(
+                        "must be in [dt_sample/1e10, 100 tau1] = [{lo:e}, {hi:e}] (at most 1e10 steps per row; at most 100 tau1, as dt_tau1 in scene files) for model {:?}, got {dt:e}",
+                        self.model
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A name as the scene files spell it (`crank-nicolson`), parsed by serde.
+fn parse_name<T: serde::de::DeserializeOwned>(name: &str) -> Option<T> {
+    serde_json::from_value(serde_json::Value::String(name.to_string())).ok()
+}
+
 /// The column names of a run's files, in order (see the [module docs](self)).
 pub fn columns(dims: usize, positions: usize, modes: usize) -> Vec<String> {
     let mut c = vec!["t".to_string()];
@@ -223,20 +355,23 @@ pub fn columns(dims: usize, positions: usize, modes: usize) -> Vec<String> {
 impl DataSidecar {
     /// Reads and checks the sidecar of data directory `dir`.
     ///
+    /// The sidecar is read as a regular file of at most [`MAX_METADATA_BYTES`]
+    /// ([`crate::input::read_text`]: a FIFO is refused at once, a byte-order mark
+    /// dropped).
+    ///
     /// # Errors
-    /// [`Error::Io`] if unreadable; [`Error::Scene`] naming the sidecar, the key, the value
-    /// and the allowed range if it is not a valid version-1 sidecar.
+    /// [`Error::Scene`] naming the sidecar, the key, the value and the allowed range if it
+    /// cannot be read or is not a valid version-1 sidecar (see [What is
+    /// refused](self#what-is-refused)).
     pub fn load(dir: &Path) -> Result<DataSidecar> {
         let path = dir.join(SIDECAR);
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let text = read_text(&path, "-", MAX_METADATA_BYTES)?;
+        json::parse(&path, &text)?;
         let sidecar: DataSidecar = serde_json::from_str(&text).map_err(|e| Error::Scene {
             file: path.clone(),
             key: "-".to_string(),
-            message: format!(
-                "not a {FORMAT} sidecar: {e} (line {}, column {})",
-                e.line(),
-                e.column()
-            ),
+            // serde_json's message ends in "at line L column C".
+            message: format!("not a {FORMAT} sidecar: {e}"),
         })?;
         sidecar.validate(&path)?;
         Ok(sidecar)
@@ -292,7 +427,7 @@ impl DataSidecar {
             return Err(bad("runs".into(), "must list at least one run".into()));
         }
         for (k, run) in self.runs.iter().enumerate() {
-            run.validate(k, f.length, self.runs.iter().take(k))
+            run.validate(k, f, self.runs.iter().take(k))
                 .map_err(|(key, message)| bad(key, message))?;
         }
         Ok(())
@@ -300,12 +435,12 @@ impl DataSidecar {
 }
 
 impl DataRun {
-    /// Checks run `k` of a sidecar (`earlier`: the runs before it), for a filament of
-    /// length `length`; on failure (key, message).
+    /// Checks run `k` of a sidecar (`earlier`: the runs before it), for filament
+    /// `filament`; on failure (key, message).
     fn validate<'a>(
         &self,
         k: usize,
-        length: f64,
+        filament: &DataFilament,
         mut earlier: impl Iterator<Item = &'a DataRun>,
     ) -> std::result::Result<(), (String, String)> {
         let key = |s: &str| format!("runs[{k}].{s}");
@@ -349,7 +484,11 @@ impl DataRun {
                 format!("must be a finite time >= 0, got {}", self.burn_in),
             ));
         }
-        self.validate_layout(k, length)
+        self.validate_layout(k, filament.length)?;
+        match &self.discretization {
+            Some(d) => d.validate(k, self.dt_sample, filament.params().tau1()),
+            None => Ok(()),
+        }
     }
 
     /// The columns and files of run `k` (for a filament of length `length`): positions
@@ -400,20 +539,153 @@ impl DataRun {
                 ));
             }
         }
-        if let Some(d) = &self.discretization
-            && let Some(dt) = d.dt
-            && !(dt.is_finite() && dt > 0.0)
-        {
-            return Err((
-                key("discretization.dt"),
-                format!("must be a positive finite time, got {dt}"),
-            ));
-        }
         Ok(())
     }
 
     /// The paths of the run's files under data directory `dir`.
     pub fn paths(&self, dir: &Path) -> Vec<PathBuf> {
         self.files.iter().map(|f| dir.join(f)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A valid sidecar of one `fem` run (τ₁ = 1/π⁴ ≈ 0.0103), as text.
+    const VALID: &str = r#"{ "format": "langevin-fem-trajectories", "version": 1, "dims": 2,
+  "filament": { "length": 1.0, "bending_rigidity": 1.0, "drag": 1.0, "kt": 1.0 },
+  "runs": [ { "name": "cn", "dt_sample": 1.0e-4, "start": "rest", "burn_in": 0.0,
+              "positions": [0.5], "modes": 2,
+              "discretization": { "model": "fem", "elements": 4,
+                                  "integrator": "crank-nicolson", "noise": "consistent", "dt": 1.0e-5 },
+              "files": ["cn/t0.csv"] } ] }"#;
+
+    /// `text` as the sidecar of a fresh directory (of its own: tests run in parallel),
+    /// loaded.
+    fn load(tag: &str, text: &str) -> Result<DataSidecar> {
+        static COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir =
+            std::env::temp_dir().join(format!("lfem-sidecar-{tag}-{n}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(SIDECAR), text).unwrap();
+        let r = DataSidecar::load(&dir);
+        std::fs::remove_dir_all(&dir).unwrap();
+        r
+    }
+
+    /// The refusal of `VALID` with `from` replaced by `to`: exit 2, naming the sidecar
+    /// and holding every string of `named`.
+    fn refused_with(from: &str, to: &str, named: &[&str]) {
+        assert!(VALID.contains(from), "{from}");
+        let e = load("bad", &VALID.replacen(from, to, 1)).unwrap_err();
+        assert_eq!(e.exit_code(), 2, "{e}");
+        let text = e.to_string();
+        assert!(text.contains(SIDECAR), "{text}");
+        for n in named {
+            assert!(text.contains(n), "{from} -> {to}: {n:?} not in {text}");
+        }
+    }
+
+    /// A valid sidecar loads, with or without a byte-order mark; optional text keys may be
+    /// null.
+    #[test]
+    fn valid_sidecars_load() {
+        let side = load("valid", VALID).unwrap();
+        assert_eq!(
+            side.runs[0].discretization.as_ref().unwrap().elements,
+            Some(4)
+        );
+        assert_eq!(load("bom", &format!("\u{feff}{VALID}")).unwrap(), side);
+        let null_noise = VALID.replace("\"consistent\"", "null");
+        let d = load("null", &null_noise).unwrap().runs[0]
+            .discretization
+            .clone();
+        assert_eq!(d.unwrap().noise, None);
+    }
+
+    /// Non-finite literals and nulls at numeric keys, named with their keys.
+    #[test]
+    fn non_numbers_are_refused_naming_the_key() {
+        refused_with(
+            "\"burn_in\": 0.0",
+            "\"burn_in\": Infinity",
+            &["`runs[0].burn_in`", "Infinity at line 3", "allow_nan=False"],
+        );
+        refused_with(
+            "\"dt\": 1.0e-5",
+            "\"dt\": null",
+            &["`runs[0].discretization.dt`", "must be a number, got null"],
+        );
+        refused_with(
+            "\"kt\": 1.0",
+            "\"kt\": null",
+            &["`filament.kt`", "got null"],
+        );
+    }
+
+    /// The numbers that size the reference of a modelled discretization are bounded,
+    /// and its names must be the scene files'; another model's are only reported.
+    #[test]
+    fn modelled_discretizations_are_bounded() {
+        for (e, v) in [("0", "got 0"), ("100000000", "got 100000000")] {
+            refused_with(
+                "\"elements\": 4",
+                &format!("\"elements\": {e}"),
+                &["`runs[0].discretization.elements`", "[1, 1000]", v],
+            );
+        }
+        for dt in ["1e-15", "2.0"] {
+            refused_with(
+                "\"dt\": 1.0e-5",
+                &format!("\"dt\": {dt}"),
+                &[
+                    "`runs[0].discretization.dt`",
+                    "1e10 steps per row",
+                    "100 tau1",
+                ],
+            );
+        }
+        refused_with(
+            "\"crank-nicolson\"",
+            "\"rk4\"",
+            &[
+                "`runs[0].discretization.integrator`",
+                "\"rk4\"",
+                "exact-modal",
+            ],
+        );
+        refused_with(
+            "\"consistent\"",
+            "\"white\"",
+            &[
+                "`runs[0].discretization.noise`",
+                "\"white\"",
+                "element-uniform",
+            ],
+        );
+        let other = VALID
+            .replace("\"fem\"", "\"finite-differences\"")
+            .replace("\"elements\": 4", "\"elements\": 100000");
+        assert!(load("other", &other).is_ok());
+    }
+
+    /// A FIFO named data.json is refused at once.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_fifo_sidecar_is_refused_at_once() {
+        let dir = std::env::temp_dir().join(format!("lfem-sidecar-fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(dir.join(SIDECAR))
+            .status()
+            .is_ok_and(|s| s.success());
+        if made {
+            let e = DataSidecar::load(&dir).unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            assert!(e.to_string().contains("FIFO"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -10,7 +10,7 @@
 //! what `run` writes and writes what `check` reads).
 
 use crate::error::{Error, Result};
-use std::io::{self, Read, Write};
+use std::io::{self, Write};
 use std::path::Path;
 
 const MAGIC: &[u8; 6] = b"\x93NUMPY";
@@ -95,39 +95,80 @@ impl<W: Write> NpyWriter<W> {
 
 /// Reads a float64 `.npy` file (versions 1–3, C order, little- or big-endian `f8`) of
 /// one or two dimensions: returns (rows, columns, row-major values); a 1-D array is one
-/// column.
+/// column. The file is read as a regular file of at most `max_bytes`
+/// ([`crate::input::read_bytes`]; `key` names what led to it), and its declared shape is
+/// compared with its size before anything is allocated.
 ///
 /// # Errors
-/// [`Error::Io`] if unreadable; [`Error::InvalidParameter`] naming the file if it is not
-/// such an array (another dtype, Fortran order, more dimensions, a truncated body).
-pub fn read_npy(path: &Path) -> Result<(usize, usize, Vec<f64>)> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse_npy(&bytes).map_err(|why| {
-        Error::invalid(
-            "trajectory file",
-            path.display(),
-            format!("a float64 .npy array of 1 or 2 dimensions in C order ({why})"),
-        )
-    })
+/// [`Error::Scene`] naming the file and `key` if it cannot be read or is not such an
+/// array (another dtype, Fortran order, more dimensions, a shape that does not match the
+/// size of the file).
+pub fn read_npy(path: &Path, key: &str, max_bytes: u64) -> Result<(usize, usize, Vec<f64>)> {
+    let bytes = crate::input::read_bytes(path, key, max_bytes)?;
+    parse_npy(&bytes).map_err(|why| npy_error(path, key, &why))
 }
 
-/// Parses the bytes of a `.npy` file (see [`read_npy`]); on failure, why.
-fn parse_npy(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), String> {
+/// The error of `.npy` file `path` (at `key`) that is not a float64 array: `why`.
+pub(super) fn npy_error(path: &Path, key: &str, why: &str) -> Error {
+    crate::input::refused(
+        path,
+        key,
+        format!("must be a float64 .npy array of 1 or 2 dimensions in C order: {why}"),
+    )
+}
+
+/// Parses the bytes of a `.npy` file (see [`read_npy`]); on failure, why. Never panics
+/// and never allocates more than the file's size, whatever the header says.
+pub(super) fn parse_npy(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), String> {
     if bytes.len() < 10 || &bytes[..6] != MAGIC {
         return Err("no NumPy magic string".into());
     }
     let (len, start) = match bytes[6] {
-        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10usize),
         2 | 3 if bytes.len() >= 12 => (
             u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
             12,
         ),
-        v => return Err(format!("format version {v}")),
+        v => return Err(format!("format version {v} (1, 2 or 3 expected)")),
     };
-    let header = bytes
-        .get(start..start + len)
-        .and_then(|h| std::str::from_utf8(h).ok())
-        .ok_or("truncated header")?;
+    let data_start = start
+        .checked_add(len)
+        .filter(|&end| end <= bytes.len())
+        .ok_or_else(|| {
+            format!(
+                "truncated header: it declares {len} bytes, the file holds {} after the preamble",
+                bytes.len() - start
+            )
+        })?;
+    let header = std::str::from_utf8(&bytes[start..data_start])
+        .map_err(|_| "header is not text".to_string())?;
+    let (big, rows, cols) = parse_header(header)?;
+    let body = &bytes[data_start..];
+    let declared = rows
+        .checked_mul(cols)
+        .and_then(|n| n.checked_mul(8).map(|b| (n, b)));
+    let Some((n, _)) = declared.filter(|&(_, b)| b == body.len()) else {
+        return Err(format!(
+            "its header declares shape ({rows}, {cols}), {} bytes of float64 data, but the file holds {} bytes of data after its {data_start}-byte header",
+            declared.map_or("more than 2^64".to_string(), |(_, b)| b.to_string()),
+            body.len()
+        ));
+    };
+    let mut values = Vec::with_capacity(n);
+    for chunk in body.chunks_exact(8) {
+        let b: [u8; 8] = chunk.try_into().map_err(|_| "short value".to_string())?;
+        values.push(if big {
+            f64::from_be_bytes(b)
+        } else {
+            f64::from_le_bytes(b)
+        });
+    }
+    Ok((rows, cols, values))
+}
+
+/// The dtype's byte order (big-endian?) and the shape (rows, columns) of a `.npy`
+/// header; on failure, why.
+fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), String> {
     let field = |name: &str| -> std::result::Result<&str, String> {
         let at = header
             .find(&format!("'{name}'"))
@@ -162,32 +203,11 @@ fn parse_npy(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), Stri
         .map(|s| s.trim_end_matches('L').parse::<usize>())
         .collect::<std::result::Result<_, _>>()
         .map_err(|_| format!("shape ({inner})"))?;
-    let (rows, cols) = match dims.as_slice() {
-        [r] => (*r, 1),
-        [r, c] => (*r, *c),
-        _ => return Err(format!("{} dimensions", dims.len())),
-    };
-    let n = rows.checked_mul(cols).ok_or("shape overflows")?;
-    let body = &bytes[start + len..];
-    if body.len() != n * 8 {
-        return Err(format!(
-            "{} data bytes for shape ({rows}, {cols}), {} expected",
-            body.len(),
-            n * 8
-        ));
+    match dims.as_slice() {
+        [r] => Ok((big, *r, 1)),
+        [r, c] => Ok((big, *r, *c)),
+        _ => Err(format!("{} dimensions", dims.len())),
     }
-    let mut values = Vec::with_capacity(n);
-    let mut chunk = [0u8; 8];
-    let mut reader = body;
-    for _ in 0..n {
-        reader.read_exact(&mut chunk).map_err(|e| e.to_string())?;
-        values.push(if big {
-            f64::from_be_bytes(chunk)
-        } else {
-            f64::from_le_bytes(chunk)
-        });
-    }
-    Ok((rows, cols, values))
 }
 
 #[cfg(test)]
@@ -222,6 +242,114 @@ mod tests {
         f4[at + 2] = b'4';
         assert!(parse_npy(&f4).unwrap_err().contains("dtype"));
         assert!(NpyWriter::new(Vec::new(), 2, 1).unwrap().finish().is_err());
+    }
+
+    /// A valid file of `rows` × `cols` values `0, 1, 2, …`.
+    fn sample(rows: u64, cols: usize) -> Vec<u8> {
+        let mut w = NpyWriter::new(Vec::new(), rows, cols).unwrap();
+        for r in 0..rows {
+            let row: Vec<f64> = (0..cols).map(|c| (r as usize * cols + c) as f64).collect();
+            w.push_row(&row).unwrap();
+        }
+        w.finish().unwrap()
+    }
+
+    /// `bytes` with the header's shape replaced by `shape` (the header length kept by
+    /// padding, so only the shape changes).
+    fn with_shape(bytes: &[u8], shape: &str) -> Vec<u8> {
+        let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        let header = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
+        let open = header.find("'shape': (").unwrap() + 9;
+        let close = open + header[open..].find(')').unwrap() + 1;
+        let mut h = format!("{}{shape}{}", &header[..open], &header[close..]);
+        h = format!("{:<width$}\n", h.trim_end(), width = len - 1);
+        assert_eq!(h.len(), len, "{h}");
+        let mut out = bytes[..10].to_vec();
+        out.extend(h.as_bytes());
+        out.extend(&bytes[10 + len..]);
+        out
+    }
+
+    /// Headers declaring more data than the file holds (2^61 values, a product that
+    /// overflows, more rows) are refused with the shape and the byte counts, before any
+    /// allocation; a header length beyond the file is a truncated header.
+    #[test]
+    fn declared_shapes_are_compared_with_the_file_size() {
+        let bytes = sample(2, 3);
+        assert_eq!(parse_npy(&bytes).unwrap().0, 2);
+        let e = parse_npy(&with_shape(&bytes, "(2305843009213693952, 1)")).unwrap_err();
+        assert!(
+            e.contains("shape (2305843009213693952, 1)")
+                && e.contains("more than 2^64")
+                && e.contains("48 bytes of data"),
+            "{e}"
+        );
+        let e = parse_npy(&with_shape(&bytes, "(3, 3)")).unwrap_err();
+        assert!(
+            e.contains("shape (3, 3), 72 bytes") && e.contains("holds 48 bytes"),
+            "{e}"
+        );
+        let e = parse_npy(&with_shape(&bytes, "(4294967296, 4294967296)")).unwrap_err();
+        assert!(e.contains("more than 2^64"), "{e}");
+        let mut long = bytes.clone();
+        long[8..10].copy_from_slice(&u16::MAX.to_le_bytes());
+        assert!(parse_npy(&long).unwrap_err().contains("truncated header"));
+        let mut v2 = bytes.clone();
+        v2[6] = 2;
+        assert!(parse_npy(&v2).is_err());
+        v2[6] = 9;
+        assert!(parse_npy(&v2).unwrap_err().contains("version 9"));
+    }
+
+    /// Random damage to a valid file (bytes overwritten, the file cut, bytes inserted,
+    /// header fields and lengths rewritten) never panics: each copy is read or refused.
+    #[test]
+    fn damaged_files_never_panic() {
+        let valid = sample(5, 4);
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let specials: [&[u8]; 8] = [
+            b"(18446744073709551615, 2)",
+            b"(9223372036854775807,)",
+            b"()",
+            b"(1, 2, 3)",
+            b"(-1, 2)",
+            b"'<f4'",
+            b"\xff\xff",
+            b"True",
+        ];
+        for _ in 0..20_000 {
+            let mut b = valid.clone();
+            for _ in 0..(1 + next() % 4) {
+                let at = (next() as usize) % b.len().max(1);
+                match next() % 6 {
+                    0 => b[at] = next() as u8,
+                    1 => b.truncate(at),
+                    2 => b.insert(at, next() as u8),
+                    3 if at < 10 => b[at] = [0, 1, 2, 3, 0xff][next() as usize % 5],
+                    4 => {
+                        let s = specials[next() as usize % specials.len()];
+                        let end = (at + s.len()).min(b.len());
+                        b.splice(at..end, s.iter().copied());
+                    }
+                    _ => {
+                        if b.len() > 11 {
+                            b[8] = next() as u8;
+                            b[9] = next() as u8;
+                        }
+                    }
+                }
+                if b.is_empty() {
+                    break;
+                }
+            }
+            let _ = parse_npy(&b);
+        }
     }
 
     #[test]

@@ -53,6 +53,10 @@ pub const MAX_POINTS: usize = 100;
 /// every 0.5 τ1, and its estimators need at least 32 samples per trajectory.
 pub const MIN_LINEAR_DURATION_TAU1: f64 = 16.0;
 
+/// The most elements (or spectral modes) of a mesh: `mesh.elements` is in
+/// [1, `MAX_ELEMENTS`], and so is a data sidecar's `discretization.elements`.
+pub const MAX_ELEMENTS: usize = 1000;
+
 /// Fewest sampled steps of a linear run per trajectory (`duration_tau1 / dt_tau1`): below
 /// this the series of the stiff modes, sampled every step, are too short for their
 /// autocorrelation-aware estimators.
@@ -281,12 +285,12 @@ impl Scene {
         if self.checks.is_empty() {
             return Err(bad(self, "checks", &"[]", "a non-empty list"));
         }
-        if !(1..=1000).contains(&self.mesh.elements) {
+        if !(1..=MAX_ELEMENTS).contains(&self.mesh.elements) {
             return Err(bad(
                 self,
                 "mesh.elements",
                 &self.mesh.elements,
-                "in [1, 1000]",
+                &format!("in [1, {MAX_ELEMENTS}]"),
             ));
         }
         let g = self.mesh.grading;

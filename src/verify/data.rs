@@ -18,10 +18,10 @@
 //! simulates, and judged by the same checks ([`crate::verify::checks::linear_checks`]),
 //! family-wise correction and report.
 
-use crate::data::{DataRun, DataSidecar, Discretization, Start, columns, read_table};
+use crate::data::{DataRun, DataSidecar, MAX_STEPS_PER_ROW, Start, Table, columns, read_table};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
-use crate::fem::noise::NoiseModel;
+use crate::input::{human_bytes, open_regular, refused};
 use crate::params::FilamentParams;
 use crate::scene::compression::{CompressionRun, CompressionTheoryTable, ForceRecord};
 use crate::scene::linear::{
@@ -49,25 +49,28 @@ pub struct DataCheck {
 /// Relative tolerance on a time or position of the data matching a scene's.
 const MATCH: f64 = 1e-6;
 
-/// Prepares the checks of data run `k` of `sidecar` (read from `dir`) against `scene`.
+/// Prepares the checks of data run `k` of `sidecar` (read from `dir`) against `scene`,
+/// reading each trajectory file as a regular file of at most `max_bytes`.
 ///
 /// # Errors
 /// [`Error::Scene`] naming the sidecar (or scene) key when the data cannot serve the
-/// scene's checks (another model kind, too few rows for the slowest checked series);
-/// [`Error::InvalidParameter`] naming a trajectory file that does not hold what the
-/// sidecar says; [`Error::Io`] if unreadable.
+/// scene's checks (another data kind, too few rows for the slowest checked series, a
+/// discretization this tool cannot build), and naming a trajectory file and its key
+/// `runs[k].files[j]` when it does not hold what the sidecar says (see the [data
+/// format](crate::data#what-is-refused)).
 pub fn prepare_data_check(
     scene: &Scene,
     sidecar: &DataSidecar,
     dir: &Path,
     k: usize,
+    max_bytes: u64,
 ) -> Result<DataCheck> {
     check_linear_data(scene, sidecar, dir, k)?;
     let data = &sidecar.runs[k];
     let filament = sidecar.filament.params();
     let continuum = HingedBeam::new(filament)?;
     let mut notes = Vec::new();
-    let discrete = discrete_run(scene, filament, data, &mut notes)?;
+    let discrete = discrete_run(scene, filament, (dir, k), data, &mut notes)?;
     let spec = data_spec(scene, data);
     let (modes, scale, discrete) = mode_references(scene, data, &continuum, discrete, &mut notes);
     let d = discrete.as_ref();
@@ -107,7 +110,7 @@ pub fn prepare_data_check(
         profile_cols: profile.3,
         tt_cols,
     };
-    let (records, products) = read_records(&run, sidecar, dir, k, &layout)?;
+    let (records, products) = read_records(&run, sidecar, dir, k, &layout, max_bytes)?;
     Ok(DataCheck {
         run,
         records,
@@ -125,19 +128,80 @@ fn sidecar_error(dir: &Path, k: usize, key: &str, message: String) -> Error {
     }
 }
 
-/// Refuses data run `k` unless `scene` is linear, the dimensions agree, the run has no
-/// strain and every listed file exists.
+/// Whether `scene` is a compression scene (its data are compression runs).
+fn is_compression(scene: &Scene) -> bool {
+    scene.compression.is_some() || scene.model == ModelKind::Compression
+}
+
+/// Refuses data of the other kind than `scene`'s, first, saying so: linear runs (no
+/// `strain_ratio`) against a compression scene, or compression runs (every run with a
+/// `strain_ratio`) against a linear scene. Data mixing both kinds are refused later,
+/// naming the first run of the wrong kind.
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar in `dir`, key `runs`.
+pub fn check_data_kind(scene: &Scene, sidecar: &DataSidecar, dir: &Path) -> Result<()> {
+    let strained = sidecar
+        .runs
+        .iter()
+        .filter(|r| r.strain_ratio.is_some())
+        .count();
+    let message = if is_compression(scene) && strained == 0 {
+        format!(
+            "the data are linear runs (no strain_ratio) but scene {} ({}) is a compression scene: check them with a linear scene, or give strain_ratio per run",
+            scene.name,
+            scene.path.display()
+        )
+    } else if !is_compression(scene) && strained == sidecar.runs.len() {
+        format!(
+            "the data are compression runs (each with a strain_ratio) but scene {} ({}) is a linear scene: check them with a compression scene",
+            scene.name,
+            scene.path.display()
+        )
+    } else {
+        return Ok(());
+    };
+    Err(refused(&dir.join(crate::data::SIDECAR), "runs", message))
+}
+
+/// Refuses the trajectory files of `sidecar` (in `dir`) unless each is a regular file
+/// and together they hold at most `max_bytes` (the memory cap of `check`): nothing is
+/// read above it.
+///
+/// # Errors
+/// [`Error::Scene`] naming a file that is missing or not a regular file and its key
+/// `runs[k].files[j]`, or the data directory, the total and the cap.
+pub fn require_data_size(sidecar: &DataSidecar, dir: &Path, max_bytes: u64) -> Result<()> {
+    let mut total: u64 = 0;
+    let mut files = 0usize;
+    for (k, run) in sidecar.runs.iter().enumerate() {
+        for (j, path) in run.paths(dir).iter().enumerate() {
+            let (_, len) = open_regular(path, &format!("runs[{k}].files[{j}]"))?;
+            total = total.saturating_add(len);
+            files += 1;
+        }
+    }
+    if total > max_bytes {
+        return Err(refused(
+            dir,
+            "runs[*].files",
+            format!(
+                "the {files} trajectory files hold {total} bytes ({}), more than the {max_bytes} bytes ({}) a check may read: raise --max-memory-gib deliberately on a larger machine, or check fewer or shorter trajectories",
+                human_bytes(total),
+                human_bytes(max_bytes)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses data run `k` unless `scene` is linear, the dimensions agree and the run has
+/// no strain.
 fn check_linear_data(scene: &Scene, sidecar: &DataSidecar, dir: &Path, k: usize) -> Result<()> {
     let sidecar_path = dir.join(crate::data::SIDECAR);
     let data = &sidecar.runs[k];
     let key_err = |key: &str, message: String| sidecar_error(dir, k, key, message);
-    if scene.compression.is_some() || scene.model == ModelKind::Compression {
-        return Err(Error::Scene {
-            file: scene.path.clone(),
-            key: "model".into(),
-            message: "check reads linear scenes (model = \"fem\" or \"spectral\"); the data format has no compression runs yet".into(),
-        });
-    }
+    check_data_kind(scene, sidecar, dir)?;
     if sidecar.dims != scene.dims {
         return Err(Error::Scene {
             file: sidecar_path.clone(),
@@ -158,24 +222,6 @@ fn check_linear_data(scene: &Scene, sidecar: &DataSidecar, dir: &Path, k: usize)
                 scene.name
             ),
         ));
-    }
-    require_files(data, dir, k)
-}
-
-/// Refuses data run `k` unless every file it lists exists.
-fn require_files(data: &DataRun, dir: &Path, k: usize) -> Result<()> {
-    for (j, path) in data.paths(dir).iter().enumerate() {
-        if !path.is_file() {
-            return Err(sidecar_error(
-                dir,
-                k,
-                &format!("files[{j}]"),
-                format!(
-                    "must name a trajectory file in the data directory; {} is not a file",
-                    path.display()
-                ),
-            ));
-        }
     }
     Ok(())
 }
@@ -323,7 +369,9 @@ fn two_time_references(
             };
             let row = |time: f64| {
                 let r = time / dts;
-                ((r - r.round()).abs() <= MATCH * r.max(1.0)).then(|| r.round() as u64)
+                ((r - r.round()).abs() <= MATCH * r.max(1.0))
+                    .then(|| r.round())
+                    .and_then(row_index)
             };
             match (
                 column_of(data, length, x),
@@ -365,22 +413,111 @@ fn two_time_references(
 /// Two-time references and the columns of their x and y.
 type TwoTimeRefs = (Vec<TwoTimeReference>, Vec<(usize, usize)>);
 
-/// Reads every file of data run `k` into records and two-time products; refuses
-/// trajectories too short for the sparsest checked series.
+/// A row index `r` (a whole number ≥ 0) as a count, if it is one that a table can
+/// have (at most 2⁵³, where every whole number is an `f64`).
+fn row_index(r: f64) -> Option<u64> {
+    (r.is_finite() && (0.0..=9.007_199_254_740_992e15).contains(&r)).then_some(r as u64)
+}
+
+/// The first row of a trajectory starting at `t0` at or after the burn-in of `data`
+/// (`usize::MAX` if the burn-in is beyond any row a file can hold).
+fn first_row(data: &DataRun, t0: f64) -> usize {
+    let r = ((data.burn_in - t0) / data.dt_sample - MATCH)
+        .ceil()
+        .max(0.0);
+    row_index(r).map_or(usize::MAX, |r| usize::try_from(r).unwrap_or(usize::MAX))
+}
+
+/// Reads trajectory file `path` of data run `data` (key `key` of the sidecar, at most
+/// `max_bytes`) with its `columns`, and checks its time column, every kind of data
+/// alike: the first row at t = 0 if the run starts from rest, and row `r` at
+/// `t₀ + r·dt_sample` within a relative 1e-6 of `dt_sample`.
+///
+/// # Errors
+/// [`read_table`]'s; [`Error::Scene`] naming the file, the key, the data row (from 1),
+/// the expected and the actual t.
+fn read_trajectory(
+    data: &DataRun,
+    path: &Path,
+    key: &str,
+    columns: &[String],
+    max_bytes: u64,
+) -> Result<Table> {
+    let table = read_table(path, key, columns, max_bytes)?;
+    let bad = |what: String| refused(path, key, what);
+    let dts = data.dt_sample;
+    let t0 = table.get(0, 0);
+    if data.start == Start::Rest && t0.abs() > MATCH * dts {
+        return Err(bad(format!(
+            "column \"t\", data row 1: must be t = 0 (the sidecar says start = \"rest\"), got t = {t0:?}"
+        )));
+    }
+    for r in 0..table.rows {
+        let t = table.get(r, 0);
+        let expected = t0 + r as f64 * dts;
+        let off = (t - expected).abs();
+        if off.is_nan() || off > MATCH * dts + 1e-12 * expected.abs() {
+            return Err(bad(format!(
+                "column \"t\", data row {}: must be t = {expected:?} (rows every dt_sample = {dts:?} from t = {t0:?}), got t = {t:?}",
+                r + 1
+            )));
+        }
+    }
+    Ok(table)
+}
+
+/// The largest magnitude of a value the checks use, in their units (deflections in the
+/// filament's length unit, modal amplitudes in the reference's, forces in F_c0): the
+/// squares, products and squared sums of a billion of them stay far from overflow.
+/// Larger finite values are no physical data (a filament is at most 1e30 long), and
+/// would make an estimator fail as if the data were too few.
+const MAX_MAGNITUDE: f64 = 1e100;
+
+/// Refuses column `col` of `table` (file `path`, key `key`) if a value of it times
+/// `factor` (the change to the checks' units) exceeds [`MAX_MAGNITUDE`], naming the
+/// column, the data row and the value.
+fn require_magnitude(
+    table: &Table,
+    (path, key): (&Path, &str),
+    col: usize,
+    factor: f64,
+) -> Result<()> {
+    let limit = MAX_MAGNITUDE / factor.abs();
+    match (0..table.rows).find(|&r| table.get(r, col).abs() > limit) {
+        None => Ok(()),
+        Some(r) => Err(refused(
+            path,
+            key,
+            format!(
+                "column {:?}, data row {}: must be at most {limit:e} in magnitude (the checks sum its squares and products, which must stay finite), got {:?}",
+                table.columns[col],
+                r + 1,
+                table.get(r, col)
+            ),
+        )),
+    }
+}
+
+/// Reads every file of data run `k` (in `dir`, each of at most `max_bytes`) into
+/// records and two-time products; refuses trajectories too short for the sparsest
+/// checked series.
 fn read_records(
     run: &LinearRun,
     sidecar: &DataSidecar,
     dir: &Path,
     k: usize,
     layout: &Layout,
+    max_bytes: u64,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let data = &sidecar.runs[k];
     let dts = data.dt_sample;
     let cols = columns(sidecar.dims, data.positions.len(), data.modes);
     let mut records = Vec::new();
     let mut products = Vec::new();
-    for path in data.paths(dir) {
-        let (rec, tt) = read_record(run, data, &path, &cols, layout)?;
+    for (j, path) in data.paths(dir).iter().enumerate() {
+        let key = format!("runs[{k}].files[{j}]");
+        let table = read_trajectory(data, path, &key, &cols, max_bytes)?;
+        let (rec, tt) = read_record(run, data, (path, &key), &table, layout)?;
         records.push(rec);
         products.push(tt);
     }
@@ -398,10 +535,10 @@ fn read_records(
             k,
             "files",
             format!(
-                "each trajectory needs at least {} stationary rows after burn_in = {} (mode 1 is taken every {sparsest} rows of dt_sample = {dts}, {MIN_SERIES_LEN} samples at least), got {}; write longer trajectories",
-                sparsest * MIN_SERIES_LEN as u64,
+                "each trajectory needs at least {} stationary rows after burn_in = {:?} (mode 1 is taken every {sparsest} rows of dt_sample = {dts:?}, {MIN_SERIES_LEN} samples at least), got {}; write longer trajectories",
+                sparsest.saturating_mul(MIN_SERIES_LEN as u64),
                 data.burn_in,
-                shortest as u64 * sparsest
+                (shortest as u64).saturating_mul(sparsest)
             ),
         ));
     }
@@ -416,47 +553,39 @@ struct Layout {
     tt_cols: Vec<(usize, usize)>,
 }
 
-/// Reads one trajectory file into the record `verify` would have built: the mode and
-/// profile series at their cadences after the burn-in (modal amplitudes in the
-/// reference's units), and the two-time products.
+/// Turns the trajectory `table` (read from file `path`, sidecar key `key`) into the
+/// record `verify` would have built: the mode and profile series at their cadences
+/// after the burn-in (modal amplitudes in the reference's units), and the two-time
+/// products.
 fn read_record(
     run: &LinearRun,
     data: &DataRun,
-    path: &Path,
-    cols: &[String],
+    (path, key): (&Path, &str),
+    table: &Table,
     layout: &Layout,
 ) -> Result<(TrajectoryRecord, Vec<f64>)> {
-    let table = read_table(path, cols)?;
-    let bad = |what: String| Error::invalid("trajectory file", path.display(), what);
-    if table.rows == 0 {
-        return Err(bad("at least one row".into()));
-    }
-    let dts = data.dt_sample;
-    let t0 = table.get(0, 0);
-    if data.start == Start::Rest && t0.abs() > MATCH * dts {
-        return Err(bad(format!(
-            "a first row at t = 0 (the sidecar says start = \"rest\"), got t = {t0}"
-        )));
-    }
-    for r in 0..table.rows {
-        let t = table.get(r, 0);
-        let expected = t0 + r as f64 * dts;
-        let off = (t - expected).abs();
-        if off.is_nan() || off > MATCH * dts + 1e-12 * expected.abs() {
-            return Err(bad(format!(
-                "rows every dt_sample = {dts} (row {} should be at t = {expected}, got {t})",
-                r + 1
-            )));
-        }
-    }
-    let first = ((data.burn_in - t0) / dts - MATCH).ceil().max(0.0) as usize;
+    let first = first_row(data, table.get(0, 0));
     let c = run.components;
     let nm = run.reference.modes.len();
     let np = layout.n_positions;
-    let rows_from = |every: u64| (first..table.rows).step_by(every as usize);
+    let rows_from = |every: u64| {
+        (first.min(table.rows)..table.rows).step_by(usize::try_from(every).unwrap_or(usize::MAX))
+    };
     // Column indices: t, w_j, (v_j), aw_n, (av_n).
     let deflection_col = |k: usize, j: usize| 1 + k * np + j;
     let mode_col = |k: usize, i: usize| 1 + c * np + k * layout.n_modes_data + i;
+    let used = layout.tt_cols.iter().flat_map(|&(x, y)| [x, y]);
+    for j in layout.profile_cols.iter().copied().chain(used) {
+        for k in 0..c {
+            require_magnitude(table, (path, key), deflection_col(k, j), 1.0)?;
+        }
+    }
+    for i in 0..nm {
+        for k in 0..c {
+            let factor = 1.0 / run.amplitude_scale[i];
+            require_magnitude(table, (path, key), mode_col(k, i), factor)?;
+        }
+    }
     let mut modes = Vec::with_capacity(c * nm);
     for k in 0..c {
         for i in 0..nm {
@@ -481,13 +610,21 @@ fn read_record(
     let tt = &run.reference.two_time;
     let mut two_time = vec![0.0; c * tt.len()];
     for (j, (q, &(cx, cy))) in tt.iter().zip(&layout.tt_cols).enumerate() {
-        let (rt, re) = (q.t_step as usize, q.eta_step as usize);
-        if re >= table.rows {
-            return Err(bad(format!(
-                "rows up to t = {} for the two-time point at eta = {} (from rest), got {} rows",
-                q.eta, q.eta, table.rows
-            )));
-        }
+        let on_rows = |step: u64| usize::try_from(step).ok().filter(|&r| r < table.rows);
+        let (Some(rt), Some(re)) = (on_rows(q.t_step), on_rows(q.eta_step)) else {
+            return Err(refused(
+                path,
+                key,
+                format!(
+                    "must have rows up to t = {:?} for the two-time point at eta = {:?} (from rest; row {} of dt_sample = {:?}), got {} rows",
+                    q.eta,
+                    q.eta,
+                    q.eta_step.saturating_add(1),
+                    data.dt_sample,
+                    table.rows
+                ),
+            ));
+        };
         for k in 0..c {
             two_time[k * tt.len() + j] =
                 table.get(rt, deflection_col(k, cx)) * table.get(re, deflection_col(k, cy));
@@ -531,6 +668,7 @@ fn data_spec(scene: &Scene, data: &DataRun) -> RunSpec {
 fn discrete_run(
     scene: &Scene,
     filament: FilamentParams,
+    (dir, k): (&Path, usize),
     data: &DataRun,
     notes: &mut Vec<String>,
 ) -> Result<Option<LinearRun>> {
@@ -555,11 +693,26 @@ fn discrete_run(
         ));
         return Ok(None);
     };
-    let name_of = |v: &Option<String>, default: &str| v.clone().unwrap_or(default.into());
-    let integrator: IntegratorKind = parse_name(&name_of(&d.integrator, "exact-modal"))
-        .ok_or_else(|| discretization_error(data, "integrator", d))?;
-    let noise: NoiseModel = parse_name(&name_of(&d.noise, "consistent"))
-        .ok_or_else(|| discretization_error(data, "noise", d))?;
+    let key_err = |key: &str, message: String| sidecar_error(dir, k, key, message);
+    // Names and ranges were checked with the sidecar (`DataSidecar::validate`).
+    let unknown = |key: &str| key_err(key, "must be a name as in scene files".into());
+    let integrator = d
+        .integrator_kind()
+        .ok_or_else(|| unknown("discretization.integrator"))?;
+    if !IntegratorKind::LINEAR.contains(&integrator) {
+        return Err(key_err(
+            "discretization.integrator",
+            format!(
+                "must be an integrator of the linear filament for linear data ({}), got {integrator} (on the linear problem metropolis-crank-nicolson equals crank-nicolson)",
+                IntegratorKind::list(&IntegratorKind::LINEAR)
+            ),
+        ));
+    }
+    let noise = d
+        .noise_model()
+        .ok_or_else(|| unknown("discretization.noise"))?;
+    let tau1 = filament.tau1();
+    fits(scene, data, (model, elements, dt / tau1)).map_err(|(key, m)| key_err(key, m))?;
     let mut scene = scene.clone();
     scene.filament = FilamentParams {
         stretch_rigidity: scene.filament.stretch_rigidity,
@@ -571,24 +724,68 @@ fn discrete_run(
     let spec = RunSpec {
         integrator,
         noise,
-        dt_tau1: dt / filament.tau1(),
+        dt_tau1: dt / tau1,
         ..data_spec(&scene, data)
     };
-    LinearRun::prepare(&scene, &spec).map(Some)
+    // The input errors of the preparation are the discretization's: say where it is.
+    LinearRun::prepare(&scene, &spec)
+        .map(Some)
+        .map_err(|e| match e {
+            Error::UnstableTimeStep { .. } => key_err("discretization.dt", e.to_string()),
+            Error::InvalidParameter { .. } => key_err("discretization", e.to_string()),
+            other => other,
+        })
 }
 
-/// A name as the scene files spell it (`crank-nicolson`), parsed by serde.
-fn parse_name<T: serde::de::DeserializeOwned>(name: &str) -> Option<T> {
-    serde_json::from_value(serde_json::Value::String(name.to_string())).ok()
-}
-
-/// An unknown integrator or noise name in a discretization.
-fn discretization_error(data: &DataRun, key: &str, d: &Discretization) -> Error {
-    Error::invalid(
-        format!("discretization.{key} of data run {}", data.name),
-        format!("{d:?}"),
-        "an integrator (euler-maruyama, backward-euler, crank-nicolson, exact-modal) and noise (consistent, element-uniform) as in scene files",
-    )
+/// Whether the modelled discretization `(model, elements, dt/τ₁)` of data run `data`
+/// can serve `scene`: it carries at least the modes the scene checks, and (from rest)
+/// puts every two-time point of the scene at most 1e10 steps from rest; on failure the
+/// key under `runs[k]` and the message.
+fn fits(
+    scene: &Scene,
+    data: &DataRun,
+    (model, elements, dt_tau1): (ModelKind, usize, f64),
+) -> std::result::Result<(), (&'static str, String)> {
+    let carried = if model == ModelKind::Fem {
+        2 * elements
+    } else {
+        elements
+    };
+    if carried < scene.sampling.modes {
+        return Err((
+            "discretization.elements",
+            format!(
+                "is {elements} (model {}): it carries {carried} modes, fewer than the {} modes scene {} checks (sampling.modes): check the data with a scene of at most {carried} modes, or leave the discretization out to be judged against the continuum",
+                if model == ModelKind::Fem {
+                    "fem"
+                } else {
+                    "spectral"
+                },
+                scene.sampling.modes,
+                scene.name
+            ),
+        ));
+    }
+    let steps = |q: &[f64; 4]| q[3] / dt_tau1;
+    if data.start == Start::Rest
+        && let Some(q) = scene
+            .sampling
+            .two_time
+            .iter()
+            .find(|q| steps(q) > MAX_STEPS_PER_ROW)
+    {
+        return Err((
+            "discretization.dt",
+            format!(
+                "puts the two-time point at eta = {} tau1 of scene {} {:e} steps from rest, more than 1e10: give the step the data were made with, or leave the discretization out to be judged against the continuum; got dt = {:e} tau1",
+                q[3],
+                scene.name,
+                steps(q),
+                dt_tau1
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The compression data of one run name: every strain of the scene, the exact theory
@@ -608,14 +805,18 @@ pub struct CompressionDataCheck {
 /// Prepares the force checks of compression data: one [`CompressionDataCheck`] per run
 /// name of the sidecar, each holding one data run per strain of the scene.
 ///
+/// Each trajectory file is read as a regular file of at most `max_bytes`.
+///
 /// # Errors
-/// [`Error::Scene`] naming the sidecar key when a strain of the scene has no data, a
-/// data run has no strain, or EA is missing; file errors as [`read_table`]; the
-/// preparation's and the theory's errors.
+/// [`Error::Scene`] naming the sidecar key when the data are linear runs, a strain of
+/// the scene has no data, a data run has no strain, or EA is missing; file errors as
+/// [`read_table`] and those of the time column (see the [data
+/// format](crate::data#what-is-refused)); the preparation's and the theory's errors.
 pub fn prepare_compression_checks(
     scene: &Scene,
     sidecar: &DataSidecar,
     dir: &Path,
+    max_bytes: u64,
 ) -> Result<Vec<CompressionDataCheck>> {
     let sidecar_path = dir.join(crate::data::SIDECAR);
     let bad = |key: String, message: String| Error::Scene {
@@ -623,6 +824,7 @@ pub fn prepare_compression_checks(
         key,
         message,
     };
+    check_data_kind(scene, sidecar, dir)?;
     let Some(comp) = &scene.compression else {
         return Err(bad(
             "runs".into(),
@@ -658,7 +860,7 @@ pub fn prepare_compression_checks(
     }
     names
         .into_iter()
-        .map(|name| compression_data_check(scene, comp, sidecar, dir, name))
+        .map(|name| compression_data_check(scene, comp, sidecar, dir, name, max_bytes))
         .collect()
 }
 
@@ -671,6 +873,7 @@ fn compression_data_check(
     sidecar: &DataSidecar,
     dir: &Path,
     name: &str,
+    max_bytes: u64,
 ) -> Result<CompressionDataCheck> {
     let sidecar_path = dir.join(crate::data::SIDECAR);
     let bad = |key: String, message: String| Error::Scene {
@@ -734,7 +937,7 @@ fn compression_data_check(
             ));
         }
     }
-    let records = read_force_records(dir, &sidecar_path, &by_strain, run.euler_load)?;
+    let records = read_force_records(dir, &by_strain, run.euler_load, max_bytes)?;
     Ok(CompressionDataCheck {
         run,
         theory,
@@ -744,16 +947,17 @@ fn compression_data_check(
 }
 
 /// F/F_c0 of every trajectory file of the data runs `by_strain` (index in the sidecar,
-/// run), from the first row at or after each run's burn-in.
+/// run), from the first row at or after each run's burn-in; each file is read as a
+/// regular file of at most `max_bytes` and its time column checked.
 ///
 /// # Errors
-/// [`Error::Scene`] naming the sidecar key of a listed file that is not a file; the
-/// table reader's errors.
+/// As [`read_trajectory`]; [`Error::Scene`] naming a file and its key
+/// `runs[k].files[j]` if no row is at or after the burn-in.
 fn read_force_records(
     dir: &Path,
-    sidecar_path: &Path,
     by_strain: &[(usize, &DataRun)],
     euler_load: f64,
+    max_bytes: u64,
 ) -> Result<Vec<Vec<ForceRecord>>> {
     let cols: Vec<String> = crate::data::COMPRESSION_COLUMNS
         .iter()
@@ -763,21 +967,22 @@ fn read_force_records(
     for &(k, data) in by_strain {
         let mut at_strain = Vec::new();
         for (j, path) in data.paths(dir).iter().enumerate() {
-            if !path.is_file() {
-                return Err(Error::Scene {
-                    file: sidecar_path.to_path_buf(),
-                    key: format!("runs[{k}].files[{j}]"),
-                    message: format!(
-                        "must name a trajectory file; {} is not a file",
-                        path.display()
+            let key = format!("runs[{k}].files[{j}]");
+            let table = read_trajectory(data, path, &key, &cols, max_bytes)?;
+            require_magnitude(&table, (path, &key), 1, 1.0 / euler_load)?;
+            let first_row = first_row(data, table.get(0, 0));
+            if first_row >= table.rows {
+                return Err(refused(
+                    path,
+                    &key,
+                    format!(
+                        "has no data row at or after burn_in = {:?} (its {} rows end at t = {:?}): write longer trajectories",
+                        data.burn_in,
+                        table.rows,
+                        table.get(table.rows - 1, 0)
                     ),
-                });
+                ));
             }
-            let table = read_table(path, &cols)?;
-            let t0 = if table.rows > 0 { table.get(0, 0) } else { 0.0 };
-            let first_row = ((data.burn_in - t0) / data.dt_sample - MATCH)
-                .ceil()
-                .max(0.0) as usize;
             at_strain.push(ForceRecord {
                 force_ratio: (first_row..table.rows)
                     .map(|r| table.get(r, 1) / euler_load)
@@ -788,4 +993,421 @@ fn read_force_records(
         records.push(at_strain);
     }
     Ok(records)
+}
+
+#[cfg(test)]
+mod tests {
+    //! Refusals of data that cannot serve a scene (exit 2, naming the file, the key, the
+    //! row and the value), on small data directories written here: tiny-linear and
+    //! tiny-compression (tests/scenes/good) with trajectories of arbitrary finite values
+    //! (the preparation reads them; no estimator runs).
+
+    use super::*;
+    use crate::data::{DataFilament, Discretization, FORMAT, SIDECAR, TrajectoryFile, VERSION};
+    use std::path::PathBuf;
+
+    const CAP: u64 = 1 << 30;
+
+    fn scene(name: &str) -> Scene {
+        crate::scene::load_scene(&format!("tests/scenes/good/{name}.toml"), None).unwrap()
+    }
+
+    fn temp(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("lfem-vdata-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// The refusal of `r`: exit 2, its message holding every string of `named`.
+    fn refusal<T>(r: Result<T>, named: &[&str]) -> String {
+        let e = r.err().expect("refused");
+        let text = e.to_string();
+        assert_eq!(e.exit_code(), 2, "{text}");
+        for n in named {
+            assert!(text.contains(n), "{n:?} not in {text}");
+        }
+        text
+    }
+
+    /// A run of two trajectory files (CSV) named `name`, rows every `dt_sample`.
+    fn run(name: &str, dt_sample: f64, strain_ratio: Option<f64>) -> DataRun {
+        DataRun {
+            name: name.into(),
+            dt_sample,
+            start: if strain_ratio.is_some() {
+                Start::Stationary
+            } else {
+                Start::Rest
+            },
+            burn_in: 0.0,
+            positions: if strain_ratio.is_some() {
+                vec![]
+            } else {
+                vec![0.5]
+            },
+            modes: if strain_ratio.is_some() { 0 } else { 2 },
+            discretization: None,
+            files: (0..2)
+                .map(|j| format!("{name}-{}/t{j}.csv", strain_ratio.unwrap_or(0.0)))
+                .collect(),
+            strain_ratio,
+        }
+    }
+
+    /// Writes `sidecar` and `rows` rows of each of its files to `dir` (t = t₀ + r·dt_sample
+    /// with t₀ = 0 from rest, else 3·dt_sample; other columns arbitrary finite values),
+    /// then reads it back as `check` does.
+    fn write(dir: &Path, sidecar: &DataSidecar, rows: u64) -> DataSidecar {
+        for r in &sidecar.runs {
+            let cols = r.column_names(sidecar.dims);
+            let t0 = if r.start == Start::Rest {
+                0.0
+            } else {
+                3.0 * r.dt_sample
+            };
+            for path in r.paths(dir) {
+                let mut f = TrajectoryFile::create(&path, &cols, rows).unwrap();
+                for i in 0..rows {
+                    let mut row = vec![t0 + i as f64 * r.dt_sample];
+                    row.extend(
+                        (1..cols.len()).map(|c| ((i * 31 + c as u64 * 17) % 97) as f64 - 48.0),
+                    );
+                    f.push_row(&row).unwrap();
+                }
+                f.commit().unwrap();
+            }
+        }
+        std::fs::write(dir.join(SIDECAR), serde_json::to_string(sidecar).unwrap()).unwrap();
+        DataSidecar::load(dir).unwrap()
+    }
+
+    /// Linear data for tiny-linear (τ₁ = 1/π⁴): one run, rows every τ₁/100 from rest.
+    fn linear(runs: Vec<DataRun>) -> DataSidecar {
+        DataSidecar {
+            format: FORMAT.into(),
+            version: VERSION,
+            producer: "test".into(),
+            dims: 2,
+            filament: DataFilament {
+                length: 1.0,
+                bending_rigidity: 1.0,
+                drag: 1.0,
+                kt: 1.0,
+                stretch_rigidity: None,
+            },
+            runs,
+            provenance: None,
+            columns: None,
+        }
+    }
+
+    fn tau1() -> f64 {
+        1.0 / std::f64::consts::PI.powi(4)
+    }
+
+    /// Valid data are read; too few rows after the burn-in are still refused naming
+    /// `runs[k].files`; a two-time point beyond the rows names the file.
+    #[test]
+    fn linear_data_are_read_and_short_ones_refused() {
+        let dir = temp("linear");
+        let s = scene("tiny-linear");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 600);
+        let dc = prepare_data_check(&s, &side, &dir, 0, CAP).unwrap();
+        assert_eq!(dc.records.len(), 2);
+        assert_eq!(dc.two_time[0].len(), 1);
+        let side = write(&dir, &side, 300);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "data.json",
+                "runs[0].files",
+                "burn_in",
+                "write longer trajectories",
+            ],
+        );
+        let side = write(&dir, &side, 60);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "t0.csv",
+                "runs[0].files[0]",
+                "two-time point",
+                "got 60 rows",
+            ],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A tiny `dt_sample` with a huge burn-in (every index beyond any row, cadences
+    /// beyond u64) is refused as too short, without a panic.
+    #[test]
+    fn absurd_cadences_and_burn_ins_do_not_panic() {
+        let dir = temp("absurd");
+        let s = scene("tiny-linear");
+        let mut r = run("cn", 1e-300, None);
+        r.burn_in = 1e300;
+        let side = write(&dir, &linear(vec![r]), 40);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "runs[0].files",
+                "at least 18446744073709551615 stationary rows",
+            ],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The time column: a first row off 0 from rest, a row off the cadence, all equal
+    /// times (compression data too, through the same function).
+    #[test]
+    fn time_columns_are_on_the_cadence() {
+        let dir = temp("times");
+        let s = scene("tiny-linear");
+        let dts = tau1() / 100.0;
+        let side = write(&dir, &linear(vec![run("cn", dts, None)]), 600);
+        let path = dir.join(&side.runs[0].files[1]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let mut bad = lines.clone();
+        let row7 = lines[7].replacen(lines[7].split(',').next().unwrap(), "1.5", 1);
+        bad[7] = &row7;
+        std::fs::write(&path, bad.join("\n")).unwrap();
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "t1.csv",
+                "runs[0].files[1]",
+                "column \"t\", data row 7",
+                "got t = 1.5",
+            ],
+        );
+        let shifted = lines[1].replacen('0', "0.5", 1);
+        bad = lines.clone();
+        bad[1] = &shifted;
+        std::fs::write(&path, bad.join("\n")).unwrap();
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &["data row 1", "start = \"rest\"", "got t = 0.5"],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Finite values too large for the checks' sums (a deflection or a force of 1e300)
+    /// are refused naming the column, the data row and the value, before any estimator.
+    #[test]
+    fn values_too_large_for_the_checks_are_refused() {
+        let dir = temp("huge");
+        let s = scene("tiny-linear");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 600);
+        let path = dir.join(&side.runs[0].files[0]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        lines[42] = lines[42].replacen(",", ",1e300,", 1);
+        let mut cells: Vec<&str> = lines[42].split(',').collect();
+        cells.remove(2);
+        lines[42] = cells.join(",");
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "t0.csv",
+                "runs[0].files[0]",
+                "column \"w_0\", data row 42",
+                "1e300",
+            ],
+        );
+        let cs = scene("tiny-compression");
+        let side = write(&dir, &compression(), 50);
+        let path = dir.join(&side.runs[2].files[1]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match (i, l.split_once(',')) {
+                (7, Some((t, rest))) => format!("{t},-1e300,{}", rest.split_once(',').unwrap().1),
+                _ => l.to_string(),
+            })
+            .collect();
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        refusal(
+            prepare_compression_checks(&cs, &side, &dir, CAP),
+            &["runs[2].files[1]", "column \"force\", data row 7", "-1e300"],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The kind of the data is checked first: linear runs against a compression scene and
+    /// compression runs against a linear scene are refused saying so.
+    #[test]
+    fn data_of_the_other_kind_are_refused_first() {
+        let dir = temp("kind");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 10);
+        let comp = scene("tiny-compression");
+        let named = [
+            "data.json",
+            "`runs`",
+            "linear runs",
+            "tiny-compression",
+            "strain_ratio",
+        ];
+        refusal(check_data_kind(&comp, &side, &dir), &named);
+        refusal(prepare_compression_checks(&comp, &side, &dir, CAP), &named);
+        let mut c = linear(vec![run("m", 0.01, Some(0.0))]);
+        c.filament.stretch_rigidity = Some(1e6);
+        let side = write(&dir, &c, 10);
+        let named = [
+            "`runs`",
+            "compression runs",
+            "tiny-linear",
+            "compression scene",
+        ];
+        refusal(
+            prepare_data_check(&scene("tiny-linear"), &side, &dir, 0, CAP),
+            &named,
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Trajectory files above the cap together are refused unread, naming the data
+    /// directory, the total, the cap and the flag; a missing file names its key.
+    #[test]
+    fn the_files_are_capped_together() {
+        let dir = temp("cap");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 10);
+        let size: u64 = side.runs[0]
+            .paths(&dir)
+            .iter()
+            .map(|p| std::fs::metadata(p).unwrap().len())
+            .sum();
+        assert!(require_data_size(&side, &dir, size).is_ok());
+        let total = format!("hold {size} bytes");
+        let cap = format!("the {} bytes", size - 1);
+        let named = [dir.to_str().unwrap(), &total, &cap, "--max-memory-gib"];
+        refusal(require_data_size(&side, &dir, size - 1), &named);
+        std::fs::remove_file(dir.join(&side.runs[0].files[1])).unwrap();
+        refusal(
+            require_data_size(&side, &dir, CAP),
+            &["runs[0].files[1]", "t1.csv"],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A discretization this tool models but cannot build for the scene: fewer modes
+    /// than the scene checks, a step putting a two-time point beyond 1e10 steps, an
+    /// integrator of the nonlinear filament; each names its sidecar key.
+    #[test]
+    fn discretizations_that_cannot_serve_are_refused_naming_the_key() {
+        let dir = temp("disc");
+        let s = scene("tiny-linear");
+        let dts = tau1() / 100.0;
+        let with = |model: &str, elements: usize, integrator: &str, dt: f64| {
+            let mut r = run("cn", dts, None);
+            r.discretization = Some(Discretization {
+                model: model.into(),
+                elements: Some(elements),
+                integrator: Some(integrator.into()),
+                noise: None,
+                dt: Some(dt),
+            });
+            write(&dir, &linear(vec![r]), 600)
+        };
+        let side = with("fem", 4, "crank-nicolson", dts / 10.0);
+        assert!(prepare_data_check(&s, &side, &dir, 0, CAP).is_ok());
+        let side = with("spectral", 1, "exact-modal", dts);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "data.json",
+                "runs[0].discretization.elements",
+                "carries 1 modes",
+                "2 modes",
+            ],
+        );
+        let side = with("fem", 4, "crank-nicolson", dts * 2e-10);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "runs[0].discretization.dt",
+                "two-time point",
+                "more than 1e10",
+            ],
+        );
+        let side = with("fem", 4, "metropolis-crank-nicolson", dts);
+        refusal(
+            prepare_data_check(&s, &side, &dir, 0, CAP),
+            &[
+                "runs[0].discretization.integrator",
+                "metropolis-crank-nicolson",
+            ],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Compression data for tiny-compression: run "metropolis" at its three strains,
+    /// rows every 0.05 τ₁ (τ₁ = 0.01/π⁴) from the burn-in.
+    fn compression() -> DataSidecar {
+        let dts = 0.05 * 0.01 / std::f64::consts::PI.powi(4);
+        let runs = [0.0, 2.0, 4.0]
+            .iter()
+            .map(|&e| DataRun {
+                burn_in: 2.0 * dts,
+                ..run("metropolis", dts, Some(e))
+            })
+            .collect();
+        let mut side = linear(runs);
+        side.filament.bending_rigidity = 100.0;
+        side.filament.stretch_rigidity = Some(1e6);
+        side
+    }
+
+    /// Compression data are read; an empty file, a file whose rows all precede the
+    /// burn-in and rows at one time are refused naming the file and its key.
+    #[test]
+    fn compression_files_are_checked_as_linear_ones() {
+        let dir = temp("compression");
+        let s = scene("tiny-compression");
+        let side = write(&dir, &compression(), 50);
+        let checks = prepare_compression_checks(&s, &side, &dir, CAP).unwrap();
+        assert_eq!(checks[0].records.len(), 3);
+        assert_eq!(checks[0].records[0][0].force_ratio.len(), 50);
+        let mut start_late = compression();
+        start_late.runs[0].burn_in = 4.5 * start_late.runs[0].dt_sample;
+        let side = write(&dir, &start_late, 50);
+        let checks = prepare_compression_checks(&s, &side, &dir, CAP).unwrap();
+        assert_eq!(checks[0].records[0][0].force_ratio.len(), 48);
+        let path = dir.join(&side.runs[1].files[0]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, "").unwrap();
+        refusal(
+            prepare_compression_checks(&s, &side, &dir, CAP),
+            &["t0.csv", "runs[1].files[0]", "no data rows"],
+        );
+        let same_t: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match i {
+                0 => l.to_string(),
+                _ => format!("1.0,{}", l.split_once(',').unwrap().1),
+            })
+            .collect();
+        std::fs::write(&path, same_t.join("\n")).unwrap();
+        refusal(
+            prepare_compression_checks(&s, &side, &dir, CAP),
+            &[
+                "runs[1].files[0]",
+                "column \"t\", data row 2",
+                "got t = 1.0",
+            ],
+        );
+        std::fs::write(&path, text).unwrap();
+        let mut late = compression();
+        late.runs[2].burn_in = 1.0;
+        let side = write(&dir, &late, 50);
+        refusal(
+            prepare_compression_checks(&s, &side, &dir, CAP),
+            &["runs[2].files[0]", "no data row at or after burn_in = 1.0"],
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

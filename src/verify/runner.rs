@@ -1121,23 +1121,28 @@ fn apply_linear_checks(
 /// format of [`crate::data`]; see [`crate::verify::data`]) and writes the report to
 /// `out` as `verify` does (summary, index, per-run tables and figures, journal); returns
 /// the summary (budget `data`) and the report run, to be finished by
-/// [`crate::report::write_report`].
+/// [`crate::report::write_report`]. The trajectory files listed may hold at most
+/// `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is read.
 ///
 /// # Errors
-/// Input (exit 2): a bad sidecar or trajectory file, data that cannot serve the scene;
-/// run failures (exit 3): an estimator that finds no answer in the data.
+/// Input (exit 2): a bad sidecar or trajectory file, data of the other kind than the
+/// scene's or that cannot serve it, files larger than `max_bytes` together; run failures
+/// (exit 3): an estimator that finds no answer in the data.
 pub fn check_data(
     scene: &Scene,
     data_dir: &Path,
     out: &Path,
     alpha: f64,
+    max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
     let sidecar = crate::data::DataSidecar::load(data_dir)?;
+    crate::verify::data::check_data_kind(scene, &sidecar, data_dir)?;
+    crate::verify::data::require_data_size(&sidecar, data_dir, max_bytes)?;
     if scene.compression.is_some() {
-        return check_compression_data(scene, &sidecar, data_dir, out, alpha);
+        return check_compression_data(scene, &sidecar, data_dir, out, alpha, max_bytes);
     }
     let prepared = (0..sidecar.runs.len())
-        .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k))
+        .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k, max_bytes))
         .collect::<Result<Vec<_>>>()?;
     let report = begin_check(scene, out)?;
     let start = Instant::now();
@@ -1225,8 +1230,10 @@ fn check_compression_data(
     data_dir: &Path,
     out: &Path,
     alpha: f64,
+    max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
-    let checks = crate::verify::data::prepare_compression_checks(scene, sidecar, data_dir)?;
+    let checks =
+        crate::verify::data::prepare_compression_checks(scene, sidecar, data_dir, max_bytes)?;
     let report = begin_check(scene, out)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
