@@ -153,9 +153,11 @@ pub fn read_text(path: &Path, key: &str, max_bytes: u64) -> Result<String> {
 /// Parses `text`, read from `path`, as JSON of type `T` (`what` names the kind of file in
 /// messages, e.g. `a shard manifest`). A refusal names the key where the parser stopped
 /// (`runs[0].dt_sample`, as serde_path_to_error tracks it; `-` at the top), the line and
-/// column, and what is wrong; the literals `NaN`, `Infinity` and `-Infinity` (which
-/// Python's `json.dump` writes for non-finite floats, but which are not JSON) are named
-/// as such, with how to avoid them.
+/// column, and what is wrong; the literals `NaN`, `Infinity`, `inf` and their signed
+/// forms (which Python's `json.dump` and other writers emit for non-finite floats, but
+/// which are not JSON) are named as such, with how to avoid them, and `null` where a value
+/// is required is named as a missing value. (`null` at an optional key reads as the key
+/// left out.)
 ///
 /// # Errors
 /// [`Error::Scene`] naming `path` and the key.
@@ -167,18 +169,39 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
     let mut de = serde_json::Deserializer::from_str(text);
     let parsed: std::result::Result<T, _> = serde_path_to_error::deserialize(&mut de);
     let value = parsed.map_err(|e| {
-        let key = match e.path().to_string() {
-            p if p.is_empty() || p == "." => "-".to_string(),
+        let at = match e.path().to_string() {
+            p if p == "." => String::new(),
             p => p,
         };
         let inner = e.inner();
-        let message = match non_json_literal(text, inner.line(), inner.column()) {
-            Some(literal) => format!(
-                "not {what}: {literal} at line {}, column {} is not JSON (JSON has no NaN or infinity: write finite numbers; Python's json.dump writes NaN unless given allow_nan=False, which finds them)",
-                inner.line(),
-                inner.column()
-            ),
-            None => format!("not {what}: {inner}"),
+        let (line, column) = (inner.line(), inner.column());
+        let said = inner.to_string();
+        // A missing or unknown field is named with its parent's path: name the field.
+        let field = ["missing field `", "unknown field `"]
+            .iter()
+            .find_map(|p| said.strip_prefix(p))
+            .and_then(|rest| rest.split('`').next());
+        let key = match (at.as_str(), field) {
+            ("", None) => "-".to_string(),
+            ("", Some(f)) => f.to_string(),
+            (p, Some(f)) => format!("{p}.{f}"),
+            (p, None) => p.to_string(),
+        };
+        let message = if let Some(literal) = non_json_literal(text, line, column) {
+            format!(
+                "{literal} at line {line}, column {column} is not JSON (JSON has no NaN or infinity): write finite numbers (in Python, json.dump(..., allow_nan=False) raises on them instead of writing them)"
+            )
+        } else if said.starts_with("invalid type: null") {
+            format!(
+                "must be given, got null at line {line}, column {column} (JSON null stands for a missing value: give the value, or leave an optional key out)"
+            )
+        } else if field.is_none() && !at.is_empty() {
+            let got = number_before(text, line, column)
+                .or_else(|| value_at(text, &at))
+                .map_or(String::new(), |v| format!(" (got {v})"));
+            format!("not {what}: {said}{got}")
+        } else {
+            format!("not {what}: {said}")
         };
         refused(path, &key, message)
     })?;
@@ -187,18 +210,82 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
     Ok(value)
 }
 
-/// The non-JSON literal (`NaN`, `Infinity`, `-Infinity`) that starts at or just before
-/// (`line`, `column`) of `text` (1-based, as serde_json reports them), if any.
-fn non_json_literal(text: &str, line: usize, column: usize) -> Option<&'static str> {
+/// The value at `path` (`runs[0].dt_sample`) of `text`, if the text is JSON, as JSON text
+/// (at most 80 characters).
+fn value_at(text: &str, path: &str) -> Option<String> {
+    let mut v: &serde_json::Value = &serde_json::from_str(text).ok()?;
+    let owned;
+    for part in path.split('.') {
+        let (name, indices) = part.split_once('[').map_or((part, ""), |(n, i)| (n, i));
+        if !name.is_empty() {
+            v = v.get(name)?;
+        }
+        for i in indices.split('[') {
+            if let Some(i) = i.strip_suffix(']') {
+                v = v.get(i.parse::<usize>().ok()?)?;
+            }
+        }
+    }
+    owned = v.to_string();
+    let mut shown: String = owned.chars().take(80).collect();
+    if shown.len() < owned.len() {
+        shown.push('…');
+    }
+    let kind = match v {
+        serde_json::Value::Array(_) => "an array ",
+        serde_json::Value::Object(_) => "an object ",
+        serde_json::Value::String(_) => "a string ",
+        _ => "",
+    };
+    Some(format!("{kind}{shown}"))
+}
+
+/// The number written just before (`line`, `column`) of `text` (where serde_json stops on
+/// a number out of range), if any.
+fn number_before(text: &str, line: usize, column: usize) -> Option<String> {
+    let row = text.lines().nth(line.checked_sub(1)?)?;
+    let end = column.min(row.len());
+    let head = row.get(..end)?;
+    let start = head
+        .rfind(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c)))
+        .map_or(0, |i| i + 1);
+    let number = &head[start..];
+    (!number.is_empty()).then(|| number.to_string())
+}
+
+/// The literals some writers put in JSON for non-finite floats, longest first (matched
+/// ignoring case).
+const NON_FINITE: [&str; 9] = [
+    "-infinity",
+    "+infinity",
+    "infinity",
+    "-inf",
+    "+inf",
+    "inf",
+    "-nan",
+    "+nan",
+    "nan",
+];
+
+/// The non-JSON literal (`NaN`, `Infinity`, `-inf`, …, as written) at which the parser
+/// stopped, at (`line`, `column`) of `text` (1-based, as serde_json reports them: on the
+/// literal's first character, or just after a sign), if any.
+fn non_json_literal(text: &str, line: usize, column: usize) -> Option<&str> {
     let row = text.lines().nth(line.checked_sub(1)?)?;
     let at = column.saturating_sub(1).min(row.len());
-    let from = row.get(..=at.min(row.len().saturating_sub(1)))?;
-    // The parser stops on the literal's first character, or just after a sign.
-    let start = from.rfind([' ', ':', '[', ',', '\t']).map_or(0, |i| i + 1);
+    // Back to the start of the token: after a separator or at the line's start.
+    let start = row
+        .get(..=at.min(row.len().saturating_sub(1)))?
+        .rfind([' ', ':', '[', ',', '\t'])
+        .map_or(0, |i| i + 1);
     let rest = row.get(start..)?.trim_start();
-    ["-Infinity", "Infinity", "NaN"]
+    NON_FINITE
         .into_iter()
-        .find(|l| rest.starts_with(l))
+        .find(|l| {
+            rest.get(..l.len())
+                .is_some_and(|head| head.eq_ignore_ascii_case(l))
+        })
+        .map(|l| &rest[..l.len()])
 }
 
 /// Refuses an output directory `out` (`--out`) that is the input directory `input`
@@ -369,7 +456,13 @@ mod tests {
                 "runs[0].dt",
                 "invalid type",
             ),
-            ("{\"runs\": [{\"dt\": null}]}", "runs[0].dt", "null"),
+            ("{\"runs\": [{\"dt\": null}]}", "runs[0].dt", "got null"),
+            ("{\"runs\": [{\"dt\": nan}]}", "runs[0].dt", "nan at line 1"),
+            (
+                "{\"runs\": [{\"dt\": +inf}]}",
+                "runs[0].dt",
+                "+inf at line 1",
+            ),
             ("{\"runs\": [{\"dt\": NaN}]}", "runs[0].dt", "NaN at line 1"),
             (
                 "{\"runs\": [{\"dt\": -Infinity}]}",
@@ -382,6 +475,13 @@ mod tests {
                 "Infinity at line 2",
             ),
             ("{\"runs\": []} x", "-", "trailing"),
+            ("{\"runs\": [{}]}", "runs[0].dt", "missing field"),
+            (
+                "{\"runs\": [{\"dt\": [1, 2]}]}",
+                "runs[0].dt",
+                "(got an array [1,2])",
+            ),
+            ("{\"runs\": [{\"dt\": 1e999}]}", "runs[0].dt", "(got 1e999)"),
         ] {
             let e = parse_json::<Top>(p, text, "a sidecar").unwrap_err();
             assert_eq!(e.exit_code(), 2);

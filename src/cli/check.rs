@@ -45,6 +45,10 @@ pub struct CheckArgs {
     /// Family-wise significance level (Holm correction over every check).
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     alpha: f64,
+    /// Cap on the trajectory data read, in GiB (the files' total size, and their values
+    /// held as float64): larger data are refused (exit 2) before anything is read.
+    #[arg(long, value_name = "GIB", default_value = "4", allow_negative_numbers = true, value_parser = super::parse_max_memory_gib)]
+    max_memory_gib: f64,
 }
 
 /// Runs the checks; exit code 0 if every check passes, 1 otherwise. Prints the scenes
@@ -63,7 +67,13 @@ pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     }
     langevin_fem::input::refuse_input_in_output(&args.out, &args.data, "--data")?;
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
-    let (summary, report) = check_data(&scene, &args.data, &args.out, args.alpha, 4 << 30)?;
+    let (summary, report) = check_data(
+        &scene,
+        &args.data,
+        &args.out,
+        args.alpha,
+        super::gib_bytes(args.max_memory_gib),
+    )?;
     write_report(report, &summary)?;
     print_scenes(&summary, verbosity, false);
     if verbosity != Verbosity::Quiet {

@@ -62,7 +62,7 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
     for dir in &args.shards {
         langevin_fem::input::refuse_input_in_output(&args.out, dir, "merge DIR")?;
     }
-    let set = ShardSet::open(&args.shards, gib_bytes(args.max_memory_gib))?;
+    let set = ShardSet::open(&args.shards, super::gib_bytes(args.max_memory_gib))?;
     match set.manifest().command.as_str() {
         COMMAND => merge_verify(set, &args, verbosity, start),
         CONVERGE => super::converge::merge(set, &args.out, verbosity),
@@ -74,11 +74,6 @@ pub fn run(args: MergeArgs, verbosity: Verbosity) -> Result<i32> {
             ),
         )),
     }
-}
-
-/// `gib` GiB in bytes (saturating).
-fn gib_bytes(gib: f64) -> u64 {
-    (gib * (1u64 << 30) as f64).min(u64::MAX as f64) as u64
 }
 
 /// `merge` of a verification's shards.

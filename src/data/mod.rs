@@ -20,8 +20,8 @@
 //! - `filament`: length L, bending rigidity EI, transverse drag per length ξ and thermal
 //!   energy kT in one consistent unit system; every time (`dt_sample`, `burn_in`, the
 //!   column `t`) is in the time unit it implies (τ₁ = ξL⁴/(π⁴EI) sets the scale).
-//! - A run's trajectories are sampled every `dt_sample`: row `r` of a file is at time
-//!   `t₀ + r·dt_sample`. `start = "rest"`: each trajectory starts from w = 0 at t = 0
+//! - A run's trajectories are sampled every `dt_sample` (between 1e-12 and 1e6 τ₁):
+//!   row `r` of a file is at time `t₀ + r·dt_sample`. `start = "rest"`: each trajectory starts from w = 0 at t = 0
 //!   (the first row), so the two-time correlation from rest, eq. (4), can be checked at
 //!   sample times; `"stationary"`: the first row is already stationary. Rows before
 //!   `burn_in` (time) are left out of the stationary statistics.
@@ -48,11 +48,11 @@
 //! - JSON that is not JSON: `NaN`, `Infinity` and `-Infinity` are not JSON numbers
 //!   (Python's `json.dump` writes them unless given `allow_nan=False`): every number of
 //!   the sidecar must be finite. A UTF-8 byte-order mark is accepted.
-//! - `null` at a numeric key (`dt_sample`, `positions[j]`, `strain_ratio`,
-//!   `discretization.dt`, …): it is not a number, and an optional numeric key that is
-//!   not known is left out rather than given as `null`. `null` at an optional text key
-//!   (`discretization`, `discretization.integrator`, `discretization.noise`) means not
-//!   given, as leaving it out does.
+//! - `null` where a value is required (`dt_sample`, `positions[j]`, `filament.kt`, …):
+//!   JSON null stands for a missing value. At an optional key (`strain_ratio`,
+//!   `filament.stretch_rigidity`, `discretization` and its keys, `producer`) `null`
+//!   reads as the key left out. Every refusal of the JSON layer (a wrong type, a missing
+//!   or unknown key) names the key, with its line and column.
 //! - A trajectory file that is not a regular file (a FIFO, a device, a directory), or
 //!   trajectory files whose total size exceeds what the check may read (`check
 //!   --max-memory-gib`).
@@ -64,7 +64,6 @@
 //!   cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at 0; a `.npy`
 //!   header whose shape does not match the file's size.
 
-mod json;
 mod npy;
 mod table;
 
@@ -79,6 +78,12 @@ use crate::params::FilamentParams;
 use crate::scene::validate::MAX_ELEMENTS;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// The shortest time between rows of a data run, in τ1 (`dt_sample`): below it a
+/// trajectory would need more than 1e12 rows per τ1.
+pub const MIN_SAMPLE_TAU1: f64 = 1e-12;
+/// The longest time between rows of a data run, in τ1 (`dt_sample`).
+pub const MAX_SAMPLE_TAU1: f64 = 1e6;
 
 /// The `format` field of a sidecar.
 pub const FORMAT: &str = "langevin-fem-trajectories";
@@ -366,13 +371,8 @@ impl DataSidecar {
     pub fn load(dir: &Path) -> Result<DataSidecar> {
         let path = dir.join(SIDECAR);
         let text = read_text(&path, "-", MAX_METADATA_BYTES)?;
-        json::parse(&path, &text)?;
-        let sidecar: DataSidecar = serde_json::from_str(&text).map_err(|e| Error::Scene {
-            file: path.clone(),
-            key: "-".to_string(),
-            // serde_json's message ends in "at line L column C".
-            message: format!("not a {FORMAT} sidecar: {e}"),
-        })?;
+        let sidecar: DataSidecar =
+            crate::input::parse_json(&path, &text, &format!("a {FORMAT} sidecar"))?;
         sidecar.validate(&path)?;
         Ok(sidecar)
     }
@@ -430,6 +430,20 @@ impl DataSidecar {
             run.validate(k, f, self.runs.iter().take(k))
                 .map_err(|(key, message)| bad(key, message))?;
         }
+        // Each file is one trajectory: listed twice, it would be counted twice.
+        let mut seen: std::collections::HashMap<&str, (usize, usize)> = Default::default();
+        for (k, run) in self.runs.iter().enumerate() {
+            for (j, file) in run.files.iter().enumerate() {
+                if let Some((k0, j0)) = seen.insert(file.as_str(), (k, j)) {
+                    return Err(bad(
+                        format!("runs[{k}].files[{j}]"),
+                        format!(
+                            "names {file:?} again (as runs[{k0}].files[{j0}]): each file is one trajectory and may be listed once"
+                        ),
+                    ));
+                }
+            }
+        }
         Ok(())
     }
 }
@@ -472,10 +486,15 @@ impl DataRun {
                 format!("must be a finite ratio in [-1e6, 1e6], got {r}"),
             ));
         }
-        if !(self.dt_sample.is_finite() && self.dt_sample > 0.0) {
+        let tau1 = filament.params().tau1();
+        let (lo, hi) = (MIN_SAMPLE_TAU1 * tau1, MAX_SAMPLE_TAU1 * tau1);
+        if !(self.dt_sample.is_finite() && (lo..=hi).contains(&self.dt_sample)) {
             return Err((
                 key("dt_sample"),
-                format!("must be a positive finite time, got {}", self.dt_sample),
+                format!(
+                    "must be a time between rows in [{MIN_SAMPLE_TAU1:e}, {MAX_SAMPLE_TAU1:e}] tau1 = [{lo:e}, {hi:e}] (tau1 = xi L^4/(pi^4 EI) = {tau1:e} from the filament), got {:e}",
+                    self.dt_sample
+                ),
             ));
         }
         if !(self.burn_in.is_finite() && self.burn_in >= 0.0) {
@@ -614,9 +633,9 @@ mod tests {
             &["`runs[0].burn_in`", "Infinity at line 3", "allow_nan=False"],
         );
         refused_with(
-            "\"dt\": 1.0e-5",
-            "\"dt\": null",
-            &["`runs[0].discretization.dt`", "must be a number, got null"],
+            "\"dt_sample\": 1.0e-4",
+            "\"dt_sample\": null",
+            &["`runs[0].dt_sample`", "got null"],
         );
         refused_with(
             "\"kt\": 1.0",

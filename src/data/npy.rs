@@ -183,9 +183,13 @@ fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), Strin
     } else if descr.starts_with("'>f8'") {
         true
     } else {
+        // A structured dtype is a list: shown whole, up to its closing bracket.
+        let shown = match descr.strip_prefix('[') {
+            Some(rest) => format!("[{}]", rest.split(']').next().unwrap_or("")),
+            None => descr.split(',').next().unwrap_or("").to_string(),
+        };
         return Err(format!(
-            "dtype {} (float64 needed)",
-            descr.split(',').next().unwrap_or("")
+            "descr (dtype) {shown}: float64 ('<f8' or '>f8') needed"
         ));
     };
     if !field("fortran_order")?.starts_with("False") {
@@ -206,7 +210,7 @@ fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), Strin
     match dims.as_slice() {
         [r] => Ok((big, *r, 1)),
         [r, c] => Ok((big, *r, *c)),
-        _ => Err(format!("{} dimensions", dims.len())),
+        _ => Err(format!("shape ({inner}) has {} dimensions", dims.len())),
     }
 }
 

@@ -180,7 +180,14 @@ fn csv_table(
         .trim(csv::Trim::All)
         .flexible(true)
         .from_reader(bytes);
-    let unreadable = |e: csv::Error| format!("must be CSV text: {e}");
+    let unreadable = |e: csv::Error| match e.position() {
+        Some(p) => format!(
+            "must be CSV text (UTF-8): data row {} (line {}) cannot be read: {e}",
+            p.record(),
+            p.line()
+        ),
+        None => format!("must be CSV text (UTF-8): {e}"),
+    };
     let header = reader.headers().map_err(unreadable)?.clone();
     if header.iter().all(str::is_empty) {
         return Err("has no data rows (not even a header line of column names)".into());
@@ -232,12 +239,20 @@ fn csv_table(
         }
         for &i in &index {
             let f = &record[i];
-            values.push(f.parse::<f64>().map_err(|_| {
+            let v = f.parse::<f64>().map_err(|_| {
                 format!(
                     "column {:?}, data row {r}: must be a number, got {f:?}",
                     &header[i]
                 )
-            })?);
+            })?;
+            if !v.is_finite() {
+                // Named as written (`nan`, `-Infinity`, `1e400`), not as parsed.
+                return Err(format!(
+                    "column {:?}, data row {r}: every value must be a finite number, got {f} (read as {v})",
+                    &header[i]
+                ));
+            }
+            values.push(v);
         }
         rows += 1;
     }

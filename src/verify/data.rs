@@ -146,22 +146,28 @@ pub fn check_data_kind(scene: &Scene, sidecar: &DataSidecar, dir: &Path) -> Resu
         .iter()
         .filter(|r| r.strain_ratio.is_some())
         .count();
-    let message = if is_compression(scene) && strained == 0 {
-        format!(
-            "the data are linear runs (no strain_ratio) but scene {} ({}) is a compression scene: check them with a linear scene, or give strain_ratio per run",
-            scene.name,
-            scene.path.display()
-        )
-    } else if !is_compression(scene) && strained == sidecar.runs.len() {
-        format!(
-            "the data are compression runs (each with a strain_ratio) but scene {} ({}) is a linear scene: check them with a compression scene",
-            scene.name,
-            scene.path.display()
-        )
-    } else {
-        return Ok(());
+    let first_strained = sidecar.runs.iter().position(|r| r.strain_ratio.is_some());
+    let (key, message) = match first_strained {
+        None if is_compression(scene) => (
+            "runs".to_string(),
+            format!(
+                "the data are linear runs (no strain_ratio) but scene {} ({}) is a compression scene: check them with a linear scene, or give strain_ratio per run",
+                scene.name,
+                scene.path.display()
+            ),
+        ),
+        Some(k) if !is_compression(scene) && strained == sidecar.runs.len() => (
+            format!("runs[{k}].strain_ratio"),
+            format!(
+                "= {} marks compression data (every run has a strain_ratio) but scene {} ({}) is a linear scene: check them with a compression scene, or leave strain_ratio out of linear runs",
+                sidecar.runs[k].strain_ratio.unwrap_or(f64::NAN),
+                scene.name,
+                scene.path.display()
+            ),
+        ),
+        _ => return Ok(()),
     };
-    Err(refused(&dir.join(crate::data::SIDECAR), "runs", message))
+    Err(refused(&dir.join(crate::data::SIDECAR), &key, message))
 }
 
 /// Refuses the trajectory files of `sidecar` (in `dir`) unless each is a regular file
@@ -176,7 +182,16 @@ pub fn require_data_size(sidecar: &DataSidecar, dir: &Path, max_bytes: u64) -> R
     let mut files = 0usize;
     for (k, run) in sidecar.runs.iter().enumerate() {
         for (j, path) in run.paths(dir).iter().enumerate() {
-            let (_, len) = open_regular(path, &format!("runs[{k}].files[{j}]"))?;
+            let key = format!("runs[{k}].files[{j}]");
+            let (_, len) = open_regular(path, &key).map_err(|e| match e {
+                // Named from the sidecar that lists the file, with why it cannot be read.
+                Error::Scene { message, .. } => refused(
+                    &dir.join(crate::data::SIDECAR),
+                    &key,
+                    format!("names {}, which {message}", path.display()),
+                ),
+                other => other,
+            })?;
             total = total.saturating_add(len);
             files += 1;
         }
@@ -973,11 +988,12 @@ fn read_force_records(
             let first_row = first_row(data, table.get(0, 0));
             if first_row >= table.rows {
                 return Err(refused(
-                    path,
-                    &key,
+                    &dir.join(crate::data::SIDECAR),
+                    &format!("runs[{k}].burn_in"),
                     format!(
-                        "has no data row at or after burn_in = {:?} (its {} rows end at t = {:?}): write longer trajectories",
+                        "= {:?} leaves no data row of {} ({key}: its {} rows end at t = {:?}): give a burn_in within the data, or write longer trajectories",
                         data.burn_in,
+                        path.display(),
                         table.rows,
                         table.get(table.rows - 1, 0)
                     ),
@@ -1145,14 +1161,17 @@ mod tests {
     fn absurd_cadences_and_burn_ins_do_not_panic() {
         let dir = temp("absurd");
         let s = scene("tiny-linear");
-        let mut r = run("cn", 1e-300, None);
+        // The shortest cadence a sidecar may give, and a burn-in beyond any data.
+        let mut r = run("cn", tau1() * crate::data::MIN_SAMPLE_TAU1, None);
         r.burn_in = 1e300;
+        r.start = Start::Stationary;
         let side = write(&dir, &linear(vec![r]), 40);
         refusal(
             prepare_data_check(&s, &side, &dir, 0, CAP),
             &[
                 "runs[0].files",
-                "at least 18446744073709551615 stationary rows",
+                "at least 4000000000000 stationary rows",
+                "got 0",
             ],
         );
         std::fs::remove_dir_all(&dir).unwrap();
@@ -1257,8 +1276,8 @@ mod tests {
         c.filament.stretch_rigidity = Some(1e6);
         let side = write(&dir, &c, 10);
         let named = [
-            "`runs`",
-            "compression runs",
+            "`runs[0].strain_ratio`",
+            "compression data",
             "tiny-linear",
             "compression scene",
         ];
@@ -1406,7 +1425,11 @@ mod tests {
         let side = write(&dir, &late, 50);
         refusal(
             prepare_compression_checks(&s, &side, &dir, CAP),
-            &["runs[2].files[0]", "no data row at or after burn_in = 1.0"],
+            &[
+                "runs[2].burn_in",
+                "runs[2].files[0]",
+                "= 1.0 leaves no data row",
+            ],
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -15,6 +15,7 @@ use super::{
     Job, RunSettings, Sink, Verbosity, compression_data_runs, compression_file, compression_what,
     linear_data_run, linear_file, linear_what, prepare_compression, prepare_linear, strain_key,
 };
+use langevin_fem::data::{COMPRESSION_COLUMNS, read_table};
 use langevin_fem::error::{Error, Result};
 use langevin_fem::output::io::write_atomic;
 use langevin_fem::shard::{Shard, ShardFile, ShardSet, files_key, refuse};
@@ -22,8 +23,17 @@ use langevin_fem::work::WorkLimits;
 use std::path::Path;
 
 /// One run's files in the whole run: the shard-manifest key (`<run>` or
-/// `<run>/strain-NN`) and the relative name of each trajectory's file, in order.
-type Expected = (String, Vec<String>);
+/// `<run>/strain-NN`), the relative name of each trajectory's file, in order, and what
+/// each file must hold: its columns and, where known, its rows.
+type Expected = (String, Vec<String>, Layout);
+
+/// What each trajectory file of a run holds: the columns of the data format, in order,
+/// and the rows (for a linear run; a compression run's rows depend on its strain's plan).
+#[derive(Clone)]
+struct Layout {
+    columns: Vec<String>,
+    rows: Option<u64>,
+}
 
 /// Where each file of one run comes from: the shard (0-based, in shard order) and its
 /// manifest entry, in trajectory order.
@@ -89,13 +99,18 @@ fn merge_linear(set: &ShardSet, job: &Job) -> Result<i32> {
     let expected: Vec<Expected> = job
         .chosen
         .iter()
-        .map(|&k| {
+        .zip(&plans)
+        .map(|(&k, plan)| {
             let name = &job.scene.runs[k].name;
             let count = job.ensemble(k).0 as u64;
             let files = (0..count)
                 .map(|j| linear_file(name, j, job.ext()))
                 .collect();
-            (name.clone(), files)
+            let layout = Layout {
+                columns: plan.columns.clone(),
+                rows: Some(plan.rows),
+            };
+            (name.clone(), files, layout)
         })
         .collect();
     let sink = copy_files(set, job, &expected)?;
@@ -105,7 +120,7 @@ fn merge_linear(set: &ShardSet, job: &Job) -> Result<i32> {
         .zip(&runs)
         .zip(&plans)
         .zip(expected)
-        .map(|(((&k, run), plan), (_, files))| linear_data_run(job, k, run, plan, files))
+        .map(|(((&k, run), plan), (_, files, _))| linear_data_run(job, k, run, plan, files))
         .collect();
     job.finish(sink, data_runs, None, linear_what(job))
 }
@@ -121,7 +136,11 @@ fn merge_compression(set: &ShardSet, job: &Job) -> Result<i32> {
             let files = (0..count)
                 .map(|j| compression_file(name, i, j, job.ext()))
                 .collect();
-            expected.push((strain_key(name, i), files));
+            let layout = Layout {
+                columns: COMPRESSION_COLUMNS.iter().map(|c| c.to_string()).collect(),
+                rows: None,
+            };
+            expected.push((strain_key(name, i), files, layout));
         }
     }
     let sink = copy_files(set, job, &expected)?;
@@ -142,16 +161,45 @@ fn copy_files(set: &ShardSet, job: &Job, expected: &[Expected]) -> Result<Sink> 
     refuse_foreign(set, scene, expected)?;
     let sources = expected
         .iter()
-        .map(|(key, files)| cover(set, scene, key, files))
+        .map(|(key, files, _)| cover(set, scene, key, files))
         .collect::<Result<Vec<_>>>()?;
     let sink = job.begin()?;
-    for ((_, files), sources) in expected.iter().zip(&sources) {
+    for ((_, files, layout), sources) in expected.iter().zip(&sources) {
         for (rel, &(k, entry)) in files.iter().zip(sources) {
             let bytes = set.read_file(k, entry)?;
+            check_trajectory(set, (k, entry), layout)?;
             write_atomic(&sink.record(&job.out, rel)?, &bytes)?;
         }
     }
     Ok(sink)
+}
+
+/// Refuses the trajectory file `entry` of shard `k` unless it holds what `run` writes:
+/// the data format's columns, every value finite ([`read_table`]), and the run's rows.
+/// Its hash only says that it is the file the shard listed: a manifest edited to match a
+/// damaged file is caught here, before the file is copied.
+fn check_trajectory(
+    set: &ShardSet,
+    (k, entry): (usize, &ShardFile),
+    layout: &Layout,
+) -> Result<()> {
+    let dir = &set.shards[k].0;
+    let key = files_key(&entry.scene, &entry.run);
+    let path = dir.join(&entry.path);
+    let table = read_table(&path, &key, &layout.columns, set.max_bytes())?;
+    match layout.rows {
+        Some(rows) if table.rows as u64 != rows => Err(refuse(
+            dir,
+            &key,
+            format!(
+                "{} holds {} rows, but run {} writes {rows} rows per trajectory: damaged or not this run's",
+                path.display(),
+                table.rows,
+                entry.run
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Refuses a file of a shard that belongs to no run of `expected` (another scene, or a
@@ -161,9 +209,9 @@ fn refuse_foreign(set: &ShardSet, scene: &str, expected: &[Expected]) -> Result<
         if let Some(f) = m
             .files
             .iter()
-            .find(|f| f.scene != scene || !expected.iter().any(|(key, _)| *key == f.run))
+            .find(|f| f.scene != scene || !expected.iter().any(|(key, ..)| *key == f.run))
         {
-            let keys: Vec<&str> = expected.iter().map(|(key, _)| key.as_str()).collect();
+            let keys: Vec<&str> = expected.iter().map(|(key, ..)| key.as_str()).collect();
             return Err(refuse(
                 dir,
                 &files_key(&f.scene, &f.run),
