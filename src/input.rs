@@ -214,7 +214,6 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
 /// (at most 80 characters).
 fn value_at(text: &str, path: &str) -> Option<String> {
     let mut v: &serde_json::Value = &serde_json::from_str(text).ok()?;
-    let owned;
     for part in path.split('.') {
         let (name, indices) = part.split_once('[').map_or((part, ""), |(n, i)| (n, i));
         if !name.is_empty() {
@@ -226,7 +225,7 @@ fn value_at(text: &str, path: &str) -> Option<String> {
             }
         }
     }
-    owned = v.to_string();
+    let owned = v.to_string();
     let mut shown: String = owned.chars().take(80).collect();
     if shown.len() < owned.len() {
         shown.push('…');
