@@ -2355,19 +2355,8 @@ fn run_case(case: &Case, logs: &Path) -> (Vec<String>, Outcome) {
         .stderr(std::fs::File::create(&err_log).expect("log"))
         .spawn()
         .expect("binary runs");
-    let mut timed_out = false;
-    let status = loop {
-        if let Some(s) = child.try_wait().expect("wait") {
-            break Some(s);
-        }
-        if start.elapsed() > TIMEOUT {
-            timed_out = true;
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
+    let status = common::wait_or_kill(&mut child, TIMEOUT);
+    let timed_out = status.is_none();
     let seconds = start.elapsed().as_secs_f64();
     let mut all = Vec::new();
     tree(root.path(), root.path(), &mut all);

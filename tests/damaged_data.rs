@@ -3274,24 +3274,12 @@ fn execute(cwd: &Path, argv: &[String], log: &Path) -> Run {
         .stderr(std::fs::File::create(log).expect("log"))
         .spawn()
         .expect("the binary runs");
-    let mut timed_out = false;
-    let status = loop {
-        if let Some(s) = child.try_wait().expect("wait") {
-            break Some(s);
-        }
-        if start.elapsed() > TIMEOUT {
-            timed_out = true;
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
+    let status = common::wait_or_kill(&mut child, TIMEOUT);
     Run {
         code: status.and_then(|s| s.code()),
         stderr: std::fs::read_to_string(log).unwrap_or_default(),
         seconds: start.elapsed().as_secs_f64(),
-        timed_out,
+        timed_out: status.is_none(),
     }
 }
 

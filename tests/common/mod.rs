@@ -234,3 +234,24 @@ pub fn copy_tree(from: &Path, to: &Path) {
             .unwrap_or_else(|e| panic!("copy {f} to {}: {e}", target.display()));
     }
 }
+
+/// Waits for `child` at most `timeout`: its exit status, or `None` if it had to be killed
+/// (a hang, for the corpora of bad and damaged input: `tests/bad_inputs.rs`,
+/// `tests/damaged_data.rs`).
+pub fn wait_or_kill(
+    child: &mut std::process::Child,
+    timeout: std::time::Duration,
+) -> Option<std::process::ExitStatus> {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            return Some(s);
+        }
+        if start.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
