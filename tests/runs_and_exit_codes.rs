@@ -59,7 +59,7 @@ fn assert_consistent(out: &Path, ctx: &str) {
         .filter(|f| !f.starts_with("convergence/"))
         .collect();
     assert!(
-        !present.iter().any(|f| transient(f)),
+        !present.iter().any(|f| common::transient(f)),
         "{ctx}: temporary or staged files left: {present:?}"
     );
     let summary = json(&out.join("summary.json"));
@@ -72,12 +72,6 @@ fn assert_consistent(out: &Path, ctx: &str) {
     assert_eq!(index_run_id(out), id, "{ctx}");
 }
 
-/// Whether `f` is a file the next run removes: a temporary file, or a file in the
-/// staging folder where a killed run's files waited (issue #25).
-fn transient(f: &str) -> bool {
-    f.contains(".tmp.") || f.starts_with(".langevin-fem-staging.")
-}
-
 /// Right after a kill: an entry point exists only for a complete run whose id it
 /// carries, and every other file is named by the journal (or is a temporary or staged
 /// file, which the next run removes).
@@ -88,7 +82,7 @@ fn assert_attributable(out: &Path, ctx: &str) {
         assert!(
             files
                 .iter()
-                .all(|f| transient(f) || f.starts_with("convergence/")),
+                .all(|f| common::transient(f) || f.starts_with("convergence/")),
             "{ctx}: {files:?} without a journal"
         );
         return;
@@ -113,7 +107,7 @@ fn assert_attributable(out: &Path, ctx: &str) {
     for f in all_files(out) {
         let ours = f == "manifest.json" || named.contains(&f);
         assert!(
-            ours || transient(&f) || f.starts_with("convergence/"),
+            ours || common::transient(&f) || f.starts_with("convergence/"),
             "{ctx}: {f} is not attributable to a run ({journal})"
         );
     }

@@ -168,8 +168,8 @@ fn verifys(f: &str) -> bool {
 fn assert_consistent(out: &Path, ctx: &str) {
     let files = all_files(out);
     assert!(
-        !files.iter().any(|f| f.contains(".tmp.")),
-        "{ctx}: temporary files left: {files:?}"
+        !files.iter().any(|f| common::transient(f)),
+        "{ctx}: temporary or staged files left: {files:?}"
     );
     let journals = journals(out);
     assert!(!journals.is_empty(), "{ctx}: no journal");
@@ -205,7 +205,7 @@ fn assert_consistent(out: &Path, ctx: &str) {
     }
 }
 
-/// Right after a kill: every file is a temporary file (removed by the next run), or
+/// Right after a kill: every file is a temporary or staged file (removed by the next run), or
 /// named by some journal, or verify's; an index, if present, lists only complete journals
 /// with their run ids; a summary, if present, carries the run id of its journal (it is
 /// written just before the journal is marked complete, and removed before a new run's
@@ -215,7 +215,7 @@ fn assert_attributable(out: &Path, ctx: &str) {
     for f in all_files(out) {
         let ours = journals.iter().any(|j| j.name == f || j.named.contains(&f));
         assert!(
-            ours || verifys(&f) || f.contains(".tmp."),
+            ours || verifys(&f) || common::transient(&f),
             "{ctx}: {f} is not attributable to a run ({journals:?})"
         );
     }
@@ -412,11 +412,17 @@ fn studies_share_the_folder_and_a_smaller_rerun_removes_only_its_own_dropped_fil
     // A temporary file of a writer that is gone (a pid above any Linux pid_max).
     let stale = out.join(".stability-cells.csv.tmp.4000000000.3");
     std::fs::write(&stale, b"half").unwrap();
+    // And the staging folder of a run that was killed before its swap.
+    let staged = out.join(".langevin-fem-staging.4000000000.0");
+    std::fs::create_dir_all(&staged).unwrap();
+    std::fs::write(staged.join("stability-cells.csv"), b"half").unwrap();
     run_ok(&stability_args(&out, "crank-nicolson"));
     if Path::new("/proc").is_dir() {
         assert!(!stale.exists(), "a dead writer's temporary file is removed");
+        assert!(!staged.exists(), "a dead run's staging folder is removed");
     } else {
         std::fs::remove_file(&stale).unwrap();
+        std::fs::remove_dir_all(&staged).unwrap();
     }
     assert_eq!(maps(&out), ["stability-map-crank-nicolson.svg"]);
     assert_ne!(json(&out.join("stability.json"))["run_id"], first_stability);

@@ -255,3 +255,10 @@ pub fn wait_or_kill(
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
 }
+
+/// Whether `f` (a path relative to an output directory) is a file the next run removes:
+/// a temporary file of an atomic write, or a file in the staging folder where a killed
+/// run's files waited (issue #25).
+pub fn transient(f: &str) -> bool {
+    f.contains(".tmp.") || f.starts_with(".langevin-fem-staging.")
+}
