@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{TempDir, describe, json, run, stderr_of};
+use common::{TempDir, all_files, describe, json, run, stderr_of};
 use std::path::Path;
 
 /// `run` of the Crank–Nicolson run of hinged-linear-2d (8 trajectories × 40 τ1, a row
@@ -160,6 +160,59 @@ fn an_injected_bias_fails_naming_the_checks() {
         last.starts_with(&totals) && last.contains(" skipped in ") && last.ends_with(" s"),
         "{last:?}, expected {totals:?}..."
     );
+}
+
+/// Every file under `dir` with its bytes.
+fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    all_files(dir)
+        .into_iter()
+        .map(|f| {
+            let bytes = std::fs::read(dir.join(&f)).unwrap();
+            (f, bytes)
+        })
+        .collect()
+}
+
+/// What: a check that fails after its report was begun (exit 3: an estimator finds no
+/// answer in valid but too short data) and one refused (exit 2: `--out` holding the
+/// data) leave an earlier report in `--out`, and the data, byte for byte (issue #25:
+/// the run's files wait in a staging folder until it succeeds).
+/// Set-up: a passing check of 8 trajectories × 40 τ1, then data of 2 trajectories × 5 τ1
+/// (too few samples for the mode-distribution check's bins). Tolerance: exact bytes.
+#[test]
+fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
+    let dir = TempDir::new("run-check-failed");
+    let (good, report) = (dir.join_str("good"), dir.join_str("report"));
+    simulate(&good, "npy");
+    let (o, args) = check(&good, &report);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let before = tree_bytes(Path::new(&report));
+    let short = dir.join_str("short");
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        "hinged-linear-2d",
+        "--run",
+        "crank-nicolson",
+        "--trajectories",
+        "2",
+        "--duration-tau1",
+        "5",
+        "--out",
+        &short,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let (o, args) = check(&short, &report);
+    assert_eq!(o.status.code(), Some(3), "{}", describe(&args, &o));
+    assert_eq!(tree_bytes(Path::new(&report)), before, "after exit 3");
+    let data = tree_bytes(Path::new(&good));
+    let (o, args) = check(&good, &good);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    assert!(stderr_of(&o).contains("--out"), "{}", describe(&args, &o));
+    assert_eq!(tree_bytes(Path::new(&good)), data, "check -d DIR -o DIR");
+    assert_eq!(tree_bytes(Path::new(&report)), before);
 }
 
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
