@@ -5,11 +5,24 @@
 mod cli;
 
 fn main() {
+    restore_sigpipe();
     match cli::run() {
         Ok(code) => std::process::exit(code),
         Err(err) => {
             eprintln!("error: {err}");
             std::process::exit(err.exit_code());
         }
+    }
+}
+
+/// Restores the default action of SIGPIPE (which Rust's runtime ignores), so that output
+/// into a closed pipe (`langevin-fem scene show NAME | head`) ends the process quietly, as
+/// it does for other Unix tools, instead of a panic on the failed write.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; setting a
+    // signal's disposition to its default has no other precondition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }

@@ -1385,3 +1385,23 @@ fn diverging_run_stops_with_the_step() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!Path::new(&out_s).join("summary.json").exists());
 }
+
+/// What: output into a pipe the reader has closed (`langevin-fem scene show NAME | head
+/// -1`, as a guide page might show) ends the process quietly, as for other Unix tools: no
+/// panic message. Set-up: stdout is a pipe whose read end is closed before the process
+/// starts, so its first write fails (deterministically, unlike `| head`).
+/// Reference: src/main.rs (SIGPIPE restored).
+#[test]
+fn output_into_a_closed_pipe_ends_quietly() {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let o = common::command()
+        .args(["scene", "show", "hinged-linear-2d"])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .expect("the binary runs");
+    let err = stderr_of(&o);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(o.status.code(), Some(101), "{err}");
+}
