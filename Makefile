@@ -7,6 +7,8 @@
 #                          shards merged (fig2-shards), then the reports rendered in
 #                          headless Chromium (browser-check)
 #   make check             fmt --check, clippy -D warnings, tests
+#   make docs              regenerate the guide's scene-key page
+#                          (docs/src/reference/scene-keys.md) from src/scene/keys.rs
 #   make bench             benchmarks (benches/), see README performance table
 #   make golden            re-run golden snapshots, accept changes, show the diff
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
@@ -23,7 +25,7 @@ BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 fig2-shards converge bench-peers example-check browser-check calibrate power
+.PHONY: all build verify test check bench golden clean fig2 fig2-shards converge bench-peers example-check browser-check calibrate power docs
 
 all: build
 
@@ -67,6 +69,12 @@ example-check: build
 	test -x $(PEERS_VENV)/bin/python || python3 -m venv $(PEERS_VENV)
 	$(PEERS_VENV)/bin/python -c "import numpy" 2>/dev/null || $(PEERS_VENV)/bin/python -m pip install -q numpy==$(PEERS_NUMPY)
 	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
+
+# The guide's page of scene keys, generated from the table in src/scene/keys.rs.
+SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
+docs: build
+	$(BIN) scene keys --format markdown > $(SCENE_KEYS_PAGE).tmp
+	mv $(SCENE_KEYS_PAGE).tmp $(SCENE_KEYS_PAGE)
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered
