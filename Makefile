@@ -2,11 +2,16 @@
 #
 #   make verify            quick verification suite (CI), reports in reports/
 #   make verify BUDGET=full   publication-grade error bars
-#   make test              all tests (unit, integration, statistical validation, golden),
-#                          then `check` against the NumPy example simulator, Fig. 2 in
-#                          shards merged (fig2-shards), then the reports rendered in
-#                          headless Chromium (browser-check)
+#   make test              all tests (unit, integration, statistical validation, golden,
+#                          every command shown in README.md and docs/), then `check`
+#                          against the NumPy example simulator, the docs' NumPy blocks
+#                          (docs-check), Fig. 2 in shards merged (fig2-shards), then the
+#                          reports rendered in headless Chromium (browser-check)
 #   make check             fmt --check, clippy -D warnings, tests
+#   make docs              regenerate the guide's scene-key page
+#                          (docs/src/reference/scene-keys.md) from src/scene/keys.rs
+#   make docs-check        the console blocks of README.md and docs/ tagged `numpy`, run
+#                          with the NumPy venv of example-check (tests/docs.rs)
 #   make bench             benchmarks (benches/), see README performance table
 #   make golden            re-run golden snapshots, accept changes, show the diff
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
@@ -23,7 +28,7 @@ BUDGET ?= quick
 OUT    ?= reports
 BIN     = target/release/langevin-fem
 
-.PHONY: all build verify test check bench golden clean fig2 fig2-shards converge bench-peers example-check browser-check calibrate power
+.PHONY: all build verify test check bench golden clean fig2 fig2-shards converge bench-peers example-check browser-check calibrate power docs docs-check numpy-venv
 
 all: build
 
@@ -56,6 +61,7 @@ calibrate: build
 test:
 	$(CARGO) test --release --locked
 	$(MAKE) --no-print-directory example-check
+	$(MAKE) --no-print-directory docs-check
 	$(MAKE) --no-print-directory fig2-shards
 	$(MAKE) --no-print-directory browser-check
 
@@ -63,10 +69,26 @@ test:
 # passes at a small time step, fails naming the biased modes at a large one; NumPy reads
 # what `run` writes. Part of `make test` (CI).
 EXAMPLE_OUT ?= target/example-check
-example-check: build
+example-check: build numpy-venv
+	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
+
+# The venv with NumPy (pinned, PEERS_NUMPY) of example-check and docs-check.
+numpy-venv:
 	test -x $(PEERS_VENV)/bin/python || python3 -m venv $(PEERS_VENV)
 	$(PEERS_VENV)/bin/python -c "import numpy" 2>/dev/null || $(PEERS_VENV)/bin/python -m pip install -q numpy==$(PEERS_NUMPY)
-	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
+
+# The guide's commands (issue #26): `cargo test` runs every console block of README.md and
+# docs/src/ (tests/docs.rs) except those tagged `numpy`, which run here, with the venv's
+# Python as `python3`. Part of `make test`, after example-check.
+docs-check: numpy-venv
+	LANGEVIN_FEM_PYTHON=$(abspath $(PEERS_VENV))/bin/python $(CARGO) test --release --locked --test docs -- --ignored
+
+# The guide's page of scene keys, generated from the table in src/scene/keys.rs (a test
+# in tests/docs.rs fails when the committed page differs from it).
+SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
+docs: build
+	$(BIN) scene keys --format markdown > $(SCENE_KEYS_PAGE).tmp
+	mv $(SCENE_KEYS_PAGE).tmp $(SCENE_KEYS_PAGE)
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered

@@ -1,11 +1,13 @@
 //! `langevin-fem scene show NAME|PATH`: a scene as it will run (TOML, every default filled
 //! in), then every key it uses with its meaning, unit, allowed range and default
-//! ([`langevin_fem::scene::keys`]).
+//! ([`langevin_fem::scene::keys`]). `langevin-fem scene keys`: the whole key table, as the
+//! same TOML comments or as the Markdown page of the guide (`make docs` writes it to
+//! `docs/src/reference/scene-keys.md`).
 
 use clap::{Args, Subcommand};
 use langevin_fem::error::Result;
 use langevin_fem::scene::builtin::resolve;
-use langevin_fem::scene::keys::{document, effective_toml, scene_keys};
+use langevin_fem::scene::keys::{document, document_all, effective_toml, markdown, scene_keys};
 use std::path::PathBuf;
 
 /// Command-line arguments of `langevin-fem scene`.
@@ -14,7 +16,9 @@ use std::path::PathBuf;
 Examples:
   langevin-fem scene show hinged-linear-2d                 as it will run, every key documented
   langevin-fem scene show hinged-linear-2d --as-written > my-scene.toml
-  langevin-fem scene show my-scene.toml")]
+  langevin-fem scene show my-scene.toml
+  langevin-fem scene keys                                  every key, as TOML comments
+  langevin-fem scene keys --format markdown                the guide's page of scene keys")]
 pub struct SceneArgs {
     #[command(subcommand)]
     command: SceneCommand,
@@ -25,6 +29,27 @@ enum SceneCommand {
     /// Print a scene as it will run (TOML, defaults filled in), then every key it uses
     /// with its meaning, unit, allowed range and default, as TOML comments.
     Show(ShowArgs),
+    /// Print every scene key (the whole table, grouped by section) with its meaning,
+    /// unit, allowed range and default: as TOML comments (as `show` writes them) or as
+    /// Markdown (the guide's page docs/src/reference/scene-keys.md, written by `make docs`).
+    Keys(KeysArgs),
+}
+
+/// Command-line arguments of `langevin-fem scene keys`.
+#[derive(Debug, Args)]
+struct KeysArgs {
+    /// Output format: TOML comment lines, or a Markdown page with one table per section.
+    #[arg(long, value_enum, default_value_t = KeysFormat::Toml)]
+    format: KeysFormat,
+}
+
+/// The formats of `scene keys`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum KeysFormat {
+    /// TOML comment lines, as `scene show` documents a scene's keys.
+    Toml,
+    /// A Markdown page: an intro on the units, then a table per section.
+    Markdown,
 }
 
 /// Command-line arguments of `langevin-fem scene show`.
@@ -48,6 +73,16 @@ struct ShowArgs {
 pub fn run(args: SceneArgs) -> Result<i32> {
     match args.command {
         SceneCommand::Show(args) => show(args),
+        SceneCommand::Keys(args) => {
+            print!(
+                "{}",
+                match args.format {
+                    KeysFormat::Toml => document_all(),
+                    KeysFormat::Markdown => markdown(),
+                }
+            );
+            Ok(0)
+        }
     }
 }
 
