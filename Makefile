@@ -12,7 +12,7 @@
 #                          (docs/src/reference/scene-keys.md) from src/scene/keys.rs
 #   make docs-check        the console blocks of README.md and docs/ tagged `numpy`, run
 #                          with the NumPy venv of example-check (tests/docs.rs)
-#   make bench             benchmarks (benches/), see README performance table
+#   make bench             benchmarks (benches/), see docs/src/reference/performance.md
 #   make golden            re-run golden snapshots, accept changes, show the diff
 #   make fig2              the paper's Fig. 2 (compression scenes, full budget)
 #   make fig2-shards       Fig. 2 as SHARDS concurrent shards and as an emulated Slurm array,
@@ -83,12 +83,18 @@ numpy-venv:
 docs-check: numpy-venv
 	LANGEVIN_FEM_PYTHON=$(abspath $(PEERS_VENV))/bin/python $(CARGO) test --release --locked --test docs -- --ignored
 
-# The guide's page of scene keys, generated from the table in src/scene/keys.rs (a test
-# in tests/docs.rs fails when the committed page differs from it).
+# The guide's generated files: the page of scene keys, from the table in
+# src/scene/keys.rs (a test in tests/docs.rs fails when the committed page differs from
+# it), and the paper's Fig. 2 shown by the README (fig2-shards, part of `make test`,
+# fails when the committed figure differs from the full-budget run's, byte for byte).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
+FIG2_IMAGE      = docs/src/images/fig2.svg
 docs: build
 	$(BIN) scene keys --format markdown > $(SCENE_KEYS_PAGE).tmp
 	mv $(SCENE_KEYS_PAGE).tmp $(SCENE_KEYS_PAGE)
+	$(BIN) verify -q $(FIG2_ARGS) --out target/docs-fig2
+	mkdir -p $(dir $(FIG2_IMAGE))
+	cp target/docs-fig2/fig2.svg $(FIG2_IMAGE)
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered
@@ -157,10 +163,11 @@ fig2-shards: build
 		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/parallel/report/$$f && \
 		cmp $(SHARD_OUT)/single/$$f $(SHARD_OUT)/array/report/$$f || exit 1; \
 	done
+	@cmp $(SHARD_OUT)/single/fig2.svg $(FIG2_IMAGE) || { echo "$(FIG2_IMAGE) differs from the full-budget Fig. 2: run make docs and commit it"; exit 1; }
 	@echo "fig2-shards: $(SHARDS) shards (concurrent, and as an emulated Slurm array) merged to the single run's force-strain.csv and fig2.svg, byte for byte"
 
 # Convergence studies, written to reports/convergence/ with an index page (about 6 min
-# after the build on 2 cores; see the README):
+# after the build on 2 cores; see docs/src/reference/studies.md):
 # - linear scenes over elements: h^4 mode variances with consistent noise (below the
 #   sampling floor by design: the exact-error order is the check), the h^2 deficit of the
 #   paper's element-uniform noise;
@@ -213,10 +220,11 @@ converge: build
 # (set on some machines for old OpenBLAS builds) are unset for that command alone, and the
 # script prints the BLAS kernel it runs. The NumPy results are compared with the exact
 # theory of the same 10-element filament (deviation in standard errors per strain).
-# Not like for like: langevin-fem's time includes the whole verify scene (the dt-halving
-# run at dt/2, the force-distribution checks, the report) and its fixed per-scene budget
-# (the same ensemble at every strain) ends below the target at most strains; the NumPy
-# peer stops each strain at the target and does nothing else.
+# Not like for like: langevin-fem's time includes the whole verify scene (the step
+# search, the pilot and main stage of its budget by target precision, the dt-halving run
+# at dt/2, the force-distribution checks, the exact theories, the report); the NumPy peer
+# stops each strain at the target and does nothing else. Results: the guide's
+# docs/src/reference/performance.md.
 PEERS_OUT    ?= $(OUT)/bench-peers
 PEERS_VENV   ?= benches/peers/.venv
 PEERS_NUMPY  ?= 2.4.6

@@ -23,7 +23,8 @@
 //!    driver and parallel ensembles).
 //! 5. Statistics: [`stats`] (estimators and hypothesis tests, validated on exactly
 //!    solvable processes).
-//! 6. Scenes: [`scene`] (scene files, their validation, and run preparation), and
+//! 6. Scenes: [`scene`] (scene files, their validation, and run preparation), [`data`]
+//!    (the trajectory data format that `run` writes and `check` reads), and
 //!    [`shard`] (a command's ensembles split across processes: the shard format, and the
 //!    checks of a shard set before a merge).
 //! 7. Verification and studies, side by side: [`verify`] (pass/fail checks and the

@@ -228,7 +228,7 @@ impl WorkLimits {
             raise.push(format!("--max-memory-gib {}", round_up(bytes / GIB)));
         }
         let how = format!(
-            "lower those, or raise the cap deliberately with {} (README, \"Limits\")",
+            "lower those, or raise the cap deliberately with {} (the guide, docs/src/reference/exit-codes-and-limits.md, \"Limits\")",
             raise.join(" ")
         );
         let what = format!("the projected work of `{}`", projection.command);

@@ -4,7 +4,7 @@
 //! and the flags of every subcommand that runs (`verify`, `converge`, `stability`,
 //! `work-precision`).
 //!
-//! What: every case must be refused the way the README's exit-code policy says:
+//! What: every case must be refused the way the exit-code policy (guide: docs/src/reference/exit-codes-and-limits.md) says:
 //! - exit 2 (not a panic, a signal, 3 or 0), within [`TIMEOUT`] (a hang is a failure and
 //!   the child is killed);
 //! - stderr names the key or flag, the value as given (full precision) and the allowed
@@ -13,7 +13,7 @@
 //!   tree with `--out out`, and afterwards the tree holds only the input files (no
 //!   `out`, nothing beside or above it).
 //!
-//! Reference: README "Exit codes", `src/scene/validate.rs`, `src/cli/`.
+//! Reference: the guide, docs/src/reference/exit-codes-and-limits.md; `src/scene/validate.rs`, `src/cli/`.
 //! Set-up: two small valid scenes ([`LINEAR`], [`COMPRESSION`]; a test checks that they
 //! parse) and one edit per case, so that each case has exactly one fault.
 //! Tolerance: exact substrings; 100 % of the corpus must pass (the pass fraction is

@@ -7,7 +7,7 @@
 //! agree with the rows; bad input exits 2 before anything runs, the work cap applying to
 //! the N seeds together.
 //!
-//! Reference: README "Calibration"; `src/cli/calibrate.rs` (seed k = first + k, each an
+//! Reference: the guide, docs/src/reference/statistics.md ("Calibration of the verifier"); `src/cli/calibrate.rs` (seed k = first + k, each an
 //! in-process `verify` of one scene); the statistics are unit-tested against R's
 //! `binom.test` and known laws in `src/verify/calibrate.rs`.
 //!

@@ -1220,7 +1220,7 @@ fn verify_alpha_out_of_range_exits_2() {
 /// lists the scene directory first and fails with exit 3
 /// "error: verification: No such file or directory (os error 2)" — exit 3 means "a run
 /// failed", and the message names neither `--scene-dir` nor the fix.
-/// Reference: `src/verify/runner.rs` `resolve_scenes`; README (`--scene NAME` or path).
+/// Reference: `src/verify/runner.rs` `resolve_scenes`; the guide, docs/src/reference/scenes.md (`--scene NAME` or path).
 /// Tolerance: exact.
 #[test]
 
@@ -1266,7 +1266,7 @@ fn verify_missing_scene_dir_is_bad_input() {
 /// What: the tiny scene run with `RAYON_NUM_THREADS=1` and `=2` gives the same
 /// `summary.json` (as parsed JSON, after deleting every `wall_seconds`) and byte-identical
 /// CSV files (same set of files, same bytes).
-/// Reference: README "Reproducibility" (one PCG stream per trajectory, derived from
+/// Reference: the guide, docs/src/reference/reproducibility.md (one PCG stream per trajectory, derived from
 /// seed, run name and index).
 /// Tolerance: exact equality; anything else is a thread-count dependence.
 #[test]
@@ -1305,7 +1305,7 @@ fn results_do_not_depend_on_thread_count() {
 /// What: the same seed run twice gives identical summaries (without `wall_seconds`) and
 /// CSVs; a copy of the scene with only the seed changed (same file name, so the same
 /// scene name) changes at least one estimate, so the seed is actually used.
-/// Reference: README "Reproducibility".
+/// Reference: the guide, docs/src/reference/reproducibility.md.
 /// Tolerance: exact equality for the repeat; any difference for the new seed (a
 /// collision of every estimate across seeds has probability ~0).
 #[test]

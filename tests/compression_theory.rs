@@ -1276,7 +1276,7 @@ fn library_caps_refuse_instead_of_hanging() {
 /// outside with exit 2, a message naming the flag, the value as typed (full precision) and
 /// the range; no stdout. The bounds printed for --stretch-ratio and --strain-ratio are
 /// accepted when copied back (compared and printed exactly).
-/// Reference: the documented ranges (`--help`, README): P in [10⁻³, 10⁶], S/P² in
+/// Reference: the documented ranges (`--help`, the guide): P in [10⁻³, 10⁶], S/P² in
 /// [10⁻², 10¹²], ε/ε_c0 in [0, 100√S/P].
 /// Set-up: default P = 100, S = 10⁶ unless given; continuum 2D.
 /// Tolerance: exact (exit codes and substrings).

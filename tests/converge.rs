@@ -352,7 +352,7 @@ fn cli_rejects_bad_input_with_exit_2() {
 /// order). Over Δt, Metropolis CN is exact (no discrete-minus-limit error at all) and the
 /// explicit-stretching Crank–Nicolson has no exact reference and expected order 1.
 /// Tolerance 0.05 on the fitted orders (the theory's errors are smooth power laws, see
-/// the fitted intervals in the README).
+/// the fitted intervals in the guide, docs/src/reference/studies.md).
 #[test]
 fn compression_exact_orders_and_classification() {
     let values = [5.0, 10.0, 20.0, 40.0];

@@ -24,7 +24,7 @@
 //!
 //! Writing into an input directory is reported too (an outcome problem, not data loss).
 //!
-//! Reference: README "Exit codes" (2: the user's input, named with file, key and value);
+//! Reference: the guide, docs/src/reference/exit-codes-and-limits.md (2: the user's input, named with file, key and value);
 //! `src/input.rs` (regular files only, capped reads, never written to); issue #25.
 //!
 //! Set-up: the valid inputs are made at test time, once per test process, in a temporary
@@ -3568,7 +3568,7 @@ fn corpus_is_large_and_names_are_distinct() {
 
 /// What: every damaged input is safe (no panic, signal, hang or data loss) and gives its
 /// expected outcome (see the module docs).
-/// Reference: README "Exit codes"; issue #25.
+/// Reference: the guide, docs/src/reference/exit-codes-and-limits.md; issue #25.
 /// Tolerance: 100 % safe, 100 % with the expected exit code, ≥ 95 % of the refusals
 /// naming file, key and value.
 #[test]
@@ -3818,7 +3818,7 @@ fn mutate(target: Target, bytes: &[u8], m: &Mutation) -> (Vec<u8>, bool) {
 
 /// What: random byte mutations of a valid `.npy`, CSV, `data.json` and run shard
 /// manifest are safe and give an allowed exit code (see the module docs).
-/// Reference: README "Exit codes"; issue #25.
+/// Reference: the guide, docs/src/reference/exit-codes-and-limits.md; issue #25.
 /// Set-up: 64 mutants per file kind (proptest, ChaCha, `SEED_DAMAGED_DATA`), each one
 /// edit of one file of a fresh copy of the valid input; `check` (data) or `merge` (shards).
 /// Tolerance: none: every mutant must pass.

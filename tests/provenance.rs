@@ -17,7 +17,7 @@
 //! (4) Every column of every CSV file those commands write has a unit in the column
 //! dictionary, recorded per file in the journal, and the recorded columns are the file's
 //! header.
-//! Reference: README "Report directory" and "Provenance"; `src/output/provenance.rs`,
+//! Reference: the guide, docs/src/reference/reports.md ("The report directory", "Provenance"); `src/output/provenance.rs`,
 //! `src/output/columns.rs`, `src/params/physical.rs`.
 //! Set-up: quick budget of 4- and 8-element scenes; studies scaled down to well under a
 //! second each.

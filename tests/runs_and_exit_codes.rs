@@ -8,7 +8,7 @@
 //! scenes' files. (3) Exit codes: 2 for the user's input, found before any run and
 //! leaving the earlier report intact; 3 for a failure after the run started (an estimator
 //! that finds no answer in the data), naming the run and the observable, never a key.
-//! Reference: README "Exit codes"; `src/output/manifest.rs`; `src/error.rs`.
+//! Reference: the guide, docs/src/reference/exit-codes-and-limits.md; `src/output/manifest.rs`; `src/error.rs`.
 //! Set-up: `tests/scenes/good/tiny-linear.toml` (well under a second per run), copied
 //! under two names so that a run writes two scene folders.
 //! Tolerance: exact (file sets, ids, codes and substrings). Kill moments are fixed

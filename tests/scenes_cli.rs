@@ -6,7 +6,7 @@
 //! CSV byte-identical and sizes the pool; `--seed` changes the results, and `--seed` equal
 //! to the scene's own seed does not; the seed used is stored in every report; bad values
 //! of the new flags exit 2 naming the flag and its range.
-//! Reference: README "Scenes"; `src/scene/builtin.rs` (resolution), `src/scene/keys.rs`
+//! Reference: the guide, docs/src/reference/scenes.md; `src/scene/builtin.rs` (resolution), `src/scene/keys.rs`
 //! (key documentation), `src/cli/mod.rs` (`SimArgs`).
 //! Set-up: the tiny linear fixture (4 elements, under a second per run) for every run
 //! that simulates; built-in scenes only where nothing is simulated (a refusal by
@@ -290,7 +290,7 @@ fn scene_show_prints_the_scene_and_documents_its_keys() {
 /// What: `--threads 1` and `--threads 2` give byte-identical CSV files (same set, same
 /// bytes) and identical notes; and `--threads` sizes the pool (work-precision records
 /// the pool's size).
-/// Reference: README "Reproducibility" (one stream per trajectory).
+/// Reference: the guide, docs/src/reference/reproducibility.md (one stream per trajectory).
 #[test]
 fn thread_count_changes_no_byte() {
     let (a, b) = (TempDir::new("t1"), TempDir::new("t2"));

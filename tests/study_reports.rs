@@ -13,7 +13,7 @@
 //! a rerun of `stability` with fewer integrators removes the maps it no longer writes and
 //! keeps the other studies' files, a user's own file and a summary no journal names;
 //! a temporary file of a dead writer is removed by the next run.
-//! Reference: README "Report directory"; `src/studies/output.rs`;
+//! Reference: the guide, docs/src/reference/reports.md; `src/studies/output.rs`;
 //! `src/output/manifest.rs`.
 //! Set-up: the smallest settings of the Makefile's verify target, scaled down (well under
 //! a second per run on 2 cores); about 20 runs in all.

@@ -830,7 +830,11 @@ fn work_above_the_caps_is_refused_at_once_naming_what_drives_it() {
             .split("raise the cap deliberately with")
             .nth(1)
             .unwrap_or_else(|| panic!("{}: no way to raise the cap: {d}", case.what));
-        assert!(raise.contains("(README, \"Limits\")"), "{}: {d}", case.what);
+        assert!(
+            raise.contains("(the guide, docs/src/reference/exit-codes-and-limits.md, \"Limits\")"),
+            "{}: {d}",
+            case.what
+        );
         assert_eq!(
             raise.contains("--max-work"),
             case.over_work,
@@ -1039,14 +1043,15 @@ fn help_documents_the_caps_with_the_library_defaults() {
         assert!(help.contains("--max-memory-gib <GIB>"), "{d}");
         assert!(help.contains("[default: 4]"), "{d}");
     }
-    let readme = std::fs::read_to_string(common::fixture("README.md")).expect("README");
+    let page = "docs/src/reference/exit-codes-and-limits.md";
+    let guide = std::fs::read_to_string(common::fixture(page)).expect("the guide's page");
     for text in [
-        "#### Limits",
+        "## Limits",
         "--max-work",
         "--max-memory-gib",
         "5e13",
         "4 GiB",
     ] {
-        assert!(readme.contains(text), "README lacks {text:?}");
+        assert!(guide.contains(text), "{page} lacks {text:?}");
     }
 }

@@ -32,7 +32,7 @@ pub struct CheckArgs {
     #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// Data directory: data.json (the sidecar) and the trajectory files it lists, as
-    /// `langevin-fem run` writes them (see the README, "Check your own simulator").
+    /// `langevin-fem run` writes them (see the guide, docs/src/reference/data-format.md).
     #[arg(short, long, value_name = "DIR")]
     data: PathBuf,
     /// Output directory for summary.json, index.html and per-run tables and figures.

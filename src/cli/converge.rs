@@ -77,7 +77,7 @@ pub struct ConvergeArgs {
     scene_dir: Option<PathBuf>,
     /// Simulate only shard I of N of every value's trajectories and write their records
     /// and a manifest to --out, without the study's tables; `langevin-fem merge` then
-    /// writes the whole study, byte for byte (see README "Running on a cluster").
+    /// writes the whole study, byte for byte (see the guide, docs/src/tutorials/cluster.md).
     #[arg(long, value_name = "I/N")]
     shard: Option<Shard>,
     #[command(flatten)]

@@ -55,8 +55,10 @@ Progress goes to stderr, the closing line (what was written, where) to stdout.";
 #[derive(Debug, Args)]
 #[command(after_help = EXAMPLES)]
 pub struct RunArgs {
-    /// Scene: a name from the scene directory or a path to a .toml file (linear scenes:
-    /// hinged-linear-2d, hinged-linear-3d, spectral-reference).
+    /// Scene: a name from the scene directory or a path to a .toml file, linear
+    /// (hinged-linear-2d, hinged-linear-3d, spectral-reference: the deflection and modal
+    /// amplitudes) or compression (compression-2d, compression-3d: F and the stored length
+    /// per strain; a budget by target precision needs --duration-tau1).
     #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// Run of the scene to simulate (repeatable; default: every run).
@@ -136,8 +138,6 @@ struct Job {
     settings: RunSettings,
     /// The output directory.
     out: PathBuf,
-    /// The scene as named on the command line (for the closing line's `check` hint).
-    scene_arg: String,
     /// What is printed on stderr while it runs.
     verbosity: Verbosity,
     scene: Scene,
@@ -180,6 +180,27 @@ impl Sink {
     }
 }
 
+/// How `check --scene` names `scene` so that it finds it again: a built-in scene by its
+/// name, any other by its file's path (which needs no `--scene-dir`).
+fn scene_argument(scene: &Scene) -> String {
+    let path = scene.path.display().to_string();
+    match path.strip_suffix(" (built in)") {
+        Some(name) => name.to_string(),
+        None => path,
+    }
+}
+
+/// `word` as one word of a POSIX shell command line: as it is if it holds only safe
+/// characters, else single-quoted.
+fn shell_word(word: &str) -> String {
+    let safe = |c: char| c.is_ascii_alphanumeric() || "-_./:=+,@%".contains(c);
+    if !word.is_empty() && word.chars().all(safe) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', "'\\''"))
+    }
+}
+
 /// The relative name of linear run `run`'s trajectory `j` in format `ext`.
 fn linear_file(run: &str, j: u64, ext: &str) -> String {
     format!("{run}/trajectory-{j:04}.{ext}")
@@ -205,7 +226,7 @@ impl Job {
         settings: RunSettings,
         scene: Scene,
         seed_note: String,
-        (out, scene_arg): (PathBuf, String),
+        out: PathBuf,
         verbosity: Verbosity,
         (shard, limits): (Shard, WorkLimits),
     ) -> Result<Job> {
@@ -252,7 +273,6 @@ impl Job {
         Ok(Job {
             settings,
             out,
-            scene_arg,
             verbosity,
             scene,
             seed_note,
@@ -336,8 +356,8 @@ impl Job {
         println!(
             "wrote {what} to {}; check them with: langevin-fem check --scene {} --data {}",
             out.display(),
-            self.scene_arg,
-            out.display()
+            shell_word(&scene_argument(&self.scene)),
+            shell_word(&out.display().to_string())
         );
         Ok(0)
     }
@@ -416,7 +436,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
         settings,
         scene,
         seed_note,
-        (args.out, args.scene),
+        args.out,
         verbosity,
         (args.shard.unwrap_or(Shard::WHOLE), args.limits.limits()),
     )?;

@@ -53,12 +53,12 @@ pub struct VerifyArgs {
     alpha: f64,
     /// Simulate only shard I of N of every run's trajectories and write their records and
     /// a manifest to --out, without checks or report; `langevin-fem merge` then writes the
-    /// report of the whole run, byte for byte (see README "Running on a cluster").
+    /// report of the whole run, byte for byte (see the guide, docs/src/tutorials/cluster.md).
     #[arg(long, value_name = "I/N")]
     shard: Option<Shard>,
     /// With --shard: take the plans of a budget by target precision (step search and
     /// pilot) from this finished shard of the same set instead of computing them again
-    /// (submit that shard first; README "Running on a cluster").
+    /// (submit that shard first; the guide, docs/src/tutorials/cluster.md).
     #[arg(long, value_name = "SHARD_DIR", requires = "shard")]
     plan_from: Option<PathBuf>,
     #[command(flatten)]

@@ -64,7 +64,6 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
         ));
     }
     let (scene, seed_note) = scenes.remove(0);
-    let scene_arg = manifest.scenes[0].source.clone();
     if verbosity.shows_progress() {
         eprintln!(
             "merging {} shards of run (scene {}, budget {}, {} run(s))",
@@ -80,7 +79,7 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
         settings,
         scene,
         seed_note,
-        (out.to_path_buf(), scene_arg),
+        out.to_path_buf(),
         verbosity,
         (Shard::WHOLE, WorkLimits::default()),
     )
