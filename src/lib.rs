@@ -13,7 +13,9 @@
 //!    capped before they are read), [`work`] (the caps on a command's projected total
 //!    work and memory) and [`progress`] (progress on stderr, weighted by that work).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
-//!    (2)–(4)).
+//!    (2)–(4), and in [`spectral::membrane`] the continuum references of a fluctuating
+//!    Helfrich membrane: modes, rates, variances, two-time correlations, point variance,
+//!    excess area).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
 //!    modes, exact discrete stationary covariances, and the von Kármán filament), and on it
 //!    [`theory`] (the exact equilibrium theory of the compressed filament, the paper's
