@@ -48,8 +48,8 @@ pub mod membrane;
 pub mod simulator;
 
 pub use membrane::{
-    ExcessArea, MAX_LISTED_MODES, MAX_MEMBRANE_MODES, Membrane, MembraneBoundary, MembraneMode,
-    MembraneParams, ModeShape,
+    ExcessArea, MAX_ASPECT_RATIO, MAX_LISTED_MODES, MAX_MEMBRANE_MODES, Membrane, MembraneBoundary,
+    MembraneMode, MembraneParams, ModeShape,
 };
 pub use simulator::ModalSimulator;
 

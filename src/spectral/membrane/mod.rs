@@ -112,6 +112,11 @@ pub const MAX_MEMBRANE_MODES: usize = 10_000_000;
 /// Largest number of modes listed by [`Membrane::modes`] and [`Membrane::modes_within`].
 pub const MAX_LISTED_MODES: usize = 1_000_000;
 
+/// Largest aspect ratio max(a, b)/min(a, b) accepted: the lattice sums tabulate one value
+/// per index along each side, up to about √(4·[`MAX_MEMBRANE_MODES`]·aspect/π) of them,
+/// which this keeps below 4·10⁶ (a membrane thinner than that is a filament).
+pub const MAX_ASPECT_RATIO: f64 = 1.0e6;
+
 /// The boundary conditions of the rectangle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -169,7 +174,8 @@ impl Default for MembraneParams {
 }
 
 impl MembraneParams {
-    /// Checks κ, ξ, kT, a, b finite and > 0, and σ finite and above the buckling tension.
+    /// Checks κ, ξ, kT, a, b finite and > 0, the aspect ratio at most
+    /// [`MAX_ASPECT_RATIO`], and σ finite and above the buckling tension.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first offending field (`bending_rigidity`,
@@ -181,6 +187,18 @@ impl MembraneParams {
         require_positive("kt", self.kt)?;
         require_positive("width", self.width)?;
         require_positive("height", self.height)?;
+        let (lo, hi) = (self.width / MAX_ASPECT_RATIO, self.width * MAX_ASPECT_RATIO);
+        if !(lo..=hi).contains(&self.height) {
+            return Err(Error::invalid(
+                "height",
+                self.height,
+                format!(
+                    "in [{lo:e}, {hi:e}] (an aspect ratio of at most {MAX_ASPECT_RATIO:e} with \
+                     width {:e})",
+                    self.width
+                ),
+            ));
+        }
         let buckling = self.buckling_tension();
         if !(self.tension.is_finite() && self.tension > buckling && buckling.is_finite()) {
             return Err(Error::invalid(
@@ -705,6 +723,21 @@ mod tests {
                 ..good
             };
             assert!(Membrane::new(near).is_ok());
+            for height in [1.7e-7, 1.7e7] {
+                let thin = MembraneParams { height, ..good };
+                match thin.validate() {
+                    Err(Error::InvalidParameter { name, .. }) => assert_eq!(name, "height"),
+                    other => panic!("height {height}: {other:?}"),
+                }
+            }
+            let extreme = MembraneParams {
+                height: 1.7e6,
+                tension: 0.0,
+                ..good
+            };
+            let mb = Membrane::new(extreme).unwrap();
+            assert!(mb.modes(3).unwrap().len() == 3);
+            assert!(mb.excess_area(mb.max_cutoff()).unwrap().n_modes <= MAX_MEMBRANE_MODES);
             type Setter = fn(&mut MembraneParams, f64);
             let setters: [(&str, Setter); 5] = [
                 ("bending_rigidity", |p, v| p.bending_rigidity = v),
