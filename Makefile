@@ -8,8 +8,9 @@
 #                          (docs-check), Fig. 2 in shards merged (fig2-shards), then the
 #                          reports rendered in headless Chromium (browser-check)
 #   make check             fmt --check, clippy -D warnings, tests
-#   make docs              regenerate the guide's scene-key page
-#                          (docs/src/reference/scene-keys.md) from src/scene/keys.rs
+#   make docs              regenerate the guide's generated parts: the scene-key page
+#                          (from src/scene/keys.rs), the commands page's --help blocks
+#                          and the README's Fig. 2 (docs/src/images/fig2.svg)
 #   make docs-check        the console blocks of README.md and docs/ tagged `numpy`, run
 #                          with the NumPy venv of example-check (tests/docs.rs)
 #   make bench             benchmarks (benches/), see docs/src/reference/performance.md
@@ -85,13 +86,15 @@ docs-check: numpy-venv
 
 # The guide's generated files: the page of scene keys, from the table in
 # src/scene/keys.rs (a test in tests/docs.rs fails when the committed page differs from
-# it), and the paper's Fig. 2 shown by the README (fig2-shards, part of `make test`,
+# it), every `--help` block of the commands page (docs/dev/refresh_help.py; the docs test
+# fails when one drifts), and the paper's Fig. 2 shown by the README (fig2-shards, part of `make test`,
 # fails when the committed figure differs from the full-budget run's, byte for byte).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
 FIG2_IMAGE      = docs/src/images/fig2.svg
 docs: build
 	$(BIN) scene keys --format markdown > $(SCENE_KEYS_PAGE).tmp
 	mv $(SCENE_KEYS_PAGE).tmp $(SCENE_KEYS_PAGE)
+	python3 docs/dev/refresh_help.py $(BIN) docs/src/reference/commands.md
 	$(BIN) verify -q $(FIG2_ARGS) --out target/docs-fig2
 	mkdir -p $(dir $(FIG2_IMAGE))
 	cp target/docs-fig2/fig2.svg $(FIG2_IMAGE)

@@ -13,7 +13,9 @@
 //!    capped before they are read), [`work`] (the caps on a command's projected total
 //!    work and memory) and [`progress`] (progress on stderr, weighted by that work).
 //! 2. References: [`spectral`] (the exact modal solution of the stochastic beam equation
-//!    (2)–(4)).
+//!    (2)–(4), and in [`spectral::membrane`] the continuum references of a fluctuating
+//!    Helfrich membrane: modes, rates, variances, two-time correlations, point variance,
+//!    excess area).
 //! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
 //!    modes, exact discrete stationary covariances, and the von Kármán filament), and on it
 //!    [`theory`] (the exact equilibrium theory of the compressed filament, the paper's
@@ -46,6 +48,7 @@
 //! | eq. (4) | two-time correlation ⟨w(x,t) w(y,η)⟩ | [`spectral::HingedBeam::correlation`]; discrete counterpart in [`scene::linear::TwoTimeReference`]; checked by [`verify::checks`] |
 //! | eq. (4), t→∞, η=t | equipartition profile ⟨w²(x)⟩ | [`spectral::HingedBeam::profile_variance`] (closed form) and [`spectral::HingedBeam::profile_variance_series`] |
 //! | per-mode law | variance 2kTL³/(π⁴n⁴EI), rate λₙ = π⁴n⁴EI/(ξL⁴), Lorentzian spectrum | [`spectral::HingedBeam::mode_variance`], [`spectral::HingedBeam::mode_rate`], [`spectral::HingedBeam::lorentzian`], [`spectral::HingedBeam::sampled_spectrum`] (AR(1), aliasing included) |
+//! | membrane (issue #27) | ξ∂h/∂t = −κ∇⁴h + σ∇²h + f: variance 4kT/(ab·c_q) (simply supported) or ⟨\|h_q\|²⟩ = kT/(ab·c_q) (periodic), rate c_q/ξ, c_q = κq⁴ + σq² | [`spectral::membrane::Membrane`] (mode variances and rates, [`spectral::membrane::Membrane::correlation`], [`spectral::membrane::Membrane::point_variance`], [`spectral::membrane::Membrane::excess_area`], spectra) |
 //! | eq. (5) | element-uniform load, variance 2ξkT/(hΔt) | [`fem::noise::NoiseModel::ElementUniform`]; its exact stationary covariance (a Lyapunov solution) in [`fem::modal::discrete_stationary_covariance`] |
 //! | element energy (von Kármán) | ∫ [EA/2 (u′ + ½w′²)² + EI/2 w″²] dx | [`fem::vonkarman::CompressedFilament`] (energy, internal force) |
 //! | step (i) | axial equilibrium for u at fixed w | [`fem::vonkarman::CompressedFilament::axial_equilibrium`] |

@@ -3,7 +3,9 @@
 use clap::{Args, Subcommand};
 use langevin_fem::FilamentParams;
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
-use langevin_fem::spectral::HingedBeam;
+use langevin_fem::spectral::{
+    HingedBeam, Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
+};
 use langevin_fem::theory::{
     CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS,
     PERSISTENCE_RATIO_RANGE, STRETCH_BEND_RATIO_RANGE, StoredLengthLaw, max_strain_ratio,
@@ -52,6 +54,7 @@ Examples:
   langevin-fem theory mode --n 3 --length 10 --bending-rigidity 17 --drag 1 --kt 4.1e-3
   langevin-fem theory correlation --x 0.5 --y 0.5 --t 0.1 --eta 0.2
   langevin-fem theory compression --dims 2 --strain-ratio 0,1,3,10 --elements 20
+  langevin-fem theory membrane --boundary periodic --m 1 --n 0 --tension 0.5 --cutoff 100
 
 Every result is one JSON object on stdout.";
 
@@ -129,6 +132,65 @@ enum Query {
         #[arg(long, default_value_t = 1.0e6, allow_negative_numbers = true)]
         stretch_ratio: f64,
     },
+    /// Exact continuum results of the Helfrich membrane ξ∂h/∂t = −κ∇⁴h + σ∇²h + f on an
+    /// a × b rectangle: wavevector, stiffness c_q = κq⁴ + σq², rate c_q/ξ and variance of
+    /// mode (m, n) with its convention; the point variance ⟨h²(x, y)⟩ with a rigorous
+    /// bound; with --cutoff, the excess area ⟨ΔA⟩ and Var ΔA of the modes with |q| ≤ Q.
+    Membrane(MembraneArgs),
+}
+
+/// `theory membrane --boundary`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum BoundaryArg {
+    /// h = ∇²h = 0 on the edges: modes sin(mπx/a) sin(nπy/b), m, n ≥ 1.
+    SimplySupported,
+    /// Periodic in x and y: modes cos(q·r), sin(q·r), q = 2π(m/a, n/b) ≠ 0.
+    Periodic,
+}
+
+/// Flags of `theory membrane` (consistent units).
+#[derive(Debug, Clone, Args)]
+pub struct MembraneArgs {
+    /// Boundary conditions.
+    #[arg(long, value_enum, default_value = "simply-supported")]
+    boundary: BoundaryArg,
+    /// Bending rigidity κ (energy).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    bending_rigidity: f64,
+    /// Tension σ (energy per area), above the buckling tension −κ·q_min².
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    tension: f64,
+    /// Friction ξ per unit area.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    drag: f64,
+    /// Thermal energy k_B T.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    kt: f64,
+    /// Side a along x.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    width: f64,
+    /// Side b along y.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    height: f64,
+    /// Mode index m along x (≥ 1 simply supported; any integer periodic, (m, n) ≠ (0, 0)).
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    m: i64,
+    /// Mode index n along y (≥ 1 simply supported; any integer periodic).
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    n: i64,
+    /// Position x of the point variance, in [0, a] (default a/2).
+    #[arg(long, allow_negative_numbers = true)]
+    x: Option<f64>,
+    /// Position y of the point variance, in [0, b] (default b/2).
+    #[arg(long, allow_negative_numbers = true)]
+    y: Option<f64>,
+    /// Bound on the truncation error of the point variance, relative to the variance of
+    /// the slowest mode, in (0, 1).
+    #[arg(long, default_value = "1e-10", allow_negative_numbers = true)]
+    tolerance: f64,
+    /// Wavenumber cutoff Q of the excess area (modes with |q| ≤ Q; ⟨ΔA⟩ grows as ln Q).
+    #[arg(long, allow_negative_numbers = true)]
+    cutoff: Option<f64>,
 }
 
 /// Parses `--strain-ratio`: a non-empty comma-separated list of numbers in `[0, max]`
@@ -248,6 +310,132 @@ fn compression(
     Ok(json!({ "dims": dims.as_u32(), "points": points }))
 }
 
+/// `err` with the library's parameter name turned into the flag (`tension` → `--tension`).
+fn as_flag(err: Error) -> Error {
+    match err {
+        Error::InvalidParameter {
+            name,
+            value,
+            allowed,
+        } => Error::InvalidParameter {
+            name: format!("--{}", name.replace('_', "-")),
+            value,
+            allowed,
+        },
+        other => other,
+    }
+}
+
+/// The real mode of `theory membrane --m --n` (for a periodic membrane the half-lattice
+/// representative of ±q, cosine) and the sign of q relative to it.
+fn membrane_mode(boundary: MembraneBoundary, m: i64, n: i64) -> Result<(MembraneMode, f64)> {
+    match boundary {
+        MembraneBoundary::SimplySupported => {
+            if m < 1 {
+                return Err(Error::invalid("--m", m, ">= 1 (simply supported)"));
+            }
+            if n < 1 {
+                return Err(Error::invalid("--n", n, ">= 1 (simply supported)"));
+            }
+            let shape = ModeShape::SineSine;
+            Ok((MembraneMode { m, n, shape }, 1.0))
+        }
+        MembraneBoundary::Periodic => {
+            if m == 0 && n == 0 {
+                return Err(Error::invalid(
+                    "--n",
+                    n,
+                    "nonzero when --m is 0 (periodic: the q = 0 mode, a uniform displacement \
+                     without restoring force, is excluded)",
+                ));
+            }
+            let flip = m < 0 || (m == 0 && n < 0);
+            let (m, n, sign) = if flip { (-m, -n, -1.0) } else { (m, n, 1.0) };
+            let shape = ModeShape::Cosine;
+            Ok((MembraneMode { m, n, shape }, sign))
+        }
+    }
+}
+
+/// The convention line of `theory membrane`.
+fn membrane_convention(boundary: MembraneBoundary) -> &'static str {
+    match boundary {
+        MembraneBoundary::SimplySupported => {
+            "h = Σ a_mn sin(mπx/a) sin(nπy/b), m, n ≥ 1; variance = ⟨a_mn²⟩ = 4kT/(A·c_q), \
+             c_q = κq⁴ + σq², A = ab, rate = c_q/ξ"
+        }
+        MembraneBoundary::Periodic => {
+            "h_q = A⁻¹∫h e^{−iq·r} d²r, q = 2π(m/a, n/b) ≠ 0 (q = 0 excluded): \
+             fourier_variance = ⟨|h_q|²⟩ = kT/(A·c_q), c_q = κq⁴ + σq², A = ab (h_q = L⁻¹∫… \
+             gives kT/c_q; a raw N×N FFT gives N⁴ times ours); real form \
+             h = Σ_{q: m>0, or m=0, n>0} [A_q cos(q·r) + B_q sin(q·r)]: variance = ⟨A_q²⟩ = \
+             ⟨B_q²⟩ = 2kT/(A·c_q); rate = c_q/ξ"
+        }
+    }
+}
+
+/// The membrane query: validates the flags and evaluates the exact references.
+fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
+    let boundary = match args.boundary {
+        BoundaryArg::SimplySupported => MembraneBoundary::SimplySupported,
+        BoundaryArg::Periodic => MembraneBoundary::Periodic,
+    };
+    let params = MembraneParams {
+        bending_rigidity: args.bending_rigidity,
+        tension: args.tension,
+        drag: args.drag,
+        kt: args.kt,
+        width: args.width,
+        height: args.height,
+        boundary,
+    };
+    let mb = Membrane::new(params).map_err(as_flag)?;
+    let (mode, sign) = membrane_mode(boundary, args.m, args.n)?;
+    let (x, y) = (
+        args.x.unwrap_or(args.width / 2.0),
+        args.y.unwrap_or(args.height / 2.0),
+    );
+    require_in_range("--x", x, 0.0, args.width)?;
+    require_in_range("--y", y, 0.0, args.height)?;
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0 && args.tolerance < 1.0) {
+        return Err(Error::invalid("--tolerance", args.tolerance, "in (0, 1)"));
+    }
+    let pv = mb.point_variance(x, y, args.tolerance).map_err(as_flag)?;
+    let [qx, qy] = mb.wavevector(mode);
+    let mut out = json!({
+        "boundary": boundary.name(),
+        "m": args.m,
+        "n": args.n,
+        "wavevector": [sign * qx, sign * qy],
+        "wavenumber": mb.wavenumber_sq(mode).sqrt(),
+        "stiffness": mb.stiffness(mode),
+        "rate": mb.mode_rate(mode),
+        "variance": mb.mode_variance(mode),
+        "buckling_tension": params.buckling_tension(),
+        "convention": membrane_convention(boundary),
+        "point_variance": {
+            "x": x, "y": y,
+            "value": pv.value,
+            "truncation_error": pv.truncation_error,
+            "terms": pv.n_modes,
+        },
+    });
+    if boundary == MembraneBoundary::Periodic {
+        out["fourier_variance"] = json!(mb.fourier_variance(args.m, args.n));
+    }
+    if let Some(cutoff) = args.cutoff {
+        let ea = mb.excess_area(cutoff).map_err(as_flag)?;
+        out["excess_area"] = json!({
+            "cutoff": ea.cutoff,
+            "modes": ea.n_modes,
+            "mean": ea.mean,
+            "variance": ea.variance,
+            "variance_tail_bound": ea.variance_tail_bound,
+        });
+    }
+    Ok(out)
+}
+
 /// Runs a theory query and prints one JSON object.
 pub fn run(args: TheoryArgs) -> Result<i32> {
     let value = match args.query {
@@ -309,6 +497,7 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             persistence_ratio,
             stretch_ratio,
         )?,
+        Query::Membrane(args) => membrane(&args)?,
     };
     if let Some(bad) = non_finite_number(&value) {
         return Err(Error::invalid(

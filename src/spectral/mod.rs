@@ -37,9 +37,20 @@
 //! for a position outside [0, L] (or non-finite); the fallible ones ([`HingedBeam::new`],
 //! [`HingedBeam::correlation`], [`HingedBeam::correlation_truncated`],
 //! [`ModalSimulator::new`]) return [`Error::InvalidParameter`] instead.
+//!
+//! # The membrane
+//!
+//! [`membrane`] holds the same kind of references for a fluctuating membrane (the Monge-gauge
+//! Helfrich membrane with tension, simply supported or periodic): [`Membrane`] and
+//! [`MembraneParams`]. Its conventions are stated once, in its module docs.
 
+pub mod membrane;
 pub mod simulator;
 
+pub use membrane::{
+    ExcessArea, MAX_ASPECT_RATIO, MAX_LISTED_MODES, MAX_MEMBRANE_MODES, Membrane, MembraneBoundary,
+    MembraneMode, MembraneParams, ModeShape,
+};
 pub use simulator::ModalSimulator;
 
 use crate::error::{Error, Result, require_in_range};
@@ -54,13 +65,14 @@ pub const MAX_MODES: usize = 100_000;
 /// A truncated mode sum together with a rigorous bound on the omitted tail.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SeriesValue {
-    /// The partial sum over modes 1..=`n_modes`.
+    /// The partial sum over modes 1..=`n_modes` (for the membrane: over the modes below
+    /// a wavenumber cutoff, see each function).
     pub value: f64,
     /// Rigorous upper bound on |exact − value| due to the omitted modes n > `n_modes`
-    /// (floating-point rounding of the partial sum, of relative order 10⁻¹⁶, is not
-    /// included).
+    /// (membrane: the modes beyond the cutoff; floating-point rounding of the partial sum,
+    /// of relative order 10⁻¹⁶, is not included).
     pub truncation_error: f64,
-    /// Number of modes summed.
+    /// Number of modes (or series terms) summed.
     pub n_modes: usize,
 }
 
@@ -91,6 +103,34 @@ pub(crate) fn sin_pi(s: f64) -> f64 {
     // sin(πr) = sin(π(1−r)); use the smaller argument.
     let r = if r > 0.5 { 1.0 - r } else { r };
     sign * (PI * r).sin()
+}
+
+/// One-sided Lorentzian power spectral density of a stationary Ornstein–Uhlenbeck process
+/// with the given variance and rate: S(f) = 4·variance·rate/(rate² + (2πf)²), f ≥ 0, with
+/// ∫₀^∞ S df = variance (the Fourier transform of variance·e^{−rate·|lag|}, doubled to fold
+/// negative frequencies).
+pub(crate) fn ou_lorentzian(variance: f64, rate: f64, f: f64) -> f64 {
+    let w = 2.0 * PI * f;
+    4.0 * variance * rate / (rate * rate + w * w)
+}
+
+/// Exact one-sided spectral density of that process sampled every `dt` (an AR(1)
+/// sequence), 0 ≤ f ≤ 1/(2dt): S(f) = 2dt·variance·(1−ρ²)/(1 − 2ρcos(2πf dt) + ρ²),
+/// ρ = e^{−rate·dt} (NaN if dt is not finite and > 0). See
+/// [`HingedBeam::sampled_spectrum`] for the derivation.
+pub(crate) fn ou_sampled_spectrum(variance: f64, rate: f64, dt: f64, f: f64) -> f64 {
+    if !(dt.is_finite() && dt > 0.0) {
+        return f64::NAN;
+    }
+    let x = rate * dt;
+    let rho = (-x).exp();
+    // 1 − ρ² computed without cancellation for small λ·dt.
+    let one_minus_rho2 = -(-2.0 * x).exp_m1();
+    // 1 − 2ρcos(2πf·dt) + ρ² = (1−ρ)² + 4ρ sin²(πf·dt), free of cancellation.
+    let one_minus_rho = -(-x).exp_m1();
+    let s = sin_pi(f * dt);
+    let denom = one_minus_rho * one_minus_rho + 4.0 * rho * s * s;
+    2.0 * dt * variance * one_minus_rho2 / denom
 }
 
 /// The hinged (simply supported) filament of eq. (2): exact modal results.
@@ -290,9 +330,7 @@ impl HingedBeam {
     /// It is the Fourier transform of [`HingedBeam::mode_autocovariance`], doubled to
     /// fold negative frequencies (the formula is even in f).
     pub fn lorentzian(&self, n: usize, f: f64) -> f64 {
-        let lam = self.mode_rate(n);
-        let w = 2.0 * PI * f;
-        4.0 * self.mode_variance(n) * lam / (lam * lam + w * w)
+        ou_lorentzian(self.mode_variance(n), self.mode_rate(n), f)
     }
 
     /// Exact one-sided power spectral density of the sampled sequence aₙ(k·dt), k ∈ ℤ,
@@ -304,18 +342,7 @@ impl HingedBeam {
     /// S(f) = 2 dt σₙ² (1−ρ²)/(1 − 2ρ cos(2πf dt) + ρ²), with ∫₀^{1/(2dt)} S df = σₙ².
     /// Sampling aliases the Lorentzian: S(f) = Σ_{m∈ℤ} `lorentzian`(f + m/dt).
     pub fn sampled_spectrum(&self, n: usize, dt: f64, f: f64) -> f64 {
-        if !(dt.is_finite() && dt > 0.0) {
-            return f64::NAN;
-        }
-        let x = self.mode_rate(n) * dt;
-        let rho = (-x).exp();
-        // 1 − ρ² computed without cancellation for small λ·dt.
-        let one_minus_rho2 = -(-2.0 * x).exp_m1();
-        // 1 − 2ρcos(2πf·dt) + ρ² = (1−ρ)² + 4ρ sin²(πf·dt), free of cancellation.
-        let one_minus_rho = -(-x).exp_m1();
-        let s = sin_pi(f * dt);
-        let denom = one_minus_rho * one_minus_rho + 4.0 * rho * s * s;
-        2.0 * dt * self.mode_variance(n) * one_minus_rho2 / denom
+        ou_sampled_spectrum(self.mode_variance(n), self.mode_rate(n), dt, f)
     }
 
     fn in_span(&self, x: f64) -> bool {

@@ -14,6 +14,16 @@ pub const SEED_ENSEMBLE: u64 = 0x5EC7_1002;
 pub const SEED_LARGE_STEP: u64 = 0x5EC7_1003;
 pub const SEED_REPRODUCIBLE: u64 = 0x5EC7_1004;
 
+// tests/membrane_reference.rs
+/// Independent Gaussian mode amplitudes: point variance, covariance, ⟨ΔA⟩, Var ΔA.
+pub const SEED_MEMBRANE_EQUILIBRIUM: u64 = 0x3E3B_7001;
+/// Exact OU ensembles from rest: the two-time correlation (M4).
+pub const SEED_MEMBRANE_FROM_REST: u64 = 0x3E3B_7002;
+/// Exact OU ensembles from equilibrium: the stationary two-time covariance.
+pub const SEED_MEMBRANE_STATIONARY: u64 = 0x3E3B_7003;
+/// The amplitudes of the quadrature (Parseval) check of ΔA and the energy.
+pub const SEED_MEMBRANE_QUADRATURE: u64 = 0x3E3B_7004;
+
 // tests/stats_validation.rs
 pub const SEED_IID_MEAN: u64 = 0x11D_0001;
 pub const SEED_AR1_TAU: u64 = 0xA41_0002;
