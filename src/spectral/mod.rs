@@ -133,6 +133,25 @@ pub(crate) fn ou_sampled_spectrum(variance: f64, rate: f64, dt: f64, f: f64) -> 
     2.0 * dt * variance * one_minus_rho2 / denom
 }
 
+/// Checks the times of a two-time correlation from rest: `t` finite and ≥ 0, `eta`
+/// finite and ≥ `t` (as `formula`, e.g. eq. 4, assumes).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `t` or `eta`.
+pub(crate) fn check_two_times(t: f64, eta: f64, formula: &str) -> Result<()> {
+    if !(t.is_finite() && t >= 0.0) {
+        return Err(Error::invalid("t", t, "finite and >= 0"));
+    }
+    if !eta.is_finite() || eta < t {
+        return Err(Error::invalid(
+            "eta",
+            eta,
+            format!("finite and >= t = {t} ({formula} assumes eta >= t)"),
+        ));
+    }
+    Ok(())
+}
+
 /// The hinged (simply supported) filament of eq. (2): exact modal results.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HingedBeam {
@@ -353,17 +372,7 @@ impl HingedBeam {
         let l = self.params.length;
         require_in_range("x", x, 0.0, l)?;
         require_in_range("y", y, 0.0, l)?;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::invalid("t", t, "finite and >= 0"));
-        }
-        if !eta.is_finite() || eta < t {
-            return Err(Error::invalid(
-                "eta",
-                eta,
-                format!("finite and >= t = {t} (eq. 4 assumes eta >= t)"),
-            ));
-        }
-        Ok(())
+        check_two_times(t, eta, "eq. 4")
     }
 
     /// Rigorous bound on the tail n > N of eq. (4).

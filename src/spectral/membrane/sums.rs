@@ -313,16 +313,7 @@ impl Membrane {
     fn rest_kernel(&self, r: (f64, f64), r2: (f64, f64), t: f64, eta: f64) -> Result<Kernel> {
         self.check_point("x", "y", r)?;
         self.check_point("x2", "y2", r2)?;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::invalid("t", t, "finite and >= 0"));
-        }
-        if !eta.is_finite() || eta < t {
-            return Err(Error::invalid(
-                "eta",
-                eta,
-                format!("finite and >= t = {t} (M4 assumes eta >= t)"),
-            ));
-        }
+        crate::spectral::check_two_times(t, eta, "M4")?;
         Ok(Kernel::FromRest { t, eta })
     }
 
