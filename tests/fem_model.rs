@@ -115,7 +115,7 @@ fn dof_layout_interpolation_and_assembled_forms_are_exact_for_cubics() {
     assert_eq!(b.node_rotation_index(6), Some(11));
     assert_eq!(b.element_dofs(0), [None, Some(0), Some(1), Some(2)]);
     assert_eq!(b.element_dofs(5), [Some(9), Some(10), None, Some(11)]);
-    assert_eq!(b.load_vectors().len(), 6);
+    assert_eq!(b.element_loads().len(), 6);
     // cubic with w(0) = w(L) = 0
     let w = |x: f64| x * (l - x) * (x + 0.3);
     let dw = |x: f64| -3.0 * x * x + 2.0 * (l - 0.3) * x + 0.3 * l;

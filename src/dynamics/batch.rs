@@ -14,8 +14,8 @@ use super::integrator::{THETA_SUGGESTION, ThetaOperators, check_dt, check_stabil
 use super::{Family, IntegratorKind};
 use crate::error::Result;
 use crate::fem::banded::{BandedCholesky, LANES, Lanes, SymBanded};
-use crate::fem::beam::BeamModel;
 use crate::fem::noise::{NoiseGenerator, NoiseModel, standard_normal};
+use crate::fem::system::LinearSystem;
 use crate::rng::TrajectoryRng;
 
 /// Up to [`LANES`] trajectories advanced together by the [`Driver`](super::Driver)'s
@@ -59,24 +59,29 @@ pub struct ThetaBatch {
 }
 
 impl ThetaBatch {
-    /// The batched θ-scheme with parameter `theta` for `beam`, noise `noise` and step
+    /// The batched θ-scheme with parameter `theta` for `system`, noise `noise` and step
     /// `dt`, or `None` if the lane sweeps do not serve its band
     /// ([`BandedCholesky::lanes_supported`]; the caller then steps trajectories one by
     /// one).
     ///
     /// # Errors
     /// As [`ThetaScheme::new`](super::ThetaScheme::new).
-    pub fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Option<Self>> {
+    pub fn new(
+        system: &LinearSystem,
+        noise: NoiseModel,
+        theta: f64,
+        dt: f64,
+    ) -> Result<Option<Self>> {
         let ThetaOperators {
             lhs,
             rhs,
             scale,
             noise,
-        } = ThetaOperators::new(beam, noise, theta, dt)?;
+        } = ThetaOperators::new(system, noise, theta, dt)?;
         if !lhs.lanes_supported(&rhs) {
             return Ok(None);
         }
-        let n = beam.n_dofs();
+        let n = system.n_dofs();
         Ok(Some(ThetaBatch {
             lhs,
             rhs,
@@ -97,7 +102,7 @@ impl ThetaBatch {
     /// As [`build_integrator`](super::build_integrator).
     pub fn build(
         kind: IntegratorKind,
-        beam: &BeamModel,
+        system: &LinearSystem,
         noise: NoiseModel,
         dt: f64,
         max_rate: f64,
@@ -106,7 +111,7 @@ impl ThetaBatch {
             Family::Theta(theta) => {
                 check_dt(dt)?;
                 check_stability(kind, dt, max_rate, THETA_SUGGESTION)?;
-                Self::new(beam, noise, theta, dt)
+                Self::new(system, noise, theta, dt)
             }
             Family::ExactModal | Family::Metropolis => Ok(None),
         }
@@ -213,6 +218,7 @@ mod tests {
     use crate::FilamentParams;
     use crate::dynamics::{Components, ThetaScheme, Trajectory};
     use crate::fem::Mesh;
+    use crate::fem::beam::BeamModel;
     use crate::rng::trajectory_rng;
 
     /// Every θ-scheme and noise model, 2D (one component) and 3D (two), uniform and

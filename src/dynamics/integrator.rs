@@ -3,9 +3,9 @@
 use super::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::banded::{BandedCholesky, RowTerm, SymBanded};
-use crate::fem::beam::BeamModel;
 use crate::fem::modal::GeneralizedModes;
 use crate::fem::noise::{NoiseGenerator, NoiseModel, NoiseStream, standard_normal};
+use crate::fem::system::LinearSystem;
 use crate::rng::TrajectoryRng;
 use nalgebra::{DMatrix, DVector};
 
@@ -86,18 +86,18 @@ pub struct ThetaScheme {
 }
 
 impl ThetaScheme {
-    /// Builds the scheme for `beam`, noise `noise` and step `dt`.
+    /// Builds the scheme for `system`, noise `noise` and step `dt`.
     ///
     /// # Errors
     /// A factorization failure (non-positive-definite left-hand side).
-    pub fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Self> {
+    pub fn new(system: &LinearSystem, noise: NoiseModel, theta: f64, dt: f64) -> Result<Self> {
         let ThetaOperators {
             lhs,
             rhs,
             scale,
             noise,
-        } = ThetaOperators::new(beam, noise, theta, dt)?;
-        let n = beam.n_dofs();
+        } = ThetaOperators::new(system, noise, theta, dt)?;
+        let n = system.n_dofs();
         Ok(ThetaScheme {
             lhs,
             rhs,
@@ -120,17 +120,22 @@ pub(super) struct ThetaOperators {
 }
 
 impl ThetaOperators {
-    /// The operators for `beam`, noise `noise`, parameter `theta` and step `dt`.
+    /// The operators for `system`, noise `noise`, parameter `theta` and step `dt`.
     ///
     /// # Errors
     /// A factorization failure (non-positive-definite left-hand side).
-    pub(super) fn new(beam: &BeamModel, noise: NoiseModel, theta: f64, dt: f64) -> Result<Self> {
-        let (k, c) = (beam.stiffness(), beam.damping());
+    pub(super) fn new(
+        system: &LinearSystem,
+        noise: NoiseModel,
+        theta: f64,
+        dt: f64,
+    ) -> Result<Self> {
+        let (k, c) = (system.stiffness(), system.damping());
         Ok(ThetaOperators {
             lhs: SymBanded::linear_combination(1.0, c, theta * dt, k)?.cholesky()?,
             rhs: SymBanded::linear_combination(1.0, c, -(1.0 - theta) * dt, k)?,
-            scale: (2.0 * beam.params().kt * dt).sqrt(),
-            noise: NoiseGenerator::new(noise, beam)?,
+            scale: (2.0 * system.kt() * dt).sqrt(),
+            noise: NoiseGenerator::new(noise, system)?,
         })
     }
 }
@@ -192,20 +197,20 @@ pub struct ExactModal {
 }
 
 impl ExactModal {
-    /// Builds the exact modal update from the generalized modes of `beam`.
+    /// Builds the exact modal update from the generalized modes of `system`.
     ///
     /// # Errors
     /// Propagates noise-generator construction errors.
     pub fn new(
-        beam: &BeamModel,
+        system: &LinearSystem,
         modes: &GeneralizedModes,
         noise: NoiseModel,
         dt: f64,
     ) -> Result<Self> {
-        let n = beam.n_dofs();
-        let kt = beam.params().kt;
+        let n = system.n_dofs();
+        let kt = system.kt();
         let phi = &modes.vectors;
-        let c = beam.damping().to_dense();
+        let c = system.damping().to_dense();
         let mut phi_m = phi.clone();
         let mut phi_g = phi.clone();
         for (i, &rate) in modes.rates.iter().enumerate() {
@@ -216,7 +221,7 @@ impl ExactModal {
         Ok(ExactModal {
             propagator: phi_m * phi.transpose() * c,
             noise_map: phi_g * phi.transpose(),
-            noise: NoiseGenerator::new(noise, beam)?,
+            noise: NoiseGenerator::new(noise, system)?,
             state: DVector::zeros(n),
             zeta: DVector::zeros(n),
             out: DVector::zeros(n),
@@ -234,7 +239,7 @@ impl Integrator for ExactModal {
     }
 }
 
-/// Builds an integrator of kind `kind` for `beam` with noise `noise` and step `dt`.
+/// Builds an integrator of kind `kind` for `system` with noise `noise` and step `dt`.
 ///
 /// `max_rate` is the largest generalized eigenvalue λ_max of (K, C), used for the
 /// stability limit of explicit schemes; `modes` are needed by `exact-modal` only.
@@ -246,7 +251,7 @@ impl Integrator for ExactModal {
 /// [`Error::InvalidParameter`] if `exact-modal` is requested without modes.
 pub fn build_integrator(
     kind: IntegratorKind,
-    beam: &BeamModel,
+    system: &LinearSystem,
     noise: NoiseModel,
     dt: f64,
     max_rate: f64,
@@ -268,7 +273,7 @@ pub fn build_integrator(
         }
         Family::Theta(theta) => {
             check_stability(kind, dt, max_rate, suggestion)?;
-            Box::new(ThetaScheme::new(beam, noise, theta, dt)?)
+            Box::new(ThetaScheme::new(system, noise, theta, dt)?)
         }
         Family::ExactModal => {
             check_stability(kind, dt, max_rate, suggestion)?;
@@ -276,10 +281,10 @@ pub fn build_integrator(
                 return Err(Error::invalid(
                     "modes",
                     "none",
-                    "the generalized modes of the beam (required by exact-modal)",
+                    "the generalized modes of the system (required by exact-modal)",
                 ));
             };
-            Box::new(ExactModal::new(beam, modes, noise, dt)?)
+            Box::new(ExactModal::new(system, modes, noise, dt)?)
         }
     })
 }
@@ -289,6 +294,7 @@ mod tests {
     use super::*;
     use crate::FilamentParams;
     use crate::fem::Mesh;
+    use crate::fem::beam::BeamModel;
     use crate::rng::trajectory_rng;
 
     /// The θ-step as separate passes (product, whole-vector draw, scale-add, solve, copy):

@@ -3,6 +3,7 @@
 use super::banded::SymBanded;
 use super::hermite;
 use super::mesh::Mesh;
+use super::system::{ElementLoad, LinearSystem};
 use crate::error::{Error, Result};
 use crate::params::FilamentParams;
 use nalgebra::{Cholesky, DMatrix, SymmetricEigen};
@@ -24,11 +25,6 @@ pub const BANDWIDTH: usize = 3;
 /// numerically (see `tests/fem_model.rs`).
 pub const UNIFORM_RATE_FACTOR: f64 = 2520.0;
 
-/// Local DOF data of one element: the element load vector `b_e = ∫ N dx`
-/// (`[h/2, h²/12, h/2, −h²/12]`) and the free-DOF index of each local DOF
-/// `[w_a, θ_a, w_b, θ_b]` (`None` for a constrained DOF).
-pub type ElementLoad = ([f64; 4], [Option<usize>; 4]);
-
 /// The linear Euler–Bernoulli beam of eq. (2) discretized by Hermite cubics, one
 /// transverse direction, hinged ends.
 ///
@@ -46,16 +42,25 @@ pub type ElementLoad = ([f64; 4], [Option<usize>; 4]);
 ///
 /// Matrices over the free DOFs (all symmetric banded, half-bandwidth 3):
 /// stiffness `K = EI ∫ N''ᵀN'' dx`, damping `C = ξ ∫ NᵀN dx`, geometric
-/// `G = ∫ N'ᵀN' dx`. The semi-discrete equation is `C ẇ = −K w + F`.
+/// `G = ∫ N'ᵀN' dx`. The semi-discrete equation is `C ẇ = −K w + F`: the beam *is* a
+/// [`LinearSystem`] (it dereferences to one: `K`, `C`, `kT`, the element loads
+/// `b_e = ∫ N dx = [h/2, h²/12, h/2, −h²/12]` with amplitude `sqrt(ξ/h_e)`), with its
+/// mesh, its geometric matrix and its DOF numbering besides.
 #[derive(Debug, Clone)]
 pub struct BeamModel {
     params: FilamentParams,
     mesh: Mesh,
-    n_dofs: usize,
-    stiffness: SymBanded,
-    damping: SymBanded,
+    system: LinearSystem,
     geometric: SymBanded,
-    loads: Vec<ElementLoad>,
+    dofs: Vec<[Option<usize>; 4]>,
+}
+
+impl std::ops::Deref for BeamModel {
+    type Target = LinearSystem;
+
+    fn deref(&self) -> &LinearSystem {
+        &self.system
+    }
 }
 
 /// Free index of global DOF `g` for a mesh with `n_nodes` nodes (see [`BeamModel`]).
@@ -103,6 +108,7 @@ impl BeamModel {
         let mut c = SymBanded::new(n_dofs, BANDWIDTH);
         let mut g = SymBanded::new(n_dofs, BANDWIDTH);
         let mut loads = Vec::with_capacity(mesh.n_elements());
+        let mut element_dofs = Vec::with_capacity(mesh.n_elements());
         for e in 0..mesh.n_elements() {
             let h = mesh.element_length(e);
             let dofs: [Option<usize>; 4] = std::array::from_fn(|a| free(2 * e + a, n_nodes));
@@ -118,16 +124,19 @@ impl BeamModel {
                     }
                 }
             }
-            loads.push((hermite::load_vector(h), dofs));
+            loads.push(ElementLoad {
+                amplitude: (params.drag / h).sqrt(),
+                load: hermite::load_vector(h).to_vec(),
+                dofs: dofs.to_vec(),
+            });
+            element_dofs.push(dofs);
         }
         Ok(BeamModel {
+            system: LinearSystem::new(params.kt, k, c, loads)?,
             params,
             mesh,
-            n_dofs,
-            stiffness: k,
-            damping: c,
             geometric: g,
-            loads,
+            dofs: element_dofs,
         })
     }
 
@@ -155,10 +164,8 @@ impl BeamModel {
     /// As [`SymBanded::linear_combination`].
     #[cfg(any(test, feature = "faults"))]
     pub(crate) fn with_scaled_matrices(mut self, k: f64, c: f64, g: f64) -> Result<Self> {
-        let scale = |m: &SymBanded, f: f64| SymBanded::linear_combination(f, m, 0.0, m);
-        self.stiffness = scale(&self.stiffness, k)?;
-        self.damping = scale(&self.damping, c)?;
-        self.geometric = scale(&self.geometric, g)?;
+        self.system.scale_matrices(k, c)?;
+        self.geometric = SymBanded::linear_combination(g, &self.geometric, 0.0, &self.geometric)?;
         Ok(self)
     }
 
@@ -172,43 +179,9 @@ impl BeamModel {
         &self.mesh
     }
 
-    /// Number of free DOFs `n = 2N`.
-    pub fn n_dofs(&self) -> usize {
-        self.n_dofs
-    }
-
-    /// Bending stiffness `K = EI ∫ N''ᵀN'' dx` over the free DOFs.
-    pub fn stiffness(&self) -> &SymBanded {
-        &self.stiffness
-    }
-
-    /// Damping matrix `C = ξ ∫ NᵀN dx` over the free DOFs.
-    pub fn damping(&self) -> &SymBanded {
-        &self.damping
-    }
-
     /// Geometric matrix `G = ∫ N'ᵀN' dx` over the free DOFs (`wᵀGw = ∫ w'² dx`).
     pub fn geometric(&self) -> &SymBanded {
         &self.geometric
-    }
-
-    /// Per element `e`: `(b_e, dofs_e)` with `b_e = ∫ N dx = [h/2, h²/12, h/2, −h²/12]`
-    /// and the free index of each local DOF (see [`ElementLoad`]).
-    pub fn load_vectors(&self) -> &[ElementLoad] {
-        &self.loads
-    }
-
-    /// Assembled load vector `b = Σ_e b_e` over the free DOFs, so that `∫₀ᴸ w dx = bᵀw`.
-    pub fn assembled_load_vector(&self) -> Vec<f64> {
-        let mut b = vec![0.0; self.n_dofs];
-        for (be, dofs) in &self.loads {
-            for (v, d) in be.iter().zip(dofs) {
-                if let Some(i) = d {
-                    b[*i] += v;
-                }
-            }
-        }
-        b
     }
 
     /// Free indices of the local DOFs `[w_a, θ_a, w_b, θ_b]` of element `e`
@@ -217,7 +190,7 @@ impl BeamModel {
     /// # Panics
     /// If `e >= n_elements`.
     pub fn element_dofs(&self, e: usize) -> [Option<usize>; 4] {
-        self.loads[e].1
+        self.dofs[e]
     }
 
     /// Free index of the deflection `w_node` (`None` for the hinged end nodes and for
@@ -240,15 +213,14 @@ impl BeamModel {
     pub fn deflection_at(&self, state: &[f64], x: f64) -> f64 {
         assert_eq!(
             state.len(),
-            self.n_dofs,
+            self.n_dofs(),
             "deflection_at: wrong state length"
         );
         let Some((e, s)) = self.mesh.locate(x) else {
             return f64::NAN;
         };
         let n = hermite::shape(self.mesh.element_length(e), s);
-        self.loads[e]
-            .1
+        self.dofs[e]
             .iter()
             .zip(n)
             .filter_map(|(d, na)| d.map(|i| na * state[i]))
@@ -270,12 +242,12 @@ impl BeamModel {
     /// # Errors
     /// [`Error::Numerical`] if the bracket cannot be established.
     pub fn max_rate(&self) -> Result<f64> {
-        let n = self.n_dofs;
+        let n = self.n_dofs();
         let count_above = |sigma: f64| -> Result<usize> {
             let mut s = sigma;
             let mut last = None;
             for _ in 0..8 {
-                let a = SymBanded::linear_combination(1.0, &self.stiffness, -s, &self.damping)?;
+                let a = SymBanded::linear_combination(1.0, self.stiffness(), -s, self.damping())?;
                 match a.negative_eigenvalue_count() {
                     // eigenvalues of (K, C) below s = negative pivots; none equals s
                     Ok(neg) => return Ok(n - neg),
@@ -312,7 +284,7 @@ impl BeamModel {
                 x[i] = 1.0;
             }
         }
-        let rq = self.stiffness.quadratic_form(&x) / self.damping.quadratic_form(&x);
+        let rq = self.stiffness().quadratic_form(&x) / self.damping().quadratic_form(&x);
         let mut lo = rq * (1.0 - 1e-9);
         if !(lo.is_finite() && lo > 0.0 && lo < hi && count_above(lo)? >= 1) {
             lo = 0.0;

@@ -6,6 +6,8 @@
 //! - [`mesh`]: node coordinates on `[0, L]` (uniform, graded, explicit).
 //! - [`hermite`]: shape functions and element matrices `C_e`, `K_e`, `G_e`, `b_e`.
 //! - [`banded`]: symmetric banded matrices, banded Cholesky, inertia counts.
+//! - [`system`]: the [`LinearSystem`] `C ẋ = −Kx + F` every object assembles to, with the
+//!   element loads of eq. (5).
 //! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
 //! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
@@ -21,10 +23,11 @@ pub mod mesh;
 pub mod modal;
 pub mod noise;
 pub mod paired;
+pub mod system;
 pub mod vonkarman;
 
 pub use banded::{BandedCholesky, SymBanded};
-pub use beam::{BeamModel, ElementLoad, UNIFORM_RATE_FACTOR};
+pub use beam::{BeamModel, UNIFORM_RATE_FACTOR};
 pub use mesh::Mesh;
 pub use modal::{
     GeneralizedModes, continuous_stationary_covariance, discrete_stationary_covariance,
@@ -32,3 +35,4 @@ pub use modal::{
 };
 pub use noise::{NoiseGenerator, NoiseModel};
 pub use paired::{ModeBlock, PairedModes};
+pub use system::{ElementLoad, LinearSystem};

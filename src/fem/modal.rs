@@ -14,16 +14,18 @@
 
 use super::beam::BeamModel;
 use super::hermite::{GAUSS5, shape};
+use super::system::LinearSystem;
 use crate::error::{Error, Result};
 use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::PI;
 
-/// Generalized eigenpairs of `K φ = λ C φ` over the free DOFs of a [`BeamModel`].
+/// Generalized eigenpairs of `K φ = λ C φ` over the free DOFs of a [`LinearSystem`].
 #[derive(Debug, Clone)]
 pub struct GeneralizedModes {
     /// Rates `λ_i`, ascending.
     pub rates: DVector<f64>,
-    /// Column `i` is `φ_i`, normalized `ΦᵀCΦ = I` (hence `ΦᵀKΦ = diag λ`). Sign: the
+    /// Column `i` is `φ_i`, normalized `ΦᵀCΦ = I` (hence `ΦᵀKΦ = diag λ`). Sign: fixed by
+    /// the object that assembled the system; for the beam ([`generalized_modes`]) the
     /// projection `∫₀ᴸ w_h(x) sin((i+1)πx/L) dx` of the interpolated mode on the
     /// continuum mode of the same index is positive (computed by 5-point Gauss per
     /// element); if that projection is negligible (< 1e-8 of its Cauchy–Schwarz bound),
@@ -45,8 +47,20 @@ fn numerical(routine: &str, detail: impl Into<String>) -> Error {
 /// # Errors
 /// [`Error::Numerical`] if `C` is not positive definite or the eigensolver fails.
 pub fn generalized_modes(beam: &BeamModel) -> Result<GeneralizedModes> {
-    let k = beam.stiffness().to_dense();
-    let c = beam.damping().to_dense();
+    generalized_modes_signed(beam, |i, col| beam_mode_flips(beam, i, col))
+}
+
+/// [`generalized_modes`] of any [`LinearSystem`], with the sign rule of the object that
+/// assembled it: column `i` (C-normalized) is negated where `flip(i, φ_i)` is true.
+///
+/// # Errors
+/// As [`generalized_modes`].
+pub fn generalized_modes_signed(
+    system: &LinearSystem,
+    flip: impl Fn(usize, &[f64]) -> bool,
+) -> Result<GeneralizedModes> {
+    let k = system.stiffness().to_dense();
+    let c = system.damping().to_dense();
     let n = k.nrows();
     let l = Cholesky::new(c)
         .ok_or_else(|| numerical("generalized_modes", "damping matrix not positive definite"))?
@@ -77,44 +91,9 @@ pub fn generalized_modes(beam: &BeamModel) -> Result<GeneralizedModes> {
             format!("rate {i} is {:e}, expected finite and > 0", rates[i]),
         ));
     }
-    // deterministic signs
-    let len = beam.mesh().length();
     for i in 0..n {
         let col: Vec<f64> = phi.column(i).iter().copied().collect();
-        let kk = (i + 1) as f64 * PI / len;
-        let mut proj = 0.0;
-        let mut norm2 = 0.0;
-        let mesh = beam.mesh();
-        for e in 0..mesh.n_elements() {
-            let h = mesh.element_length(e);
-            let x0 = mesh.nodes()[e];
-            let dofs = beam.element_dofs(e);
-            for &(t, wq) in &GAUSS5 {
-                let s = 0.5 * h * (t + 1.0);
-                let nv = shape(h, s);
-                let w: f64 = dofs
-                    .iter()
-                    .zip(nv)
-                    .filter_map(|(d, na)| d.map(|j| na * col[j]))
-                    .sum();
-                proj += 0.5 * h * wq * w * (kk * (x0 + s)).sin();
-                norm2 += 0.5 * h * wq * w * w;
-            }
-        }
-        let bound = (norm2 * 0.5 * len).sqrt();
-        let flip = if proj.abs() > 1e-8 * bound {
-            proj < 0.0
-        } else {
-            let jmax = col
-                .iter()
-                .enumerate()
-                .fold((0, 0.0_f64), |(bj, bv), (j, v)| {
-                    if v.abs() > bv { (j, v.abs()) } else { (bj, bv) }
-                })
-                .0;
-            col[jmax] < 0.0
-        };
-        if flip {
+        if flip(i, &col) {
             phi.column_mut(i).neg_mut();
         }
     }
@@ -122,6 +101,47 @@ pub fn generalized_modes(beam: &BeamModel) -> Result<GeneralizedModes> {
         rates,
         vectors: phi,
     })
+}
+
+/// The beam's sign rule for mode `i` with C-normalized vector `col` (see
+/// [`GeneralizedModes::vectors`]): whether its projection on the continuum sine mode of the
+/// same index is negative (or, where that projection is negligible, its largest-magnitude
+/// component is).
+fn beam_mode_flips(beam: &BeamModel, i: usize, col: &[f64]) -> bool {
+    let len = beam.mesh().length();
+    let kk = (i + 1) as f64 * PI / len;
+    let mut proj = 0.0;
+    let mut norm2 = 0.0;
+    let mesh = beam.mesh();
+    for e in 0..mesh.n_elements() {
+        let h = mesh.element_length(e);
+        let x0 = mesh.nodes()[e];
+        let dofs = beam.element_dofs(e);
+        for &(t, wq) in &GAUSS5 {
+            let s = 0.5 * h * (t + 1.0);
+            let nv = shape(h, s);
+            let w: f64 = dofs
+                .iter()
+                .zip(nv)
+                .filter_map(|(d, na)| d.map(|j| na * col[j]))
+                .sum();
+            proj += 0.5 * h * wq * w * (kk * (x0 + s)).sin();
+            norm2 += 0.5 * h * wq * w * w;
+        }
+    }
+    let bound = (norm2 * 0.5 * len).sqrt();
+    if proj.abs() > 1e-8 * bound {
+        proj < 0.0
+    } else {
+        let jmax = col
+            .iter()
+            .enumerate()
+            .fold((0, 0.0_f64), |(bj, bv), (j, v)| {
+                if v.abs() > bv { (j, v.abs()) } else { (bj, bv) }
+            })
+            .0;
+        col[jmax] < 0.0
+    }
 }
 
 impl GeneralizedModes {
@@ -137,9 +157,9 @@ impl GeneralizedModes {
 
     /// Modal projector `P` with rows `φ_iᵀC`, `i < n_modes` (clamped to the number of
     /// modes), so modal amplitudes are `q = P w` and `w = Φ q` (all modes).
-    pub fn projector(&self, beam: &BeamModel, n_modes: usize) -> DMatrix<f64> {
+    pub fn projector(&self, system: &LinearSystem, n_modes: usize) -> DMatrix<f64> {
         let r = n_modes.min(self.len());
-        let c = beam.damping().to_dense();
+        let c = system.damping().to_dense();
         self.vectors.columns(0, r).transpose() * c
     }
 }

@@ -13,9 +13,10 @@
 //!   `Σ_ζ = Σ_e (ξ/h_e) b_e b_eᵀ` and `cov F = Σ_e (2ξkT/(h_e Δt)) b_e b_eᵀ ≠ 2kT·C/Δt`.
 
 use super::banded::BandedCholesky;
-use super::beam::{BeamModel, ElementLoad};
+use super::beam::BeamModel;
 use super::mesh::Mesh;
 use super::modal::{generalized_modes, modal_noise_covariance};
+use super::system::{ElementLoad, LinearSystem};
 use crate::error::Result;
 use crate::params::FilamentParams;
 use nalgebra::DMatrix;
@@ -57,7 +58,7 @@ impl std::fmt::Display for NoiseModel {
 enum Source {
     Consistent(BandedCholesky),
     ElementUniform {
-        /// `sqrt(ξ/h_e)` per element.
+        /// `sqrt(ξ/|Ω_e|)` per element (the loads' amplitudes, gathered).
         amplitude: Vec<f64>,
         loads: Vec<ElementLoad>,
         /// The same loads by free DOF, for [`NoiseStream`].
@@ -81,8 +82,8 @@ impl DofLoads {
     fn new(n: usize, loads: &[ElementLoad]) -> Self {
         let mut elements_needed = Vec::with_capacity(n);
         let mut per_dof = vec![Vec::new(); n];
-        for (e, (b, dofs)) in loads.iter().enumerate() {
-            for (bv, d) in b.iter().zip(dofs) {
+        for (e, l) in loads.iter().enumerate() {
+            for (bv, d) in l.load.iter().zip(&l.dofs) {
                 if let Some(i) = d {
                     per_dof[*i].push((e, *bv));
                 }
@@ -117,7 +118,7 @@ pub fn standard_normal<R: rand::Rng + ?Sized>(rng: &mut R) -> f64 {
 }
 
 /// Draws the standardized noise vector `ζ` (covariance `Σ_ζ`) over the free DOFs of a
-/// [`BeamModel`]; the caller scales it by `sqrt(2kT/Δt)`.
+/// [`LinearSystem`]; the caller scales it by `sqrt(2kT/Δt)`.
 #[derive(Debug, Clone)]
 pub struct NoiseGenerator {
     model: NoiseModel,
@@ -131,17 +132,13 @@ impl NoiseGenerator {
     ///
     /// # Errors
     /// [`crate::Error::Numerical`] if `C` is not positive definite.
-    pub fn new(model: NoiseModel, beam: &BeamModel) -> Result<Self> {
-        let n = beam.n_dofs();
+    pub fn new(model: NoiseModel, system: &LinearSystem) -> Result<Self> {
+        let n = system.n_dofs();
         let source = match model {
-            NoiseModel::Consistent => Source::Consistent(beam.damping().cholesky()?),
+            NoiseModel::Consistent => Source::Consistent(system.damping().cholesky()?),
             NoiseModel::ElementUniform => {
-                let xi = beam.params().drag;
-                let mesh = beam.mesh();
-                let amplitude: Vec<f64> = (0..mesh.n_elements())
-                    .map(|e| (xi / mesh.element_length(e)).sqrt())
-                    .collect();
-                let loads = beam.load_vectors().to_vec();
+                let loads = system.element_loads().to_vec();
+                let amplitude: Vec<f64> = loads.iter().map(|l| l.amplitude).collect();
                 let by_dof = DofLoads::new(n, &loads);
                 Source::ElementUniform {
                     amplitude,
@@ -194,9 +191,9 @@ impl NoiseGenerator {
                 amplitude, loads, ..
             } => {
                 out.fill(0.0);
-                for (a, (b, dofs)) in amplitude.iter().zip(loads) {
+                for (a, l) in amplitude.iter().zip(loads) {
                     let f = a * standard_normal(rng);
-                    for (bv, d) in b.iter().zip(dofs) {
+                    for (bv, d) in l.load.iter().zip(&l.dofs) {
                         if let Some(i) = d {
                             out[*i] += f * bv;
                         }
@@ -256,9 +253,10 @@ impl NoiseGenerator {
                 amplitude, loads, ..
             } => {
                 let mut cov = DMatrix::zeros(self.n, self.n);
-                for (a, (b, dofs)) in amplitude.iter().zip(loads) {
-                    for p in 0..4 {
-                        for q in 0..4 {
+                for (a, l) in amplitude.iter().zip(loads) {
+                    let (b, dofs) = (&l.load, &l.dofs);
+                    for p in 0..b.len() {
+                        for q in 0..b.len() {
                             if let (Some(i), Some(j)) = (dofs[p], dofs[q]) {
                                 cov[(i, j)] += a * a * b[p] * b[q];
                             }
