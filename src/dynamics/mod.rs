@@ -34,6 +34,7 @@
 //! ([`modal_metropolis`], O(n) per step with 2×2 solves).
 
 pub mod batch;
+pub mod discrete;
 pub mod driver;
 pub mod ensemble;
 mod integrator;
@@ -41,6 +42,7 @@ pub mod modal_metropolis;
 pub mod nonlinear;
 
 pub use batch::{BatchTrajectory, ComponentBatch, LaneOf, ThetaBatch};
+pub use discrete::DiscreteLaw;
 pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};

@@ -9,7 +9,7 @@
 //! of the Helfrich membrane's `ξ ∂h/∂t = −κ∇⁴h + σ∇²h + f` for the plate). The noise, the
 //! integrators, the generalized modes and every exact discrete reference are written for a
 //! [`LinearSystem`], whichever object assembled it: the beam ([`super::BeamModel`]) and the
-//! plate ([`super::plate`]) are two ways of building one.
+//! Bogner–Fox–Schmit plate of the membrane are two ways of building one.
 //!
 //! The paper's element-uniform noise (eq. 5) needs one more thing per element: a uniform
 //! random load `f_e` with `var f_e = 2ξkT/(|Ω_e| Δt)` on an element of measure `|Ω_e|`

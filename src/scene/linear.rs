@@ -10,6 +10,7 @@
 //! the *continuum* reference is the modal solution of eq. (2) (per-mode variance
 //! 2kTL³/(π⁴n⁴EI), rate λ_n, profile kT x²(L−x)²/(3EI L), eq. 4).
 
+use crate::dynamics::discrete::DiscreteLaw;
 use crate::dynamics::{
     BatchTrajectory, ComponentBatch, Components, Driver, Integrator, IntegratorKind, LaneOf,
     Observer, ThetaBatch, Trajectory, build_integrator, par_indexed,
@@ -17,10 +18,8 @@ use crate::dynamics::{
 use crate::error::{Error, Result};
 use crate::fem::banded::LANES;
 use crate::fem::beam::BeamModel;
-use crate::fem::modal::{
-    GeneralizedModes, discrete_stationary_covariance, generalized_modes, modal_noise_covariance,
-};
-use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::fem::modal::{GeneralizedModes, generalized_modes};
+use crate::fem::noise::NoiseModel;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
@@ -556,7 +555,7 @@ impl Setup<'_> {
 
     /// The finite-element filament: fails early above the stability limit, then the
     /// exact discrete references from the generalized modes
-    /// ([`discrete_stationary_covariance`]).
+    /// ([`DiscreteLaw`]: the same law whichever object assembled the system).
     fn fem(&self) -> Result<Prepared> {
         let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
         let kt = p.kt;
@@ -579,25 +578,17 @@ impl Setup<'_> {
         let max_rate = gm.rates[gm.rates.len() - 1];
         // Fails early with the stability limit if the step is too large.
         build_integrator(spec.integrator, &beam, spec.noise, dt, max_rate, Some(&gm))?;
-        let sigma_zeta = NoiseGenerator::new(spec.noise, &beam)?.covariance();
-        let sigma_q = modal_noise_covariance(&gm, &sigma_zeta);
-        let (m, g): (Vec<f64>, Vec<f64>) = gm
-            .rates
-            .iter()
-            .map(|&r| spec.integrator.modal_form(r, dt, kt))
-            .unzip();
-        let s = discrete_stationary_covariance(&sigma_q, &m, &g)?;
+        let law = DiscreteLaw::new(&beam, &gm, spec.integrator, spec.noise, dt)?;
         let mut refs = Vec::new();
         for i in 0..self.scene.sampling.modes {
             let n = i + 1;
-            let rate = gm.rates[i];
             refs.push(ModeReference {
                 n,
-                variance_discrete: s[(i, i)],
-                variance_equipartition: kt / rate,
+                variance_discrete: law.mode_variance(i),
+                variance_equipartition: law.equipartition(i),
                 variance_continuum: kt / self.continuum.mode_rate(n),
-                multiplier: m[i],
-                rate_discrete: (m[i] > 0.0).then(|| -m[i].ln() / dt),
+                multiplier: law.multipliers[i],
+                rate_discrete: law.decay_rate(i),
                 rate_continuum: self.continuum.mode_rate(n),
             });
         }
@@ -608,10 +599,10 @@ impl Setup<'_> {
             .iter()
             .map(|&x| {
                 let a = probe(x);
-                (a.transpose() * &s * &a)[(0, 0)]
+                law.point_covariance(&a, &a)
             })
             .collect();
-        let two_time = self.fem_two_time(&m, &g, &sigma_q, &probe)?;
+        let two_time = self.fem_two_time(&law, &probe)?;
         let projector = gm.projector(&beam, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
         let scale = (2.0 / (p.drag * p.length)).sqrt();
@@ -637,14 +628,11 @@ impl Setup<'_> {
         })
     }
 
-    /// The two-time references of the finite-element filament from rest, with per-mode
-    /// multipliers `m` and gains `g`, modal noise covariance `sigma_q` and the modal
-    /// probe vectors `probe(x)`.
+    /// The two-time references of the finite-element filament from rest, under the
+    /// discrete law `law`, with the modal probe vectors `probe(x)`.
     fn fem_two_time(
         &self,
-        m: &[f64],
-        g: &[f64],
-        sigma_q: &DMatrix<f64>,
+        law: &DiscreteLaw,
         probe: &dyn Fn(f64) -> DVector<f64>,
     ) -> Result<Vec<TwoTimeReference>> {
         let (length, dt, tau1) = (self.scene.filament.length, self.dt, self.tau1);
@@ -656,23 +644,6 @@ impl Setup<'_> {
                 self.steps(q[3] * tau1).max(1),
             );
             let (t, eta) = (ts as f64 * dt, es as f64 * dt);
-            // From rest: S_k,ij = g_i g_j Σq_ij (1 − (m_i m_j)^k)/(1 − m_i m_j), then
-            // ⟨q(η) q(t)ᵀ⟩ = diag(m^{η−t}) S_t.
-            let n = m.len();
-            let mut st = DMatrix::zeros(n, n);
-            for i in 0..n {
-                for j in 0..n {
-                    let mm = m[i] * m[j];
-                    let transient = if mm == 1.0 {
-                        0.0
-                    } else {
-                        1.0 - mm.powf(ts as f64)
-                    };
-                    st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * transient / (1.0 - mm)
-                        * m[i].powf((es - ts) as f64);
-                }
-            }
-            let (ax, ay) = (probe(x), probe(y));
             tt.push(TwoTimeReference {
                 x,
                 y,
@@ -680,7 +651,7 @@ impl Setup<'_> {
                 eta,
                 t_step: ts,
                 eta_step: es,
-                discrete: (ay.transpose() * &st * &ax)[(0, 0)],
+                discrete: law.two_time(ts, es, &probe(x), &probe(y)),
                 continuum: self.continuum.correlation(x, y, t, eta, 1e-12)?.value,
             });
         }

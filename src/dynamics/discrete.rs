@@ -1,0 +1,195 @@
+//! The exact discrete references of a linear system under one integrator, noise model and
+//! time step, whichever object assembled the system (filament or membrane).
+//!
+//! In the generalized modes of `(K, C)` every linear integrator is the per-mode recursion
+//! `q_{k+1} = M q_k + G Φᵀζ_k` (`M = diag m`, `G = diag g`,
+//! [`IntegratorKind::modal_form`]), driven by the modal noise covariance
+//! `Σ_q = Φᵀ Σ_ζ Φ` (the identity for consistent noise, not for the paper's element-uniform
+//! load, eq. 5). Hence, exactly:
+//!
+//! - the stationary covariance `S_ij = g_i g_j Σ_q,ij / (1 − m_i m_j)`
+//!   ([`discrete_stationary_covariance`]);
+//! - the discrete decay rate of mode `i`, `−ln(m_i)/Δt` (for `m_i > 0`);
+//! - from rest, the covariance after `k` steps
+//!   `S_k,ij = g_i g_j Σ_q,ij (1 − (m_i m_j)^k)/(1 − m_i m_j)`, and the two-time
+//!   covariance `⟨q(η) q(t)ᵀ⟩ = diag(m^{η−t}) S_t` (the discrete eq. 4);
+//! - at a point with modal probe `a_x = Φᵀ p_x` (`w(x) = p_xᵀ w`),
+//!   `⟨w(x) w(y)⟩ = a_yᵀ S a_x`.
+
+use crate::dynamics::IntegratorKind;
+use crate::error::Result;
+use crate::fem::modal::{GeneralizedModes, discrete_stationary_covariance, modal_noise_covariance};
+use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::fem::system::LinearSystem;
+use nalgebra::{DMatrix, DVector};
+
+/// The exact discrete-time law of a linear system's modal amplitudes under one integrator,
+/// noise model and step (see the module docs).
+#[derive(Debug, Clone)]
+pub struct DiscreteLaw {
+    /// Time step Δt.
+    pub dt: f64,
+    /// Thermal energy kT.
+    pub kt: f64,
+    /// Generalized rates `λ_i`, ascending (all modes).
+    pub rates: Vec<f64>,
+    /// One-step multipliers `m_i`.
+    pub multipliers: Vec<f64>,
+    /// Noise gains `g_i`.
+    pub gains: Vec<f64>,
+    /// Modal noise covariance `Σ_q = Φᵀ Σ_ζ Φ`.
+    pub noise_covariance: DMatrix<f64>,
+    /// Stationary modal covariance `S`.
+    pub stationary: DMatrix<f64>,
+}
+
+impl DiscreteLaw {
+    /// The law of `system` with generalized modes `modes` under `integrator`, `noise` and
+    /// step `dt`.
+    ///
+    /// # Errors
+    /// A noise-generator failure (non-positive-definite `C`); [`crate::Error::InvalidParameter`]
+    /// naming the mode if the step is unstable for some mode (`|m| ≥ 1`).
+    pub fn new(
+        system: &LinearSystem,
+        modes: &GeneralizedModes,
+        integrator: IntegratorKind,
+        noise: NoiseModel,
+        dt: f64,
+    ) -> Result<Self> {
+        let kt = system.kt();
+        let sigma_zeta = NoiseGenerator::new(noise, system)?.covariance();
+        let noise_covariance = modal_noise_covariance(modes, &sigma_zeta);
+        let (multipliers, gains): (Vec<f64>, Vec<f64>) = modes
+            .rates
+            .iter()
+            .map(|&r| integrator.modal_form(r, dt, kt))
+            .unzip();
+        let stationary = discrete_stationary_covariance(&noise_covariance, &multipliers, &gains)?;
+        Ok(DiscreteLaw {
+            dt,
+            kt,
+            rates: modes.rates.iter().copied().collect(),
+            multipliers,
+            gains,
+            noise_covariance,
+            stationary,
+        })
+    }
+
+    /// Stationary variance of modal amplitude `i` (0-based).
+    pub fn mode_variance(&self, i: usize) -> f64 {
+        self.stationary[(i, i)]
+    }
+
+    /// Equipartition's variance `kT/λ_i` of the discrete mode `i`.
+    pub fn equipartition(&self, i: usize) -> f64 {
+        self.kt / self.rates[i]
+    }
+
+    /// The discrete decay rate `−ln(m_i)/Δt` of mode `i`, `None` if `m_i ≤ 0` (the mode
+    /// alternates in sign and has no rate).
+    pub fn decay_rate(&self, i: usize) -> Option<f64> {
+        let m = self.multipliers[i];
+        (m > 0.0).then(|| -m.ln() / self.dt)
+    }
+
+    /// Stationary `⟨w(x) w(y)⟩ = a_yᵀ S a_x` for modal probes `a_x`, `a_y`.
+    pub fn point_covariance(&self, ax: &DVector<f64>, ay: &DVector<f64>) -> f64 {
+        (ay.transpose() * &self.stationary * ax)[(0, 0)]
+    }
+
+    /// `⟨w(x, t) w(y, η)⟩` from rest, `t = ts·Δt ≤ η = es·Δt`, for modal probes `ax` (at
+    /// the earlier time) and `ay` (at the later): `a_yᵀ diag(m^{es−ts}) S_ts a_x`.
+    pub fn two_time(&self, ts: u64, es: u64, ax: &DVector<f64>, ay: &DVector<f64>) -> f64 {
+        let (m, g, sigma_q) = (&self.multipliers, &self.gains, &self.noise_covariance);
+        let n = m.len();
+        let mut st = DMatrix::zeros(n, n);
+        for i in 0..n {
+            for j in 0..n {
+                let mm = m[i] * m[j];
+                let transient = if mm == 1.0 {
+                    0.0
+                } else {
+                    1.0 - mm.powf(ts as f64)
+                };
+                st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * transient / (1.0 - mm)
+                    * m[i].powf((es - ts) as f64);
+            }
+        }
+        (ay.transpose() * &st * ax)[(0, 0)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::banded::SymBanded;
+    use crate::fem::modal::generalized_modes_signed;
+    use crate::fem::system::ElementLoad;
+
+    /// One DOF, `c ẋ = −k x + F`: rate λ = k/c, and for Euler–Maruyama the closed forms
+    /// m = 1 − λΔt, stationary variance (kT/λ)/(1 − λΔt/2) (consistent noise), the
+    /// element-uniform noise with Σ_ζ = s² instead of c scaling it by s²/c, and from rest
+    /// ⟨q(η) q(t)⟩ = m^{η−t} g² (1 − m^{2t})/(1 − m²).
+    #[test]
+    fn one_dof_closed_forms() {
+        let (k, c, kt, dt, s) = (3.0, 2.0, 0.7, 0.1, 0.9);
+        let mut km = SymBanded::new(1, 0);
+        km.add(0, 0, k).unwrap();
+        let mut cm = SymBanded::new(1, 0);
+        cm.add(0, 0, c).unwrap();
+        let load = ElementLoad {
+            amplitude: s,
+            load: vec![1.0],
+            dofs: vec![Some(0)],
+        };
+        let sys = LinearSystem::new(kt, km, cm, vec![load]).unwrap();
+        let modes = generalized_modes_signed(&sys, |_, _| false).unwrap();
+        let lambda = k / c;
+        let a = lambda * dt;
+        let law = DiscreteLaw::new(
+            &sys,
+            &modes,
+            IntegratorKind::EulerMaruyama,
+            NoiseModel::Consistent,
+            dt,
+        )
+        .unwrap();
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-13 * y.abs();
+        assert!(close(law.rates[0], lambda));
+        assert!(close(law.multipliers[0], 1.0 - a));
+        assert!(close(law.mode_variance(0), kt / lambda / (1.0 - a / 2.0)));
+        assert!(close(law.equipartition(0), kt / lambda));
+        assert!(close(law.decay_rate(0).unwrap(), -(1.0 - a).ln() / dt));
+        // The modal probe of x itself: x = φ q with φ = 1/sqrt(c).
+        let probe = DVector::from_element(1, 1.0 / c.sqrt());
+        assert!(close(
+            law.point_covariance(&probe, &probe),
+            law.mode_variance(0) / c
+        ));
+        let (m, g2) = (1.0 - a, 2.0 * kt * dt);
+        let expect = m.powi(3) * g2 * (1.0 - m.powi(8)) / (1.0 - m * m);
+        assert!(close(law.two_time(4, 7, &probe, &probe), expect / c));
+        let eu = DiscreteLaw::new(
+            &sys,
+            &modes,
+            IntegratorKind::EulerMaruyama,
+            NoiseModel::ElementUniform,
+            dt,
+        )
+        .unwrap();
+        assert!(close(eu.mode_variance(0), law.mode_variance(0) * s * s / c));
+        // A wrong closed form is told apart: backward Euler's variance is not EM's.
+        let be = DiscreteLaw::new(
+            &sys,
+            &modes,
+            IntegratorKind::BackwardEuler,
+            NoiseModel::Consistent,
+            dt,
+        )
+        .unwrap();
+        assert!(!close(be.mode_variance(0), law.mode_variance(0)));
+        assert!(close(be.mode_variance(0), kt / lambda / (1.0 + a / 2.0)));
+    }
+}
