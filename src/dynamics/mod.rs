@@ -39,6 +39,7 @@ pub mod driver;
 pub mod ensemble;
 mod integrator;
 pub mod modal_metropolis;
+pub mod modal_step;
 pub mod nonlinear;
 
 pub use batch::{BatchTrajectory, ComponentBatch, LaneOf, ThetaBatch};
@@ -47,6 +48,7 @@ pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
 pub use modal_metropolis::ModalMetropolis;
+pub use modal_step::ModalStep;
 pub use nonlinear::{NonlinearIntegrator, NonlinearStep};
 
 use crate::error::Error;
