@@ -386,19 +386,34 @@ pub fn element_uniform_variance_ratios(
         .map(|&ne| {
             let beam = BeamModel::new(*params, Mesh::uniform(params.length, ne)?)?;
             let gm = generalized_modes(&beam)?;
-            let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, &beam)?.covariance();
-            let sq = modal_noise_covariance(&gm, &sigma_zeta);
-            Ok((0..n_modes)
-                .map(|i| {
-                    if i < gm.rates.len() {
-                        sq[(i, i)]
-                    } else {
-                        f64::NAN
-                    }
-                })
-                .collect())
+            element_uniform_ratios(&beam, &gm, n_modes)
         })
         .collect()
+}
+
+/// [`element_uniform_variance_ratios`] of any [`LinearSystem`] with generalized modes
+/// `modes` (`K φ = λ C φ`, `ΦᵀCΦ = I`): the diagonal `(ΦᵀΣ_ζΦ)_ii` of the modal noise
+/// covariance of the element-uniform noise (eq. 5 per element measure) for the first
+/// `n_modes` modes, NaN for a mode the system does not have.
+///
+/// # Errors
+/// As [`NoiseGenerator::new`].
+pub fn element_uniform_ratios(
+    system: &LinearSystem,
+    modes: &super::modal::GeneralizedModes,
+    n_modes: usize,
+) -> Result<Vec<f64>> {
+    let sigma_zeta = NoiseGenerator::new(NoiseModel::ElementUniform, system)?.covariance();
+    let sq = modal_noise_covariance(modes, &sigma_zeta);
+    Ok((0..n_modes)
+        .map(|i| {
+            if i < modes.rates.len() {
+                sq[(i, i)]
+            } else {
+                f64::NAN
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]
