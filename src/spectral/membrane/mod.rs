@@ -96,8 +96,10 @@
 //!   under a central point load, 0.01160·Pa²/D for a square).
 
 mod levy;
+pub mod simulator;
 mod sums;
 
+pub use simulator::MembraneSimulator;
 pub use sums::ExcessArea;
 
 use super::{ou_lorentzian, ou_sampled_spectrum, sin_pi};

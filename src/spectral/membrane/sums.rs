@@ -59,7 +59,7 @@ pub struct ExcessArea {
 
 /// Time dependence of a two-time mode sum.
 #[derive(Debug, Clone, Copy)]
-enum Kernel {
+pub(super) enum Kernel {
     /// From rest, h(·, 0) = 0, times t ≤ η: e^{−λ(η−t)} − e^{−λ(η+t)}.
     FromRest { t: f64, eta: f64 },
     /// Stationary, lag ≥ 0: e^{−λ·lag}.
@@ -67,7 +67,8 @@ enum Kernel {
 }
 
 impl Kernel {
-    fn factor(self, rate: f64) -> f64 {
+    /// The factor of a mode of rate `rate`.
+    pub(super) fn factor(self, rate: f64) -> f64 {
         match self {
             // e^{−λ(η−t)} (1 − e^{−2λt}), without cancellation.
             Kernel::FromRest { t, eta } => (-rate * (eta - t)).exp() * -(-2.0 * rate * t).exp_m1(),
