@@ -18,7 +18,7 @@ use crate::dynamics::{
 use crate::error::{Error, Result};
 use crate::fem::banded::LANES;
 use crate::fem::beam::BeamModel;
-use crate::fem::modal::{GeneralizedModes, generalized_modes};
+use crate::fem::modal::GeneralizedModes;
 use crate::fem::noise::NoiseModel;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
@@ -28,7 +28,10 @@ use crate::stats;
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
+mod object;
 mod stream;
+
+use object::{Continuum, FemObject};
 
 pub use stream::RowPlan;
 
@@ -98,12 +101,17 @@ pub struct LinearReference {
 /// (Hermite interpolation) and Φ are the generalized modes: `⟨w(x)w(y)⟩ = a_yᵀ S a_x` for a
 /// modal covariance S.
 pub fn modal_probe(beam: &BeamModel, vectors: &DMatrix<f64>, x: f64) -> DVector<f64> {
-    let n = beam.n_dofs();
+    probe_of(beam.n_dofs(), vectors, |e| beam.deflection_at(e, x))
+}
+
+/// The probe vector `Φᵀ p` of the linear functional `value` of a state of `n` DOFs
+/// (`value(e_k)` for every unit vector `e_k` gives `p`).
+fn probe_of(n: usize, vectors: &DMatrix<f64>, value: impl Fn(&[f64]) -> f64) -> DVector<f64> {
     let mut e = vec![0.0; n];
     let mut v = DVector::zeros(n);
     for k in 0..n {
         e[k] = 1.0;
-        v[k] = beam.deflection_at(&e, x);
+        v[k] = value(&e);
         e[k] = 0.0;
     }
     vectors.transpose() * v
@@ -180,7 +188,7 @@ fn project_modes(projector: &DMatrix<f64>, s: &[f64], out: &mut [f64]) {
 /// each lane reports its observables as [`FemSampler`] does, from the lane's state
 /// gathered into `lane` (so every lane is bit-identical to its one-trajectory run).
 struct FemBatch<'a> {
-    beam: &'a BeamModel,
+    object: &'a FemObject,
     projector: &'a DMatrix<f64>,
     filament: ComponentBatch,
     lane: RefCell<Vec<f64>>,
@@ -216,18 +224,20 @@ impl Observables for LaneOf<'_, FemBatch<'_>> {
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
         self.batch.each_component(self.lane, |c, s| {
             for (j, &x) in xs.iter().enumerate() {
-                out[c * xs.len() + j] = self.batch.beam.deflection_at(s, x);
+                out[c * xs.len() + j] = self.batch.object.value_at(s, x);
             }
         });
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
-        self.batch
-            .each_component(self.lane, |_, s| add_slope_squares(self.batch.beam, s, acc));
+        if let Some(beam) = self.batch.object.beam() {
+            self.batch
+                .each_component(self.lane, |_, s| add_slope_squares(beam, s, acc));
+        }
     }
 }
 
 struct FemSampler<'a> {
-    beam: &'a BeamModel,
+    object: &'a FemObject,
     projector: &'a DMatrix<f64>,
     filament: Components<Box<dyn Integrator>>,
 }
@@ -251,13 +261,15 @@ impl Observables for FemSampler<'_> {
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
         for (c, s) in self.filament.states.iter().enumerate() {
             for (j, &x) in xs.iter().enumerate() {
-                out[c * xs.len() + j] = self.beam.deflection_at(s, x);
+                out[c * xs.len() + j] = self.object.value_at(s, x);
             }
         }
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
-        for s in &self.filament.states {
-            add_slope_squares(self.beam, s, acc);
+        if let Some(beam) = self.object.beam() {
+            for s in &self.filament.states {
+                add_slope_squares(beam, s, acc);
+            }
         }
     }
 }
@@ -456,7 +468,7 @@ pub struct LinearRun {
 
 enum Model {
     Fem {
-        beam: Box<BeamModel>,
+        object: FemObject,
         modes: Option<GeneralizedModes>,
         projector: DMatrix<f64>,
         noise: NoiseModel,
@@ -484,7 +496,7 @@ struct Prepared {
 struct Setup<'s> {
     scene: &'s Scene,
     spec: &'s RunSpec,
-    continuum: HingedBeam,
+    continuum: Continuum,
     tau1: f64,
     dt: f64,
     profile_x: Vec<f64>,
@@ -499,7 +511,14 @@ impl Setup<'_> {
     /// The exact modal simulator of eq. (2): its references are the continuum's, the
     /// profile truncated to the simulated modes.
     fn spectral(&self) -> Result<Prepared> {
-        let (continuum, dt) = (&self.continuum, self.dt);
+        let Continuum::Filament(continuum) = &self.continuum else {
+            return Err(Error::invalid(
+                "model",
+                "spectral",
+                "fem for a membrane (its spectral reference scene is not wired yet)",
+            ));
+        };
+        let dt = self.dt;
         let n_modes = self.scene.mesh.elements;
         let mut refs = Vec::new();
         for n in 1..=self.scene.sampling.modes {
@@ -562,23 +581,25 @@ impl Setup<'_> {
         let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
         #[cfg(any(test, feature = "faults"))]
         let beam = crate::fault::shared_model(self.scene.fault, beam)?;
+        let object = FemObject::Beam(Box::new(beam));
+        let system = object.system();
         // An explicit step above its limit fails at once (λ_max by an O(n)
         // inertia bisection), before the O(n³) eigen-decomposition.
         if spec.integrator.stability_limit(1.0).is_some() {
             build_integrator(
                 spec.integrator,
-                &beam,
+                system,
                 spec.noise,
                 dt,
-                beam.max_rate()?,
+                object.max_rate()?,
                 None,
             )?;
         }
-        let gm = generalized_modes(&beam)?;
-        let max_rate = gm.rates[gm.rates.len() - 1];
+        let gm = object.modes()?;
+        let max_rate = gm.rates.max();
         // Fails early with the stability limit if the step is too large.
-        build_integrator(spec.integrator, &beam, spec.noise, dt, max_rate, Some(&gm))?;
-        let law = DiscreteLaw::new(&beam, &gm, spec.integrator, spec.noise, dt)?;
+        build_integrator(spec.integrator, system, spec.noise, dt, max_rate, Some(&gm))?;
+        let law = DiscreteLaw::new(system, &gm, spec.integrator, spec.noise, dt)?;
         let mut refs = Vec::new();
         for i in 0..self.scene.sampling.modes {
             let n = i + 1;
@@ -593,7 +614,7 @@ impl Setup<'_> {
             });
         }
         // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
-        let probe = |x: f64| modal_probe(&beam, &gm.vectors, x);
+        let probe = |x: f64| probe_of(system.n_dofs(), &gm.vectors, |e| object.value_at(e, x));
         let profile_discrete = self
             .profile_x
             .iter()
@@ -603,7 +624,7 @@ impl Setup<'_> {
             })
             .collect();
         let two_time = self.fem_two_time(&law, &probe)?;
-        let projector = gm.projector(&beam, self.scene.sampling.modes);
+        let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
         let scale = (2.0 / (p.drag * p.length)).sqrt();
         let amplitude_scale = (1..=self.scene.sampling.modes)
@@ -615,7 +636,7 @@ impl Setup<'_> {
         Ok(Prepared {
             amplitude_scale,
             model: Model::Fem {
-                beam: Box::new(beam),
+                object,
                 modes: keep_modes.then_some(gm),
                 projector,
                 noise: spec.noise,
@@ -652,7 +673,7 @@ impl Setup<'_> {
                 t_step: ts,
                 eta_step: es,
                 discrete: law.two_time(ts, es, &probe(x), &probe(y)),
-                continuum: self.continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                continuum: self.continuum.correlation(x, y, t, eta)?,
             });
         }
         Ok(tt)
@@ -668,19 +689,20 @@ impl LinearRun {
     /// failures of the reference computations.
     pub fn prepare(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
         let p = scene.filament;
-        let continuum = HingedBeam::new(p)?;
+        let continuum = Continuum::Filament(HingedBeam::new(p)?);
         let tau1 = p.tau1();
         let dt = spec.dt_tau1 * tau1;
+        let length = continuum.line_length();
         let profile_x: Vec<f64> = scene
             .sampling
             .profile_points
             .iter()
-            .map(|f| f * p.length)
+            .map(|f| f * length)
             .collect();
-        let profile_continuum: Vec<f64> = profile_x
+        let profile_continuum = profile_x
             .iter()
             .map(|&x| continuum.profile_variance(x))
-            .collect();
+            .collect::<Result<Vec<f64>>>()?;
         let setup = Setup {
             scene,
             spec,
@@ -775,7 +797,7 @@ impl LinearRun {
 
     fn n_nodes(&self) -> usize {
         match &self.model {
-            Model::Fem { beam, .. } => beam.mesh().n_nodes(),
+            Model::Fem { object, .. } => object.beam().map_or(0, |b| b.mesh().n_nodes()),
             Model::Spectral { .. } | Model::Data => 0,
         }
     }
@@ -838,9 +860,10 @@ impl LinearRun {
     /// ensemble's profile samples (all components): `(rms slope, node x/L)`. `None` for
     /// the spectral model or without samples.
     pub fn measured_rms_slope(&self, records: &[TrajectoryRecord]) -> Option<(f64, f64)> {
-        let Model::Fem { beam, .. } = &self.model else {
+        let Model::Fem { object, .. } = &self.model else {
             return None;
         };
+        let beam = object.beam()?;
         let n = records.iter().map(|r| r.slope_samples).sum::<usize>() * self.components;
         let sums: Vec<f64> = (0..beam.mesh().n_nodes())
             .map(|k| records.iter().map(|r| r.slope_squares[k]).sum())
@@ -851,7 +874,7 @@ impl LinearRun {
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {
         Ok(match &self.model {
             Model::Fem {
-                beam,
+                object,
                 modes,
                 projector,
                 noise,
@@ -859,28 +882,33 @@ impl LinearRun {
             } => {
                 let stepper = build_integrator(
                     *integrator,
-                    beam,
+                    object.system(),
                     *noise,
                     self.reference.dt,
                     self.reference.max_rate,
                     modes.as_ref(),
                 )?;
+                // The fault catalogue's integrator faults are the beam's.
                 #[cfg(any(test, feature = "faults"))]
-                let stepper = crate::fault::linear_integrator(
-                    self.fault,
-                    stepper,
-                    crate::fault::IntegratorParts {
-                        kind: *integrator,
-                        beam,
-                        noise: *noise,
-                        dt: self.reference.dt,
-                        components: self.components,
-                    },
-                )?;
+                let stepper = match object.beam() {
+                    Some(beam) => crate::fault::linear_integrator(
+                        self.fault,
+                        stepper,
+                        crate::fault::IntegratorParts {
+                            kind: *integrator,
+                            beam,
+                            noise: *noise,
+                            dt: self.reference.dt,
+                            components: self.components,
+                        },
+                    )?,
+                    None => stepper,
+                };
+                let n = object.system().n_dofs();
                 Box::new(FemSampler {
-                    beam,
+                    object,
                     projector,
-                    filament: Components::at_rest(stepper, self.components, beam.n_dofs()),
+                    filament: Components::at_rest(stepper, self.components, n),
                 })
             }
             Model::Spectral { beam, n_modes } => {
@@ -1058,7 +1086,7 @@ impl LinearRun {
     /// integrator a θ-scheme the lane sweeps serve ([`ThetaBatch::build`]).
     fn batch(&self) -> Result<Option<FemBatch<'_>>> {
         let Model::Fem {
-            beam,
+            object,
             projector,
             noise,
             integrator,
@@ -1073,12 +1101,13 @@ impl LinearRun {
             return Ok(None);
         }
         let r = &self.reference;
-        let batch = ThetaBatch::build(*integrator, beam, *noise, r.dt, r.max_rate)?;
+        let system = object.system();
+        let batch = ThetaBatch::build(*integrator, system, *noise, r.dt, r.max_rate)?;
         Ok(batch.map(|t| FemBatch {
-            beam,
+            object,
             projector,
             filament: ComponentBatch::at_rest(t, self.components),
-            lane: RefCell::new(vec![0.0; beam.n_dofs()]),
+            lane: RefCell::new(vec![0.0; system.n_dofs()]),
         }))
     }
 

@@ -42,7 +42,7 @@ impl LinearRun {
     ) -> Result<RowPlan> {
         let length = scene.filament.length;
         let mut positions: Vec<f64> = match &self.model {
-            Model::Fem { beam, .. } => beam.mesh().nodes().to_vec(),
+            Model::Fem { object, .. } => object.line_nodes(),
             Model::Spectral { .. } | Model::Data => {
                 let n = scene.mesh.elements;
                 (0..=n).map(|k| length * k as f64 / n as f64).collect()
