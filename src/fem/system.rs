@@ -131,7 +131,8 @@ impl LinearSystem {
     /// `max_e λ_max(K_e, C_e)`), confirmed by its count and doubled until no eigenvalue lies
     /// above it; the Rayleigh quotient of `trial` (times `1 − 10⁻⁹`) is a lower bound, used
     /// if its count confirms it (else 0). Bisection then runs to a relative width of 1e-13.
-    /// Cost `O(n·bw²)` per step, about 45 steps. Used by [`super::BeamModel::max_rate`].
+    /// Cost `O(n·bw²)` per step, about 45 steps. Shared by [`super::BeamModel::max_rate`]
+    /// and [`super::PlateModel::max_rate`].
     ///
     /// # Errors
     /// [`Error::Numerical`] if the bracket cannot be established.
