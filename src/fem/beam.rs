@@ -232,75 +232,28 @@ impl BeamModel {
     /// ([`UNIFORM_RATE_FACTOR`]); explicit Euler(–Maruyama) is stable only for
     /// `Δt < 2/λ_max` ([`BeamModel::explicit_euler_dt_limit`]).
     ///
-    /// Computed by Sturm-sequence bisection, without any eigensolver: the number of
-    /// eigenvalues below `σ` equals the number of negative pivots of the banded `LDLᵀ`
-    /// of `K − σC` (Sylvester). The bracket starts at the Rayleigh quotient of the
-    /// all-rotations vector (a lower bound) and Fried's element bound
-    /// `max_e λ_max(K_e, C_e)` (an upper bound, checked by its count); bisection runs to
-    /// a relative width of 1e-13. Cost `O(n)` per step, about 45 steps.
+    /// Computed by Sturm-sequence bisection ([`LinearSystem::max_rate_bisection`]),
+    /// without any eigensolver: the number of eigenvalues below `σ` equals the number of
+    /// negative pivots of the banded `LDLᵀ` of `K − σC` (Sylvester). The bracket starts at
+    /// the Rayleigh quotient of the all-rotations vector (a lower bound) and Fried's element
+    /// bound `max_e λ_max(K_e, C_e)` (an upper bound, checked by its count); bisection runs
+    /// to a relative width of 1e-13. Cost `O(n)` per step, about 45 steps.
     ///
     /// # Errors
     /// [`Error::Numerical`] if the bracket cannot be established.
     pub fn max_rate(&self) -> Result<f64> {
-        let n = self.n_dofs();
-        let count_above = |sigma: f64| -> Result<usize> {
-            let mut s = sigma;
-            let mut last = None;
-            for _ in 0..8 {
-                let a = SymBanded::linear_combination(1.0, self.stiffness(), -s, self.damping())?;
-                match a.negative_eigenvalue_count() {
-                    // eigenvalues of (K, C) below s = negative pivots; none equals s
-                    Ok(neg) => return Ok(n - neg),
-                    Err(e) => {
-                        last = Some(e);
-                        s *= 1.0 + 1e-13;
-                    }
-                }
-            }
-            Err(last.unwrap_or_else(|| Error::Numerical {
-                routine: "max_rate".into(),
-                detail: "inertia count failed".into(),
-            }))
-        };
         // upper bound: Fried's element eigenvalue bound, scaled by EI/(ξh⁴)
         let p = &self.params;
         let hmin = self.mesh.min_element_length();
-        let mut hi = 1.001 * element_rate_factor()? * p.bending_rigidity / (p.drag * hmin.powi(4));
-        let mut tries = 0;
-        while count_above(hi)? > 0 {
-            hi *= 2.0;
-            tries += 1;
-            if tries > 60 {
-                return Err(Error::Numerical {
-                    routine: "max_rate".into(),
-                    detail: "no upper bound for lambda_max found".into(),
-                });
-            }
-        }
+        let hi = 1.001 * element_rate_factor()? * p.bending_rigidity / (p.drag * hmin.powi(4));
         // lower bound: Rayleigh quotient of the all-rotations vector
-        let mut x = vec![0.0; n];
+        let mut x = vec![0.0; self.n_dofs()];
         for node in 0..self.mesh.n_nodes() {
             if let Some(i) = self.node_rotation_index(node) {
                 x[i] = 1.0;
             }
         }
-        let rq = self.stiffness().quadratic_form(&x) / self.damping().quadratic_form(&x);
-        let mut lo = rq * (1.0 - 1e-9);
-        if !(lo.is_finite() && lo > 0.0 && lo < hi && count_above(lo)? >= 1) {
-            lo = 0.0;
-        }
-        for _ in 0..200 {
-            if hi - lo <= 1e-13 * hi {
-                break;
-            }
-            let mid = 0.5 * (lo + hi);
-            if count_above(mid)? >= 1 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Ok(0.5 * (lo + hi))
+        self.system.max_rate_bisection(hi, &x)
     }
 
     /// Explicit Euler(–Maruyama) stability limit `Δt < 2/λ_max` (the amplification

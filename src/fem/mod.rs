@@ -1,4 +1,5 @@
-//! Finite-element model of the filament (the semi-discrete form of eq. 2): Hermite-cubic beam elements,
+//! Finite-element model of the filament (the semi-discrete form of eq. 2) and of the membrane
+//! (Bogner–Fox–Schmit plates): Hermite-cubic beam elements,
 //! banded assembly over the free DOFs of a hinged beam, the paper's element-uniform noise
 //! (eq. 5) and consistent noise, generalized modes of `(K, C)` and the exact stationary
 //! covariances of the discrete system.
@@ -9,6 +10,11 @@
 //! - [`system`]: the [`LinearSystem`] `C ẋ = −Kx + F` every object assembles to, with the
 //!   element loads of eq. (5).
 //! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
+//! - [`plate`]: the Helfrich membrane `ξ ∂h/∂t = −κ∇⁴h + σ∇²h + f` on Bogner–Fox–Schmit
+//!   rectangles ([`PlateModel`]), simply supported or periodic, and its `λ_max`.
+//! - [`plate_modes`]: the separable modes of the uniform plate ([`PlateModes`]): `K`, `C`
+//!   block-diagonal with blocks of at most 4×4 per pair of 1D waves, labelled by the
+//!   continuum modes.
 //! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
 //! - [`paired`]: the paired modal form of a uniform hinged beam ([`PairedModes`]): `K`,
@@ -23,6 +29,8 @@ pub mod mesh;
 pub mod modal;
 pub mod noise;
 pub mod paired;
+pub mod plate;
+pub mod plate_modes;
 pub mod system;
 pub mod vonkarman;
 
@@ -35,4 +43,11 @@ pub use modal::{
 };
 pub use noise::{NoiseGenerator, NoiseModel};
 pub use paired::{ModeBlock, PairedModes};
+pub use plate::{
+    MAX_BAND_ENTRIES, MAX_PLATE_DOFS, NodeDof, PLATE_RATE_FACTOR, PlateElementMatrix, PlateModel,
+    SLOPE_RATE_FACTOR,
+};
+pub use plate_modes::{
+    MAX_DENSE_MODE_DOFS, MAX_PLATE_MODE_DOFS, PlateMode, PlateModeLabel, PlateModes,
+};
 pub use system::{ElementLoad, LinearSystem};

@@ -55,3 +55,9 @@ pub const SEED_SCENE_FUZZ: u64 = 0xF022_5CE4;
 /// The byte mutator of the damaged-data property test (ChaCha): the same mutants of the
 /// valid .npy, CSV, data.json and shard.json on every run.
 pub const SEED_DAMAGED_DATA: u64 = 0xDA3A_6ED0;
+
+// tests/plate_model.rs
+/// Random points and bicubic coefficients of the interpolation checks.
+pub const SEED_PLATE_INTERPOLATION: u64 = 0xB1A7_E001;
+/// Random free-DOF vectors of the element-noise and load-vector checks.
+pub const SEED_PLATE_NOISE: u64 = 0xB1A7_E002;
