@@ -136,7 +136,7 @@ impl Wave {
         self.kinds[0] == 0
     }
 
-    /// Whether it is a periodic wave with two parts (0 < 2k < N).
+    /// Whether the wave has both parts (`0 < k < N` hinged, `0 < 2k < N` periodic).
     fn is_interior(&self) -> bool {
         self.kinds.len() == 2
     }
