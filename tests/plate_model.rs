@@ -232,26 +232,9 @@ fn degenerate_pairs_are_separable_sine_products_in_label_order() {
         assert_eq!(j, i + 1, "({m},{n}) then ({n},{m})");
         assert_eq!(form.modes()[i].rate, form.modes()[j].rate);
     }
-    let (hx, hy) = model.element_size();
     for (idx, mode) in form.modes().iter().enumerate() {
-        let Some(target) = mode.continuum else {
-            continue;
-        };
-        let v = form.mode_vector(idx);
-        let mut ratio = None;
-        for i in 1..6 {
-            for j in 1..6 {
-                let shape = continuum.mode_shape(target, i as f64 * hx, j as f64 * hy);
-                let w = v[model.node_height_index(i, j).unwrap()];
-                if shape.abs() > 0.1 {
-                    let r = w / shape;
-                    assert!(r > 0.0, "{target:?}: sign");
-                    let r0 = *ratio.get_or_insert(r);
-                    assert!((r - r0).abs() <= 1e-12 * r0, "{target:?}: not separable");
-                } else {
-                    assert!(w.abs() < 1e-12 * v.iter().fold(0.0_f64, |a, b| a.max(b.abs())));
-                }
-            }
+        if let Some(target) = mode.continuum {
+            assert_heights_proportional(&model, &continuum, target, &form.mode_vector(idx));
         }
     }
     let again = PlateModes::new(&model).unwrap();
@@ -343,12 +326,53 @@ fn constraining_the_normal_slope_does_not_converge_to_simply_supported() {
     }
 }
 
+/// Asserts that the nodal heights of `v` are a positive multiple of the continuum shape
+/// `target` at every node (the separable form and the sign convention), to 1e-12.
+fn assert_heights_proportional(
+    model: &PlateModel,
+    continuum: &Membrane,
+    target: MembraneMode,
+    v: &[f64],
+) {
+    let (nx, ny) = model.elements();
+    let (hx, hy) = model.element_size();
+    let vmax = v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let mut ratio = None;
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let shape = continuum.mode_shape(target, i as f64 * hx, j as f64 * hy);
+            let w = model.node_height_index(i, j).map_or(0.0, |k| v[k]);
+            if shape.abs() > 0.1 {
+                let r = w / shape;
+                assert!(r > 0.0, "{target:?}: sign");
+                let r0 = *ratio.get_or_insert(r);
+                assert!(
+                    (r - r0).abs() <= 1e-12 * r0,
+                    "{target:?}: not the continuum shape"
+                );
+            }
+        }
+    }
+    let r0 = ratio.expect("a node where the shape is not small");
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let shape = continuum.mode_shape(target, i as f64 * hx, j as f64 * hy);
+            let w = model.node_height_index(i, j).map_or(0.0, |k| v[k]);
+            assert!(
+                (w - r0 * shape).abs() <= 1e-12 * vmax,
+                "{target:?} at ({i}, {j})"
+            );
+        }
+    }
+}
+
 /// What: the periodic plate has exactly one zero rate, the uniform translation
 /// (`zero_mode`: `K u = 0`, `uᵀCu = 1`, labelled (0, 0, Cosine, 0) with rate exactly 0);
 /// every other rate is positive; and the acoustic rates of (1, 0) cosine and sine, (0, 1),
 /// (1, 1) and (1, −1) converge from above at fourth order to the periodic continuum
-/// (κq⁴ + σq²)/ξ, q = 2π(m/a, n/b). The dense `generalized_modes` of the blocks leave the
-/// zero mode out and are C-orthogonal to it. Reference: Sylvester's inertia of `K ∓ εC`
+/// (κq⁴ + σq²)/ξ, q = 2π(m/a, n/b), their nodal heights being positive multiples of
+/// cos(q·r) or sin(q·r) (the travelling combinations and the sign convention). The dense
+/// `generalized_modes` of the blocks leave the zero mode out and are C-orthogonal to it. Reference: Sylvester's inertia of `K ∓ εC`
 /// (exactly one eigenvalue in (−ε, ε)); `Membrane::mode_rate` (periodic). Set-up:
 /// a = 1.7, b = 1.1, σ = 0.3, nx = ny ∈ {4, 8, 16, 32}. Tolerance: orders in [3.7, 4.3]
 /// for the pairs from 8 (the O(h²) correction); `‖Ku‖ ≤ 1e-13 ‖K‖∞‖u‖`, round-off.
@@ -391,6 +415,13 @@ fn periodic_plate_has_one_zero_mode_and_converges() {
             let err = fe.rate / continuum.mode_rate(mode) - 1.0;
             assert!(err > 0.0, "{mode:?} at {ne}: {err:e}");
             errors[t].push(err);
+        }
+        if ne == 8 {
+            for &(m, n, shape) in &targets {
+                let target = MembraneMode { m, n, shape };
+                let index = form.find(form.acoustic(target).unwrap().label).unwrap().0;
+                assert_heights_proportional(&model, &continuum, target, &form.mode_vector(index));
+            }
         }
         if ne == 4 {
             let gm = form.generalized_modes().unwrap();

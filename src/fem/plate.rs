@@ -25,12 +25,12 @@
 //!
 //! Because the mesh is a tensor grid, the assembled matrices are the same tensor products of
 //! the assembled 1D matrices, and that is how they are built (one term per entry,
-//! `O(n·bw₁²)`; `PlateModel::new`'s unit tests compare them with element-by-element
-//! assembly of the 16×16 element matrices).
+//! `O(n·bw₁²)`; the unit tests compare them with element-by-element assembly of the
+//! 16×16 element matrices, [`PlateModel::element_matrices`]).
 //!
 //! **The bending form and `∫(∇²h)²`.** Per element, `∫(∇²N)ᵀ(∇²N)` is *not* the bending
-//! block above: the two differ by `2∫(N_xx N_yy − N_xy²)`, the Gaussian-curvature term
-//! (nonzero element by element). Over the assembled spaces of this module the difference
+//! block above: the two differ by `∫(N_xxᵀN_yy + N_yyᵀN_xx − 2N_xyᵀN_xy)`, the
+//! Gaussian-curvature term `2∫(h_xx h_yy − h_xy²)` (nonzero element by element). Over the assembled spaces of this module the difference
 //! vanishes: integrating by parts in x then in y (the interpolant is C¹, piecewise bicubic),
 //! `∫ h_xx h_yy = ∫ h_xy² + ∮` boundary terms `[h_x h_yy]` on the x-edges and `[h_x h_xy]`
 //! on the y-edges. Simply supported, `h = 0` along every edge (`w` and the tangential
@@ -55,7 +55,10 @@
 //!   Brownian translation with no stationary variance. Downstream modal code must exclude
 //!   it ([`super::modal::generalized_modes_signed`] refuses zero rates; see
 //!   [`super::plate_modes`]). For `σ` above the buckling tension every other rate is
-//!   positive: on the FE space `∫(∇²h)² ≥ q_min² ∫|∇h|²` as in the continuum.
+//!   positive: the FE functions are periodic H² functions, for which
+//!   `∫(∇²h)² ≥ q_min² ∫|∇h|²` (Fourier), so `xᵀKx ≥ (κq_min² + σ)∫|∇h|² > 0` unless
+//!   `h` is constant. (Simply supported, `h ∈ H² ∩ H¹₀` and the same holds with the
+//!   Dirichlet `q_min² = π²(1/a² + 1/b²)`: `K` is positive definite.)
 //!
 //! # The fastest rate
 //!
@@ -324,6 +327,10 @@ pub(crate) fn element_load(hx: f64, hy: f64) -> [f64; 16] {
 ///   position `p(i) = 2i` if `2i < N`, else `2(N−1−i) + 1`, so that neighbours (including
 ///   `N−1` and 0) are at most 2 positions apart; `w_i ↦ 2p(i)`, `θ_i ↦ 2p(i) + 1`.
 ///
+/// For example, simply supported, the height of an interior node `(i, j)` has the free
+/// index `(2j − 1)·2nx + 2i − 1` and the twist `w_xy` of the corner `(0, 0)` the index 0;
+/// periodic, the height of node `(0, 0)` has the index 0 and that of `(1, 0)` the index 4.
+///
 /// The 1D matrices then have half-bandwidth `b₁ = 3` (simply supported) or 5 (periodic)
 /// and the 2D ones `b₁·nfx + b₁`: `6nx + 3` simply supported, `10nx + 5` periodic (put the
 /// direction with fewer elements along x).
@@ -367,9 +374,10 @@ fn check_elements(name: &str, value: usize, boundary: MembraneBoundary) -> Resul
 
 /// Refuses meshes whose DOF count or band storage exceeds the caps.
 fn check_size(axes: &[Axis; 2]) -> Result<()> {
-    let (nfx, nfy) = (axes[0].n_free() as u128, axes[1].n_free() as u128);
-    let n = nfx * nfy;
-    let entries = n * (axes[0].bandwidth() as u128 * (nfx + 1) + 1);
+    // in u128 from the element counts, saturating: no overflow for any usize input
+    let (nfx, nfy) = (2 * axes[0].elements as u128, 2 * axes[1].elements as u128);
+    let n = nfx.saturating_mul(nfy);
+    let entries = n.saturating_mul(axes[0].bandwidth() as u128 * (nfx + 1) + 1);
     if n > MAX_PLATE_DOFS as u128 || entries > MAX_BAND_ENTRIES as u128 {
         return Err(Error::invalid(
             "elements (nx, ny)",
@@ -437,6 +445,14 @@ impl PlateModel {
     /// Element size `(hx, hy) = (a/nx, b/ny)`.
     pub fn element_size(&self) -> (f64, f64) {
         (self.axes[0].h(), self.axes[1].h())
+    }
+
+    /// The element stiffness `K_e` and damping `C_e` (16×16, local order of
+    /// [`PlateElementMatrix`]; the same for every element of the uniform mesh): the tensor
+    /// products of the module docs with the 1D element matrices of [`super::hermite`].
+    pub fn element_matrices(&self) -> (PlateElementMatrix, PlateElementMatrix) {
+        let (hx, hy) = self.element_size();
+        element_matrices(&self.params, hx, hy)
     }
 
     /// The x and y chains (crate-internal: for [`super::plate_modes`]).
@@ -860,8 +876,7 @@ mod tests {
     fn assemble_by_elements(model: &PlateModel) -> (SymBanded, SymBanded) {
         let (n, bw) = (model.n_dofs(), model.stiffness().bandwidth());
         let (mut k, mut c) = (SymBanded::new(n, bw), SymBanded::new(n, bw));
-        let (hx, hy) = model.element_size();
-        let (ke, ce) = element_matrices(model.params(), hx, hy);
+        let (ke, ce) = model.element_matrices();
         for load in model.element_loads() {
             for a in 0..16 {
                 for b in 0..=a {
@@ -1052,6 +1067,29 @@ mod tests {
         assert_eq!(PLATE_RATE_FACTOR, 8568.0);
     }
 
+    /// What: the numbering examples of the [`PlateModel`] docs. Reference: the docs.
+    /// Tolerance: exact.
+    #[test]
+    fn documented_numbering_examples() {
+        let (nx, ny) = (4, 3);
+        let model = PlateModel::new(params(SS), nx, ny).unwrap();
+        for (i, j) in [(1, 1), (3, 2), (2, 1)] {
+            assert_eq!(
+                model.node_height_index(i, j),
+                Some((2 * j - 1) * 2 * nx + 2 * i - 1)
+            );
+        }
+        assert_eq!(model.node_dof_index(0, 0, NodeDof::Twist), Some(0));
+        assert_eq!(model.node_height_index(0, 2), None);
+        assert_eq!(model.node_dof_index(nx, 1, NodeDof::SlopeY), None);
+        assert!(model.node_dof_index(nx, 1, NodeDof::SlopeX).is_some());
+        assert_eq!(model.node_height_index(nx + 1, 1), None);
+        let model = PlateModel::new(params(PERIODIC), nx, ny).unwrap();
+        assert_eq!(model.node_height_index(0, 0), Some(0));
+        assert_eq!(model.node_height_index(1, 0), Some(4));
+        assert_eq!(model.node_height_index(nx, ny), Some(0));
+    }
+
     /// What: bad meshes are refused with the key named. Reference: [`PlateModel::new`]'s
     /// contract. Tolerance: exact.
     #[test]
@@ -1077,6 +1115,10 @@ mod tests {
             ..params(SS)
         };
         assert_eq!(name(PlateModel::new(bad, 2, 2)), "drag");
+        assert_eq!(
+            name(PlateModel::new(params(SS), usize::MAX, 2)),
+            "elements (nx, ny)"
+        );
         assert!(PlateModel::new(params(SS), 1, 1).is_ok());
         assert!(PlateModel::new(params(PERIODIC), 2, 2).is_ok());
     }
