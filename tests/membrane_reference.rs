@@ -1058,3 +1058,105 @@ fn theory_membrane_rejects_bad_input_with_exit_2() {
         }
     }
 }
+
+/// What: `theory membrane --elements` gives the Bogner–Fox–Schmit plate's discrete rate
+/// of mode (2, 1), converging to the continuum rate from above at fourth order (observed
+/// order log₂ of successive error ratios on 4, 8, 16 elements in [3.7, 4.3]), the
+/// element-uniform noise's variance ratio below 1 and rising towards 1, and with --dt the
+/// exact discrete law (Crank–Nicolson, consistent noise: ratio to equipartition 1; Euler–
+/// Maruyama: 1/(1 − λΔt/2) for the mode's own λ). Refusals: an explicit step at its
+/// stability limit, a mode the mesh does not resolve, too many elements, exit 2 naming
+/// the flag. Reference: the continuum of `theory membrane` and the closed forms above.
+/// Tolerance: 1e-9 relative for the closed forms (rounding), the order band for the
+/// convergence.
+#[test]
+fn theory_membrane_finite_elements() {
+    let fe = |elements: &str, extra: &[&str]| {
+        let mut args = vec![
+            "--m",
+            "2",
+            "--n",
+            "1",
+            "--tension",
+            "3",
+            "--elements",
+            elements,
+        ];
+        args.extend(extra);
+        let out = theory_membrane(&args);
+        let f = out["finite_elements"].clone();
+        (num(&Value::Object(out), "rate"), f)
+    };
+    let errors: Vec<f64> = ["4", "8", "16"]
+        .iter()
+        .map(|e| {
+            let (exact, f) = fe(e, &[]);
+            assert!(num(&f, "rate") > exact);
+            num(&f, "rate_relative_error")
+        })
+        .collect();
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!(
+            (3.7..=4.3).contains(&order),
+            "order {order} from {errors:?}"
+        );
+    }
+    let ratios: Vec<f64> = ["4", "16"]
+        .iter()
+        .map(|e| num(&fe(e, &[]).1, "element_uniform_variance_ratio"))
+        .collect();
+    assert!(ratios[0] < ratios[1] && ratios[1] < 1.0, "{ratios:?}");
+    let (_, cn) = fe("8", &["--dt", "1e-3"]);
+    let d = &cn["discrete"];
+    assert!(
+        (num(d, "variance_ratio_to_equipartition") - 1.0).abs() < 1e-9,
+        "{d}"
+    );
+    let (_, f) = fe("8", &[]);
+    let dt = 0.25 * 2.0 / num(&f, "max_rate");
+    let dt_s = format!("{dt:e}");
+    let (_, em) = fe("8", &["--dt", &dt_s, "--integrator", "euler-maruyama"]);
+    let a = num(&f, "rate") * dt;
+    let want = 1.0 / (1.0 - a / 2.0);
+    let got = num(&em["discrete"], "variance_ratio_to_equipartition");
+    assert!((got / want - 1.0).abs() < 1e-9, "{got} vs {want}");
+    let limit = format!("{:e}", 2.0 / num(&f, "max_rate"));
+    for (extra, needle) in [
+        (
+            vec![
+                "--tension",
+                "3",
+                "--elements",
+                "8",
+                "--dt",
+                limit.as_str(),
+                "--integrator",
+                "euler-maruyama",
+            ],
+            "--dt must be <",
+        ),
+        (
+            vec!["--elements", "2", "--m", "3"],
+            "--m/--n must be a mode the 2 x 2 mesh",
+        ),
+        (
+            vec!["--elements", "65"],
+            "--elements must be in [1, 64], got 65",
+        ),
+        (
+            vec!["--elements", "4", "--dt", "1e-3", "--noise", "white"],
+            "--noise must be",
+        ),
+    ] {
+        let full: Vec<&str> = ["theory", "membrane"]
+            .iter()
+            .copied()
+            .chain(extra)
+            .collect();
+        let o = run(&full);
+        assert_no_panic(&full, &o);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&full, &o));
+        assert!(stderr_of(&o).contains(needle), "{}", describe(&full, &o));
+    }
+}

@@ -2,7 +2,11 @@
 
 use clap::{Args, Subcommand};
 use langevin_fem::FilamentParams;
+use langevin_fem::dynamics::{DiscreteLaw, IntegratorKind};
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
+use langevin_fem::fem::noise::{NoiseModel, element_uniform_ratios};
+use langevin_fem::fem::plate::PlateModel;
+use langevin_fem::fem::plate_modes::PlateModes;
 use langevin_fem::spectral::{
     HingedBeam, Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
 };
@@ -191,6 +195,145 @@ pub struct MembraneArgs {
     /// Wavenumber cutoff Q of the excess area (modes with |q| ≤ Q; ⟨ΔA⟩ grows as ln Q).
     #[arg(long, allow_negative_numbers = true)]
     cutoff: Option<f64>,
+    /// Also the finite elements: a uniform mesh of this many Bogner–Fox–Schmit plate
+    /// elements along x (the discrete rate and variance of mode (m, n), its error, the
+    /// element-uniform noise's variance ratio; with --dt, the exact discrete law of
+    /// --integrator). At most 64 (the plate's separable modes are computed in full).
+    #[arg(long)]
+    elements: Option<usize>,
+    /// Elements along y (default: --elements).
+    #[arg(long, requires = "elements")]
+    elements_y: Option<usize>,
+    /// Time step of the discrete law (consistent time units), with --elements.
+    #[arg(long, requires = "elements", allow_negative_numbers = true)]
+    dt: Option<f64>,
+    /// Integrator of the discrete law: euler-maruyama, backward-euler, crank-nicolson or
+    /// exact-modal.
+    #[arg(long, default_value = "crank-nicolson", requires = "dt")]
+    integrator: String,
+    /// Noise of the discrete law: consistent or element-uniform.
+    #[arg(long, default_value = "consistent", requires = "dt")]
+    noise: String,
+}
+
+/// The most plate elements per side `theory membrane --elements` takes.
+const MAX_THEORY_PLATE_ELEMENTS: usize = 64;
+
+/// The finite-element part of `theory membrane`: the acoustic plate mode converging to
+/// `mode` on `nx × ny` elements, its rate and (continuum-convention) variance, the
+/// element-uniform noise's ratio (eq. 5 per element area) and, with `dt`, the exact
+/// discrete law of `integrator` with `noise` ([`DiscreteLaw`]).
+fn membrane_fem(
+    args: &MembraneArgs,
+    mb: &Membrane,
+    mode: MembraneMode,
+    nx: usize,
+) -> Result<serde_json::Value> {
+    let ny = args.elements_y.unwrap_or(nx);
+    for (flag, v) in [("--elements", nx), ("--elements-y", ny)] {
+        if !(1..=MAX_THEORY_PLATE_ELEMENTS).contains(&v) {
+            return Err(Error::invalid(
+                flag,
+                v,
+                format!("in [1, {MAX_THEORY_PLATE_ELEMENTS}]"),
+            ));
+        }
+    }
+    let plate = PlateModel::new(mb.params, nx, ny).map_err(as_flag)?;
+    let modes = PlateModes::new(&plate)?;
+    let Some(fe) = modes.acoustic(mode) else {
+        return Err(Error::invalid(
+            "--m/--n",
+            format!("({}, {})", mode.m, mode.n),
+            format!("a mode the {nx} x {ny} mesh resolves (index below its element count)"),
+        ));
+    };
+    let rate = fe.rate;
+    let exact = mb.mode_rate(mode);
+    // The continuum amplitude's variance scaled by the ratio of the rates: the variance
+    // of the discrete mode's amplitude (kT/λ_h of its C-normalized amplitude) in the
+    // continuum's convention.
+    let variance = mb.mode_variance(mode) * exact / rate;
+    let gm = modes.generalized_modes()?;
+    let index = (0..gm.len())
+        .find(|&i| gm.rates[i] == rate)
+        .ok_or_else(|| Error::Numerical {
+            routine: "theory membrane".into(),
+            detail: "the mode's column is missing from the dense modes".into(),
+        })?;
+    let ratios = element_uniform_ratios(&plate, &gm, gm.len())?;
+    let mut out = json!({
+        "elements": [nx, ny],
+        "unknowns": plate.n_dofs(),
+        "rate": rate,
+        "rate_relative_error": rate / exact - 1.0,
+        "variance": variance,
+        "element_uniform_variance_ratio": ratios[index],
+        "max_rate": plate.max_rate()?,
+    });
+    if let Some(dt) = args.dt {
+        require_positive("--dt", dt)?;
+        let integrator: IntegratorKind = args
+            .integrator
+            .parse()
+            .map_err(as_flag_named("--integrator"))?;
+        if !IntegratorKind::LINEAR.contains(&integrator) {
+            return Err(Error::invalid(
+                "--integrator",
+                integrator,
+                IntegratorKind::list(&IntegratorKind::LINEAR),
+            ));
+        }
+        let noise = match args.noise.as_str() {
+            "consistent" => NoiseModel::Consistent,
+            "element-uniform" => NoiseModel::ElementUniform,
+            other => {
+                return Err(Error::invalid(
+                    "--noise",
+                    other,
+                    "consistent or element-uniform",
+                ));
+            }
+        };
+        if let Some(limit) = integrator.stability_limit(plate.max_rate()?)
+            && dt >= limit
+        {
+            return Err(Error::invalid(
+                "--dt",
+                dt,
+                format!("< {limit:e}, the {integrator} stability limit 2/lambda_max of this mesh"),
+            ));
+        }
+        let law = DiscreteLaw::new(&plate, &gm, integrator, noise, dt)?;
+        out["discrete"] = json!({
+            "dt": dt,
+            "integrator": integrator.name(),
+            "noise": noise.name(),
+            "multiplier": law.multipliers[index],
+            "variance": law.mode_variance(index) / law.equipartition(index) * variance,
+            "variance_ratio_to_equipartition": law.mode_variance(index) / law.equipartition(index),
+        });
+        match law.decay_rate(index) {
+            Some(r) => out["discrete"]["decay_rate"] = json!(r),
+            None => {
+                out["discrete"]["decay_rate_note"] =
+                    json!("multiplier <= 0: the mode alternates in sign and has no decay rate")
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Renames the parameter of an [`Error::InvalidParameter`] to `flag`.
+fn as_flag_named(flag: &'static str) -> impl Fn(Error) -> Error {
+    move |err| match err {
+        Error::InvalidParameter { value, allowed, .. } => Error::InvalidParameter {
+            name: flag.to_string(),
+            value,
+            allowed,
+        },
+        other => other,
+    }
 }
 
 /// Parses `--strain-ratio`: a non-empty comma-separated list of numbers in `[0, max]`
@@ -422,6 +565,9 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
     });
     if boundary == MembraneBoundary::Periodic {
         out["fourier_variance"] = json!(mb.fourier_variance(args.m, args.n));
+    }
+    if let Some(nx) = args.elements {
+        out["finite_elements"] = membrane_fem(args, &mb, mode, nx)?;
     }
     if let Some(cutoff) = args.cutoff {
         let ea = mb.excess_area(cutoff).map_err(as_flag)?;
