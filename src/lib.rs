@@ -16,13 +16,16 @@
 //!    (2)–(4), and in [`spectral::membrane`] the continuum references of a fluctuating
 //!    Helfrich membrane: modes, rates, variances, two-time correlations, point variance,
 //!    excess area).
-//! 3. Model: [`fem`] (Hermite-cubic beam elements, assembly, noise models, generalized
-//!    modes, exact discrete stationary covariances, and the von Kármán filament), and on it
+//! 3. Model: [`fem`] (the [`fem::LinearSystem`] every object assembles to; Hermite-cubic
+//!    beam elements and Bogner–Fox–Schmit plate elements with their separable modes
+//!    ([`fem::plate`], [`fem::plate_modes`]), assembly, noise models, generalized modes,
+//!    exact discrete stationary covariances, and the von Kármán filament), and on it
 //!    [`theory`] (the exact equilibrium theory of the compressed filament, the paper's
 //!    Fig. 2, for the continuum and for a given mesh).
 //! 4. Dynamics: [`dynamics`] (every fact about an integrator in
-//!    [`dynamics::IntegratorKind`], the linear and nonlinear integrators, the trajectory
-//!    driver and parallel ensembles).
+//!    [`dynamics::IntegratorKind`], the linear and nonlinear integrators, their exact
+//!    discrete law on any linear system ([`dynamics::DiscreteLaw`]), the O(n) modal step
+//!    ([`dynamics::ModalStep`]), the trajectory driver and parallel ensembles).
 //! 5. Statistics: [`stats`] (estimators and hypothesis tests, validated on exactly
 //!    solvable processes).
 //! 6. Scenes: [`scene`] (scene files, their validation, and run preparation), [`data`]
@@ -49,6 +52,7 @@
 //! | eq. (4), t→∞, η=t | equipartition profile ⟨w²(x)⟩ | [`spectral::HingedBeam::profile_variance`] (closed form) and [`spectral::HingedBeam::profile_variance_series`] |
 //! | per-mode law | variance 2kTL³/(π⁴n⁴EI), rate λₙ = π⁴n⁴EI/(ξL⁴), Lorentzian spectrum | [`spectral::HingedBeam::mode_variance`], [`spectral::HingedBeam::mode_rate`], [`spectral::HingedBeam::lorentzian`], [`spectral::HingedBeam::sampled_spectrum`] (AR(1), aliasing included) |
 //! | membrane (issue #27) | ξ∂h/∂t = −κ∇⁴h + σ∇²h + f: variance 4kT/(ab·c_q) (simply supported) or ⟨\|h_q\|²⟩ = kT/(ab·c_q) (periodic), rate c_q/ξ, c_q = κq⁴ + σq² | [`spectral::membrane::Membrane`] (mode variances and rates, [`spectral::membrane::Membrane::correlation`], [`spectral::membrane::Membrane::point_variance`], [`spectral::membrane::Membrane::excess_area`], spectra) |
+| membrane, finite elements (issue #27) | C = ξM⊗M, K = κ(K4⊗M + 2K2⊗K2 + M⊗K4) + σ(K2⊗M + M⊗K2), eq. (5) per element area; exact modal simulator of (M1) | [`fem::plate::PlateModel`], [`fem::plate_modes::PlateModes`] (separable modes), [`spectral::membrane::MembraneSimulator`] |
 //! | eq. (5) | element-uniform load, variance 2ξkT/(hΔt) | [`fem::noise::NoiseModel::ElementUniform`]; its exact stationary covariance (a Lyapunov solution) in [`fem::modal::discrete_stationary_covariance`] |
 //! | element energy (von Kármán) | ∫ [EA/2 (u′ + ½w′²)² + EI/2 w″²] dx | [`fem::vonkarman::CompressedFilament`] (energy, internal force) |
 //! | step (i) | axial equilibrium for u at fixed w | [`fem::vonkarman::CompressedFilament::axial_equilibrium`] |
