@@ -11,9 +11,12 @@
 use crate::error::Result;
 use crate::fem::beam::BeamModel;
 use crate::fem::modal::{GeneralizedModes, generalized_modes};
+use crate::fem::plate::PlateModel;
+use crate::fem::plate_modes::PlateModes;
 use crate::fem::system::LinearSystem;
 use crate::spectral::HingedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode};
+use nalgebra::{DMatrix, DVector};
 
 /// Relative tolerance of the membrane's continuum mode sums (their rigorous truncation
 /// bound, relative to the variance of the slowest mode).
@@ -102,6 +105,17 @@ fn midline(membrane: &Membrane) -> f64 {
 pub(crate) enum FemObject {
     /// Hermite-cubic beam elements.
     Beam(Box<BeamModel>),
+    /// Bogner–Fox–Schmit plate elements on a uniform mesh, with their separable modes
+    /// and the continuum modes that are checked (their acoustic modes come first in
+    /// [`FemObject::modes`]).
+    Plate {
+        /// The plate.
+        plate: Box<PlateModel>,
+        /// Its separable modes.
+        modes: Box<PlateModes>,
+        /// The checked continuum modes, slowest first.
+        checked: Vec<MembraneMode>,
+    },
 }
 
 impl FemObject {
@@ -109,7 +123,40 @@ impl FemObject {
     pub(crate) fn system(&self) -> &LinearSystem {
         match self {
             FemObject::Beam(b) => b,
+            FemObject::Plate { plate, .. } => plate,
         }
+    }
+
+    /// The plate of a membrane with `nx × ny` elements, its separable modes, and `checked`
+    /// (continuum modes, each resolved by the mesh).
+    ///
+    /// # Errors
+    /// As [`PlateModel::new`] and [`PlateModes::new`]; [`crate::Error::InvalidParameter`]
+    /// naming `sampling.modes` if a checked mode is not resolved by the mesh.
+    #[allow(dead_code)] // built by the membrane scenes (issue #27), next to be wired
+    pub(crate) fn plate(
+        membrane: &Membrane,
+        nx: usize,
+        ny: usize,
+        checked: Vec<MembraneMode>,
+    ) -> Result<Self> {
+        let plate = PlateModel::new(membrane.params, nx, ny)?;
+        let modes = PlateModes::new(&plate)?;
+        if let Some(m) = checked.iter().find(|m| modes.acoustic(**m).is_none()) {
+            return Err(crate::Error::invalid(
+                "sampling.modes",
+                checked.len(),
+                format!(
+                    "at most the modes a {nx} x {ny} mesh resolves (mode ({}, {}) is not)",
+                    m.m, m.n
+                ),
+            ));
+        }
+        Ok(FemObject::Plate {
+            plate: Box::new(plate),
+            modes: Box::new(modes),
+            checked,
+        })
     }
 
     /// The largest rate λ_max of `(K, C)` by an O(n) inertia bisection
@@ -120,6 +167,7 @@ impl FemObject {
     pub(crate) fn max_rate(&self) -> Result<f64> {
         match self {
             FemObject::Beam(b) => b.max_rate(),
+            FemObject::Plate { plate, .. } => plate.max_rate(),
         }
     }
 
@@ -131,6 +179,36 @@ impl FemObject {
     pub(crate) fn modes(&self) -> Result<GeneralizedModes> {
         match self {
             FemObject::Beam(b) => generalized_modes(b),
+            FemObject::Plate { modes, checked, .. } => {
+                let all = modes.generalized_modes()?;
+                // The checked modes' acoustic columns first, in the continuum's order,
+                // then every other column in rate order (the periodic zero mode is not
+                // among them: PlateModes::generalized_modes leaves it out).
+                // Column of a plate mode: its index among the modes, less one past the
+                // periodic zero mode (left out of the dense modes). By label, so that a
+                // square's equal-rate (1, 2) and (2, 1) are told apart.
+                let zero = modes.zero_mode();
+                let mut order: Vec<usize> = Vec::with_capacity(all.len());
+                for m in checked {
+                    let i = modes
+                        .modes()
+                        .iter()
+                        .position(|p| p.continuum == Some(*m))
+                        .ok_or_else(|| crate::Error::Numerical {
+                            routine: "FemObject::modes".into(),
+                            detail: format!("mode ({}, {}) is not resolved", m.m, m.n),
+                        })?;
+                    order.push(i - usize::from(zero.is_some_and(|z| z < i)));
+                }
+                let rest: Vec<usize> = (0..all.len()).filter(|j| !order.contains(j)).collect();
+                order.extend(rest);
+                Ok(GeneralizedModes {
+                    rates: DVector::from_iterator(order.len(), order.iter().map(|&j| all.rates[j])),
+                    vectors: DMatrix::from_fn(all.vectors.nrows(), order.len(), |r, c| {
+                        all.vectors[(r, order[c])]
+                    }),
+                })
+            }
         }
     }
 
@@ -138,6 +216,16 @@ impl FemObject {
     pub(crate) fn value_at(&self, state: &[f64], x: f64) -> f64 {
         match self {
             FemObject::Beam(b) => b.deflection_at(state, x),
+            FemObject::Plate { plate, .. } => {
+                let h = plate.height_at(state, x, 0.5 * plate.params().height);
+                match plate.zero_mode() {
+                    // Periodic: the height relative to the spatial mean (the q = 0 mode,
+                    // a free translation, is excluded as in the continuum): the mean is
+                    // bᵀx/A with b the assembled load vector.
+                    Some(_) => h - mean_height(plate, state),
+                    None => h,
+                }
+            }
         }
     }
 
@@ -146,6 +234,11 @@ impl FemObject {
     pub(crate) fn line_nodes(&self) -> Vec<f64> {
         match self {
             FemObject::Beam(b) => b.mesh().nodes().to_vec(),
+            FemObject::Plate { plate, .. } => {
+                let (nx, _) = plate.elements();
+                let a = plate.params().width;
+                (0..=nx).map(|i| a * i as f64 / nx as f64).collect()
+            }
         }
     }
 
@@ -153,8 +246,23 @@ impl FemObject {
     pub(crate) fn beam(&self) -> Option<&BeamModel> {
         match self {
             FemObject::Beam(b) => Some(b),
+            FemObject::Plate { .. } => None,
         }
     }
+}
+
+/// The spatial mean height `bᵀx/(ab)` of a plate state (`b = ∫N`, the assembled loads).
+fn mean_height(plate: &PlateModel, state: &[f64]) -> f64 {
+    let area = plate.params().width * plate.params().height;
+    let mut sum = 0.0;
+    for l in plate.element_loads() {
+        for (v, d) in l.load.iter().zip(&l.dofs) {
+            if let Some(i) = d {
+                sum += v * state[*i];
+            }
+        }
+    }
+    sum / area
 }
 
 #[cfg(test)]
@@ -185,5 +293,63 @@ mod tests {
             .value;
         assert_eq!(c.correlation(0.3, 0.5, 0.01, 0.02).unwrap(), want);
         assert!(c.profile_variance(1.5).is_err());
+    }
+
+    /// The plate's modes put the checked continuum modes first, by label: on a square the
+    /// equal-rate (1, 2) and (2, 1) get their own columns — (1, 2) vanishes on the midline
+    /// y = b/2, (2, 1) does not — every column satisfies Kφ = λCφ, and the first rates are
+    /// the acoustic ones. Periodic: the field is measured from the spatial mean, so the
+    /// zero mode (a uniform translation) reads 0 everywhere.
+    #[test]
+    fn plate_modes_follow_the_checked_modes_by_label() {
+        let mb = Membrane::new(MembraneParams::default()).unwrap();
+        let checked = mb.modes(4).unwrap();
+        let obj = FemObject::plate(&mb, 6, 6, checked.clone()).unwrap();
+        let gm = obj.modes().unwrap();
+        let FemObject::Plate { modes, .. } = &obj else {
+            unreachable!()
+        };
+        let sys = obj.system();
+        for (i, m) in checked.iter().enumerate() {
+            assert_eq!(gm.rates[i], modes.acoustic(*m).unwrap().rate);
+            let col: Vec<f64> = gm.vectors.column(i).iter().copied().collect();
+            let (mut kx, mut cx) = (vec![0.0; col.len()], vec![0.0; col.len()]);
+            sys.stiffness().mul_vec(&col, &mut kx);
+            sys.damping().mul_vec(&col, &mut cx);
+            let res = kx
+                .iter()
+                .zip(&cx)
+                .map(|(k, c)| (k - gm.rates[i] * c).abs())
+                .fold(0.0, f64::max);
+            let scale = kx.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            assert!(res <= 1e-9 * scale, "mode {m:?}: residual {res:e}");
+            let on_midline = obj.value_at(&col, 0.3);
+            let peak = (0..=20)
+                .map(|k| obj.value_at(&col, k as f64 / 20.0).abs())
+                .fold(0.0, f64::max);
+            if m.n % 2 == 0 {
+                assert!(
+                    on_midline.abs() < 1e-9,
+                    "{m:?} on the midline: {on_midline}"
+                );
+            } else {
+                assert!(peak > 0.1, "{m:?} peak {peak}");
+            }
+        }
+        assert_eq!(gm.len(), sys.n_dofs());
+        let per = Membrane::new(MembraneParams {
+            boundary: MembraneBoundary::Periodic,
+            ..MembraneParams::default()
+        })
+        .unwrap();
+        let obj = FemObject::plate(&per, 4, 4, per.modes(3).unwrap()).unwrap();
+        let FemObject::Plate { plate, .. } = &obj else {
+            unreachable!()
+        };
+        let zero = plate.zero_mode().unwrap();
+        assert!(obj.value_at(&zero, 0.37).abs() < 1e-12);
+        assert_eq!(obj.modes().unwrap().len(), plate.n_dofs() - 1);
+        let too_many = per.modes(200).unwrap();
+        assert!(FemObject::plate(&per, 4, 4, too_many).is_err());
     }
 }
