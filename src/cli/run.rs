@@ -417,6 +417,7 @@ impl Job {
 /// Runs the command (progress on stderr unless quiet); exit code 0.
 pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
+    scene.refuse_membrane("writing trajectories (run)")?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
     let runs = if args.runs.is_empty() {

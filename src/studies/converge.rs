@@ -1007,9 +1007,9 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 /// `<scene>-<run>-<over>.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
-/// diverges, or whose estimators fail, is recorded in [`ConvergeSummary::failed`], not
-/// fatal.
+/// Bad input (exit 2) naming the flag, or a membrane scene ([`Scene::refuse_membrane`]);
+/// run failures (exit 3). A value whose run diverges, or whose estimators fail, is
+/// recorded in [`ConvergeSummary::failed`], not fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
     let setup = setup(opts)?;
@@ -1053,6 +1053,8 @@ pub(crate) struct Setup {
 /// # Errors
 /// Bad input (exit 2) naming the flag.
 fn setup(opts: &ConvergeOptions) -> Result<Setup> {
+    opts.scene
+        .refuse_membrane("the convergence study (converge)")?;
     let run = select_run(&opts.scene, opts.run.as_deref())?;
     let mut scene = opts.scene.clone();
     let mut label = scene.runs[run].name.clone();

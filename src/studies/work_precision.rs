@@ -254,6 +254,8 @@ pub struct WorkPrecisionSummary {
 }
 
 fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
+    opts.scene
+        .refuse_membrane("the work-precision study (work-precision)")?;
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
             "--scene",
@@ -368,8 +370,9 @@ type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 /// `work-precision.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag), a projected work or memory above
-/// `opts.limits`; run failures.
+/// Bad options (exit 2, naming the flag), a membrane scene (exit 2,
+/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`; run
+/// failures.
 pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
     let start = Instant::now();
     let provenance = Provenance::begin(&[&opts.scene]);

@@ -123,13 +123,15 @@ pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
 /// invalidated only once the input has passed every check.
 ///
 /// # Errors
-/// Input (exit 2): bad scene files, a projected work or memory above `opts.limits`, a
-/// time step above a stability limit, a budget that gives a check fewer samples than its
+/// Input (exit 2): bad scene files, a membrane scene (not yet simulated:
+/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`, a time
+/// step above a stability limit, a budget that gives a check fewer samples than its
 /// estimator needs ([`Error::Scene`]). Run failures (exit 3): diverging runs
 /// ([`Error::Diverged`]), estimator or set-up failures ([`Error::RunFailed`]), I/O
 /// failures.
 pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes = &opts.scenes;
+    refuse_membranes(scenes)?;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
     let mut work = projected_work(scenes, opts.budget);
@@ -171,6 +173,17 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         provenance: report.provenance_ref(),
     };
     Ok((summary, report))
+}
+
+/// Refuses, before anything is projected or prepared, a membrane scene among `scenes`:
+/// the runs of a scene are a filament's ([`Scene::refuse_membrane`]).
+///
+/// # Errors
+/// [`Error::Scene`] naming the first membrane scene (exit 2).
+pub(super) fn refuse_membranes(scenes: &[Scene]) -> Result<()> {
+    scenes
+        .iter()
+        .try_for_each(|s| s.refuse_membrane("simulation (verify)"))
 }
 
 /// Prepares every run of every scene and checks, before any long work, that the budget
@@ -1125,7 +1138,8 @@ fn apply_linear_checks(
 /// `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is read.
 ///
 /// # Errors
-/// Input (exit 2): a bad sidecar or trajectory file, data of the other kind than the
+/// Input (exit 2): a membrane scene (not yet supported: [`Scene::refuse_membrane`]), a
+/// bad sidecar or trajectory file, data of the other kind than the
 /// scene's or that cannot serve it, files larger than `max_bytes` together; run failures
 /// (exit 3): an estimator that finds no answer in the data.
 pub fn check_data(
@@ -1135,6 +1149,7 @@ pub fn check_data(
     alpha: f64,
     max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
+    scene.refuse_membrane("checking trajectory data (check)")?;
     let sidecar = crate::data::DataSidecar::load(data_dir)?;
     crate::verify::data::check_data_kind(scene, &sidecar, data_dir)?;
     crate::verify::data::require_data_size(&sidecar, data_dir, max_bytes)?;
