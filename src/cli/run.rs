@@ -451,7 +451,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
 /// The chosen runs of a linear scene, prepared, with their row plans.
 fn prepare_linear(job: &Job) -> Result<(Vec<LinearRun>, Vec<RowPlan>)> {
     let scene = &job.scene;
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let runs = job
         .chosen
         .iter()

@@ -393,7 +393,7 @@ fn prepare(scene: &Scene, run: usize, over: Over, value: f64) -> Result<(Scene, 
     let spec = s.runs[run].clone();
     let lr = LinearRun::prepare(&s, &spec).map_err(|e| match e {
         Error::UnstableTimeStep { limit, .. } => {
-            let limit_tau1 = limit / s.filament.tau1();
+            let limit_tau1 = limit / s.tau1();
             match over {
                 Over::Dt => Error::invalid(
                     "--values",
@@ -1130,7 +1130,7 @@ fn linear_study(
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
         let seed = derive_seed(s.seed, &seed_label(&spec.name, over, v));
-        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.tau1());
         let outcome = source.linear(
             (scene, &spec.name, over, v),
             (&ensemble, lr),

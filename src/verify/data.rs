@@ -86,7 +86,7 @@ pub fn prepare_data_check(
     let rate1 = continuum.mode_rate(1);
     let profile_every = every(4.0 * rate1);
     let max_rate = modes.last().map_or(rate1, |m| m.rate_continuum);
-    let components = scene.dims - 1;
+    let components = scene.components();
     let reference = LinearReference {
         modes,
         profile_x: profile.0,

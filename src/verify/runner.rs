@@ -272,7 +272,7 @@ fn prepare_error(scene: &Scene, k: usize, err: Error) -> Error {
 fn check_sample_counts(scene: &Scene, k: usize, run: &LinearRun, budget: Budget) -> Result<()> {
     let e = run.spec.ensemble(budget);
     let checks = run.spec.checks(scene);
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let dt_tau1 = run.reference.dt / tau1;
     let steps = run.sampled_steps(e.duration_tau1 * tau1);
     let key = |k2: &str| format!("runs[{k}].{}.{k2}", budget.name());
@@ -665,7 +665,7 @@ pub(super) fn simulate_compression(
     let (steps, plan) = match e.precision_target() {
         None => {
             let steps: Vec<u64> = (0..run.points())
-                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
+                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.tau1()))
                 .collect();
             (steps, None)
         }
@@ -739,7 +739,7 @@ fn targeted_plan(
     budget: Budget,
     bar: &Progress,
 ) -> Result<TargetedPlan> {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let name = &run.spec.name;
     let tick = tick_work(scene, k, budget, run, e);
     let (search, adapted) = match target.step_search {
@@ -856,7 +856,7 @@ fn compression_run_note(
     est: &ForceEstimates,
     slope: Option<RmsSlope>,
 ) -> String {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let dts: Vec<f64> = (0..run.points()).map(|i| run.dt_at(i) / tau1).collect();
     let dt = if dts.iter().all(|&d| d == run.spec.dt_tau1) {
         format!("{:.3e} tau1", run.spec.dt_tau1)
@@ -1312,7 +1312,7 @@ pub(super) fn simulate_linear(
     shard: Shard,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let seed = derive_seed(scene.seed, &run.spec.name);
-    let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+    let steps = run.sampled_steps(e.duration_tau1 * scene.tau1());
     let full = e.trajectories as u64;
     // The work of one full trajectory and of one extra two-time trajectory (much
     // shorter), from the run's projection.
@@ -1680,7 +1680,7 @@ fn write_two_time(
 
 /// The two-time figure of [`write_two_time`] from the rows of `<run>-two-time.csv`.
 fn two_time_figure(scene: &Scene, units: AxisUnits, name: &str, rows: &[Vec<f64>]) -> Figure {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let length = scene.filament.length;
     let beam = HingedBeam::new(scene.filament).ok();
     let eta_max = 1.25 * rows.iter().map(|r| r[3]).fold(0.0, f64::max);

@@ -189,7 +189,7 @@ fn write_compression(
             let common = entry
                 .map(|f| &f.common)
                 .ok_or_else(|| refuse("no plan of this run".to_string()))?;
-            let tau1 = scene.filament.tau1();
+            let tau1 = scene.tau1();
             Some(decode_plan(common, target, run, tau1).map_err(refuse)?)
         }
         _ => None,
@@ -303,7 +303,7 @@ pub(super) fn merged_compression(
     let plan = match e.precision_target() {
         None => None,
         Some(target) => Some(
-            decode_plan(&files[0].file.common, target, run, scene.filament.tau1())
+            decode_plan(&files[0].file.common, target, run, scene.tau1())
                 .map_err(|m| incomplete(set, scene, name, m))?,
         ),
     };
