@@ -14,8 +14,10 @@
 //!   `out`, nothing beside or above it).
 //!
 //! Reference: the guide, docs/src/reference/exit-codes-and-limits.md; `src/scene/validate.rs`, `src/cli/`.
-//! Set-up: two small valid scenes ([`LINEAR`], [`COMPRESSION`]; a test checks that they
-//! parse) and one edit per case, so that each case has exactly one fault.
+//! Set-up: three small valid scenes ([`LINEAR`], [`COMPRESSION`], [`MEMBRANE`]; a test
+//! checks that they parse) and one edit per case, so that each case has exactly one
+//! fault (a membrane scene, valid, is refused by every command that simulates: nothing
+//! simulates membranes yet).
 //! Tolerance: exact substrings; 100 % of the corpus must pass (the pass fraction is
 //! printed). Cases run on two threads; the corpus takes a few seconds because every
 //! refusal comes before any simulation.
@@ -110,11 +112,50 @@ standard = { trajectories = 4, duration_tau1 = 20.0 }
 full = { trajectories = 4, target_std_error = 0.05, pilot_tau1 = 2.0, max_duration_tau1 = 20.0 }
 "#;
 
+/// A small valid membrane scene (issue #27: simply supported 2 x 1 rectangle under
+/// tension, 8 x 4 elements): each case edits one line. Valid, but not simulated yet: the
+/// commands that simulate refuse it (the `membrane-refused-*` cases).
+const MEMBRANE: &str = r#"description = "bad-input corpus: membrane"
+seed = 13
+dims = 3
+model = "fem"
+checks = ["profile", "mode-variance", "two-time"]
+
+[membrane]
+bending_rigidity = 1.0
+tension = 0.5
+drag = 1.0
+kt = 1.0
+width = 2.0
+height = 1.0
+boundary = "simply-supported"
+
+[mesh]
+elements = 8
+elements_y = 4
+
+[sampling]
+burn_in_tau1 = 2.0
+modes = 4
+profile_points = [0.25, 0.5]
+two_time = [[0.5, 0.25, 0.5, 1.0]]
+
+[[runs]]
+name = "cn"
+integrator = "crank-nicolson"
+noise = "consistent"
+dt_tau1 = 0.01
+quick = { trajectories = 4, duration_tau1 = 40.0, two_time_trajectories = 8 }
+standard = { trajectories = 8, duration_tau1 = 100.0 }
+full = { trajectories = 16, duration_tau1 = 400.0 }
+"#;
+
 /// The scene a case starts from.
 #[derive(Clone, Copy)]
 enum Base {
     Linear,
     Compression,
+    Membrane,
 }
 
 impl Base {
@@ -122,6 +163,7 @@ impl Base {
         match self {
             Base::Linear => LINEAR,
             Base::Compression => COMPRESSION,
+            Base::Membrane => MEMBRANE,
         }
     }
 }
@@ -168,6 +210,14 @@ const fn comp(name: &'static str, edits: &'static [Edit], expect: &'static [&'st
     Case {
         name,
         input: Input::Scene(Base::Compression, edits),
+        expect,
+    }
+}
+
+const fn memb(name: &'static str, edits: &'static [Edit], expect: &'static [&'static str]) -> Case {
+    Case {
+        name,
+        input: Input::Scene(Base::Membrane, edits),
         expect,
     }
 }
@@ -593,9 +643,262 @@ fn corpus() -> Vec<Case> {
     v.extend(filament_cases());
     v.extend(linear_cases());
     v.extend(compression_cases());
+    v.extend(membrane_cases());
     v.extend(name_cases());
     v.extend(cli_cases());
     v
+}
+
+/// A membrane scene (issue #27): its parameters, its mesh, its sampling positions, the
+/// keys of the filament it cannot have, and every command that simulates or checks it
+/// (none does yet: refused naming the scene and "not yet supported for membranes").
+fn membrane_cases() -> Vec<Case> {
+    const REFUSED: &[&str] = &["key `membrane`", "not yet supported for membranes"];
+    let refused = |name: &'static str, a: &'static [&'static str]| Case {
+        name,
+        input: Input::Args(a, Some((Base::Membrane, &[]))),
+        expect: REFUSED,
+    };
+    vec![
+        memb(
+            "membrane-kappa-nan",
+            &[("bending_rigidity = 1.0", "bending_rigidity = nan")],
+            &[
+                "key `membrane.bending_rigidity`",
+                "got NaN",
+                "in [1e-30, 1e30]",
+            ],
+        ),
+        memb(
+            "membrane-kappa-zero",
+            &[("bending_rigidity = 1.0", "bending_rigidity = 0.0")],
+            &[
+                "key `membrane.bending_rigidity`",
+                "got 0",
+                "in [1e-30, 1e30]",
+            ],
+        ),
+        memb(
+            "membrane-drag-negative",
+            &[("drag = 1.0", "drag = -1.0")],
+            &["key `membrane.drag`", "got -1", "in [1e-30, 1e30]"],
+        ),
+        memb(
+            "membrane-kt-huge",
+            &[("kt = 1.0", "kt = 1e300")],
+            &["key `membrane.kt`", "got 1e300", "in [1e-30, 1e30]"],
+        ),
+        memb(
+            "membrane-width-tiny",
+            &[("width = 2.0", "width = 1e-300")],
+            &["key `membrane.width`", "got 1e-300", "in [1e-30, 1e30]"],
+        ),
+        memb(
+            "membrane-height-inf",
+            &[("height = 1.0", "height = inf")],
+            &["key `membrane.height`", "got inf", "in [1e-30, 1e30]"],
+        ),
+        memb(
+            "membrane-aspect-ratio",
+            &[("height = 1.0", "height = 1e7")],
+            &[
+                "key `membrane.height`",
+                "got 1e7",
+                "an aspect ratio of at most 1e6",
+            ],
+        ),
+        memb(
+            "membrane-tension-nan",
+            &[("tension = 0.5", "tension = nan")],
+            &[
+                "key `membrane.tension`",
+                "got NaN",
+                "finite, in [-1e30, 1e30]",
+            ],
+        ),
+        memb(
+            "membrane-tension-huge",
+            &[("tension = 0.5", "tension = -1e300")],
+            &["key `membrane.tension`", "got -1e300", "in [-1e30, 1e30]"],
+        ),
+        memb(
+            "membrane-tension-below-buckling",
+            &[("tension = 0.5", "tension = -100.0")],
+            &[
+                "key `membrane.tension`",
+                "got -100",
+                "> -1.2337005501361698e1, the buckling tension",
+            ],
+        ),
+        memb(
+            "membrane-boundary-unknown",
+            &[("boundary = \"simply-supported\"", "boundary = \"clamped\"")],
+            &[
+                "key `membrane.boundary`",
+                "clamped",
+                "`simply-supported` or `periodic`",
+            ],
+        ),
+        memb(
+            "membrane-unknown-key",
+            &[("kt = 1.0", "kt = 1.0\nthickness = 0.1")],
+            &["key `membrane.thickness`", "unknown field `thickness`"],
+        ),
+        memb(
+            "membrane-and-filament",
+            &[("[membrane]", "[filament]\nlength = 1.0\n\n[membrane]")],
+            &[
+                "key `filament`",
+                "left out of a membrane scene",
+                "got a [filament] table",
+            ],
+        ),
+        memb(
+            "membrane-model-compression",
+            &[("model = \"fem\"", "model = \"compression\"")],
+            &[
+                "key `model`",
+                "got \"compression\"",
+                "compression is the filament's Fig. 2",
+            ],
+        ),
+        memb(
+            "membrane-dims-2",
+            &[("dims = 3", "dims = 2")],
+            &["key `dims`", "got 2", "3 for a membrane scene"],
+        ),
+        memb(
+            "membrane-elements-zero",
+            &[("elements = 8", "elements = 0")],
+            &["key `mesh.elements`", "got 0", "in [1, 256] for a membrane"],
+        ),
+        memb(
+            "membrane-elements-y-huge",
+            &[("elements_y = 4", "elements_y = 257")],
+            &[
+                "key `mesh.elements_y`",
+                "got 257",
+                "in [1, 256] for a membrane",
+            ],
+        ),
+        memb(
+            "membrane-elements-y-negative",
+            &[("elements_y = 4", "elements_y = -4")],
+            &["key `mesh.elements_y`", "-4", "a whole number >= 0"],
+        ),
+        memb(
+            "membrane-periodic-one-element",
+            &[
+                ("boundary = \"simply-supported\"", "boundary = \"periodic\""),
+                ("elements_y = 4", "elements_y = 1"),
+            ],
+            &[
+                "key `mesh.elements_y`",
+                "got 1",
+                "in [2, 256] for a periodic membrane",
+            ],
+        ),
+        memb(
+            "membrane-elements-product",
+            &[
+                ("elements = 8", "elements = 100"),
+                ("elements_y = 4", "elements_y = 100"),
+            ],
+            &[
+                "key `mesh.elements_y`",
+                "got 100",
+                "at most 40",
+                "at most 4096 elements",
+            ],
+        ),
+        memb(
+            "membrane-elements-product-default-y",
+            &[("elements = 8", "elements = 100"), ("elements_y = 4\n", "")],
+            &[
+                "key `mesh.elements`",
+                "got 100",
+                "at most 64 when mesh.elements_y is left out",
+            ],
+        ),
+        memb(
+            "membrane-grading",
+            &[("elements_y = 4", "elements_y = 4\ngrading = 0.5")],
+            &["key `mesh.grading`", "got 0.5", "1 for a membrane scene"],
+        ),
+        memb(
+            "membrane-modes-too-many",
+            &[("modes = 4", "modes = 33")],
+            &["key `sampling.modes`", "got 33", "in [1, 32]", "8 x 4 = 32"],
+        ),
+        memb(
+            "membrane-periodic-modes-too-many",
+            &[
+                ("boundary = \"simply-supported\"", "boundary = \"periodic\""),
+                ("elements = 8", "elements = 2"),
+                ("elements_y = 4", "elements_y = 2"),
+            ],
+            &[
+                "key `sampling.modes`",
+                "got 4",
+                "in [1, 3]",
+                "2 x 2 - 1 = 3",
+            ],
+        ),
+        memb(
+            "membrane-profile-at-edge",
+            &[(
+                "profile_points = [0.25, 0.5]",
+                "profile_points = [0.25, 1.0]",
+            )],
+            &[
+                "key `sampling.profile_points[1]`",
+                "got 1",
+                "in (0, 1) (x/a on the midline y = b/2",
+            ],
+        ),
+        memb(
+            "membrane-periodic-profile-at-one",
+            &[
+                ("boundary = \"simply-supported\"", "boundary = \"periodic\""),
+                (
+                    "profile_points = [0.25, 0.5]",
+                    "profile_points = [0.0, 1.0]",
+                ),
+            ],
+            &[
+                "key `sampling.profile_points[1]`",
+                "got 1",
+                "in [0, 1) (x/a on the midline y = b/2 of a periodic membrane",
+            ],
+        ),
+        memb(
+            "membrane-two-time-at-edge",
+            &[("[[0.5, 0.25, 0.5, 1.0]]", "[[0.5, 0.0, 0.5, 1.0]]")],
+            &["key `sampling.two_time[0][1] (x'/a)`", "got 0", "in (0, 1)"],
+        ),
+        refused("membrane-refused-verify", &["verify", "--scene", "SCENE"]),
+        refused(
+            "membrane-refused-verify-shard",
+            &["verify", "--scene", "SCENE", "--shard", "1/2"],
+        ),
+        refused("membrane-refused-run", &["run", "--scene", "SCENE"]),
+        refused(
+            "membrane-refused-calibrate",
+            &["calibrate", "--scene", "SCENE", "--seeds", "2"],
+        ),
+        refused(
+            "membrane-refused-converge",
+            &["converge", "--scene", "SCENE", "--over", "elements"],
+        ),
+        refused(
+            "membrane-refused-stability",
+            &["stability", "--scene", "SCENE"],
+        ),
+        refused(
+            "membrane-refused-work-precision",
+            &["work-precision", "--scene", "SCENE"],
+        ),
+    ]
 }
 
 /// Non-finite, non-positive, huge and tiny values of every filament parameter.
@@ -2407,11 +2710,15 @@ fn problems(case: &Case, o: &Outcome) -> Vec<String> {
     p
 }
 
-/// What: the two base scenes are valid, so that each case's single edit is its only
+/// What: the three base scenes are valid, so that each case's single edit is its only
 /// fault.
 #[test]
 fn base_scenes_are_valid() {
-    for (name, text) in [("linear.toml", LINEAR), ("compression.toml", COMPRESSION)] {
+    for (name, text) in [
+        ("linear.toml", LINEAR),
+        ("compression.toml", COMPRESSION),
+        ("membrane.toml", MEMBRANE),
+    ] {
         if let Err(e) = Scene::parse(text, Path::new(name)) {
             panic!("{name}: {e}");
         }

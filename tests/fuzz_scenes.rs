@@ -8,7 +8,9 @@
 //! - accepted as a scene whose work is bounded the way validation documents it: names are
 //!   path components of at most 64 characters, at most 100 profile points, two-time
 //!   points and strains, at most 100000 trajectories (and two-time trajectories) per
-//!   budget, at most 1e10 steps per trajectory, and validation accepts it again.
+//!   budget, at most 1e10 steps per trajectory, a membrane's mesh of at most 256 elements
+//!   a side and 4096 in all (uniform, in 3 dims, never compression, with a finite τ1 above
+//!   the buckling tension), and validation accepts it again.
 //!
 //! Mutations (one to four per mutant, on the bytes of a base file): delete, duplicate or
 //! swap lines; replace a number by an extreme one (0, negative, ±1e308, 1e-300, NaN, ±inf,
@@ -234,6 +236,27 @@ fn check_bounded(scene: &Scene) -> Result<(), String> {
     };
     if !name_ok(&scene.name) {
         return Err(format!("scene name {:?}", scene.name));
+    }
+    if let Some(m) = &scene.membrane {
+        let (nx, ny) = (scene.mesh.elements, scene.mesh.elements_along_y());
+        if nx > 256 || ny > 256 || nx * ny > 4096 || scene.mesh.grading != 1.0 {
+            return Err(format!(
+                "membrane mesh {nx} x {ny}, grading {}",
+                scene.mesh.grading
+            ));
+        }
+        if scene.dims != 3 || scene.model == ModelKind::Compression {
+            return Err(format!(
+                "membrane in {} dims, model {:?}",
+                scene.dims, scene.model
+            ));
+        }
+        let tau1 = scene.tau1();
+        if !(tau1.is_finite() && tau1 > 0.0 && m.tension > m.buckling_tension()) {
+            return Err(format!("membrane tau1 {tau1:e}, {m:?}"));
+        }
+    } else if scene.mesh.elements_y.is_some() {
+        return Err("a filament with mesh.elements_y".into());
     }
     let s = &scene.sampling;
     if s.profile_points.len() > 100 || s.two_time.len() > 100 {

@@ -417,6 +417,7 @@ impl Job {
 /// Runs the command (progress on stderr unless quiet); exit code 0.
 pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
+    scene.refuse_membrane("writing trajectories (run)")?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
     let runs = if args.runs.is_empty() {
@@ -450,7 +451,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
 /// The chosen runs of a linear scene, prepared, with their row plans.
 fn prepare_linear(job: &Job) -> Result<(Vec<LinearRun>, Vec<RowPlan>)> {
     let scene = &job.scene;
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let runs = job
         .chosen
         .iter()

@@ -8,6 +8,7 @@ use clap::{Args, Subcommand};
 use langevin_fem::error::Result;
 use langevin_fem::scene::builtin::resolve;
 use langevin_fem::scene::keys::{document, document_all, effective_toml, markdown, scene_keys};
+use langevin_fem::scene::validate::Num;
 use std::path::PathBuf;
 
 /// Command-line arguments of `langevin-fem scene`.
@@ -106,12 +107,22 @@ fn show(args: ShowArgs) -> Result<i32> {
         println!();
     }
     println!();
-    println!(
-        "# Keys of {}: [unit] allowed range; default, then the meaning. Times in units of \
-         tau1 = xi L^4/(pi^4 EI) where the key ends in _tau1; [filament] in the scene's own \
-         consistent units.",
-        scene.name
-    );
+    if scene.is_membrane() {
+        println!(
+            "# Keys of {}: [unit] allowed range; default, then the meaning. Times in units of \
+             tau1 = xi/(kappa q1^4 + sigma q1^2) = {} of the membrane's slowest mode where the \
+             key ends in _tau1; [membrane] in the scene's own consistent units.",
+            scene.name,
+            Num(scene.tau1())
+        );
+    } else {
+        println!(
+            "# Keys of {}: [unit] allowed range; default, then the meaning. Times in units of \
+             tau1 = xi L^4/(pi^4 EI) where the key ends in _tau1; [filament] in the scene's own \
+             consistent units.",
+            scene.name
+        );
+    }
     print!("{}", document(&scene_keys(&scene)?));
     Ok(0)
 }

@@ -43,8 +43,10 @@ impl CompressionTheoryTable {
     /// Computes the theory for `scene`.
     ///
     /// # Errors
-    /// Numerical failures of the theory.
+    /// Numerical failures of the theory; a membrane scene ([`Scene::refuse_membrane`],
+    /// exit 2: compression is a filament's).
     pub fn new(scene: &Scene, spec: &CompressionSpec) -> Result<Self> {
+        scene.refuse_membrane("the compression model")?;
         let p = scene.filament;
         let dims = Dims::from_u32(scene.dims as u32)?;
         let disc = CompressionTheory::new(
@@ -262,8 +264,10 @@ impl CompressionRun {
     /// Prepares run `spec` of compression scene `scene`.
     ///
     /// # Errors
-    /// Invalid integrator or a time step above an explicit stability limit (exit 2).
+    /// Invalid integrator or a time step above an explicit stability limit, a membrane
+    /// scene ([`Scene::refuse_membrane`]) (exit 2).
     pub fn prepare(scene: &Scene, comp: &CompressionSpec, spec: &RunSpec) -> Result<Self> {
+        scene.refuse_membrane("the compression model")?;
         let p = scene.filament;
         let tau1 = p.tau1();
         let dt = spec.dt_tau1 * tau1;
@@ -774,4 +778,36 @@ pub fn force_estimates_diagnosed(
             ),
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectral::membrane::MembraneParams;
+
+    /// The compression model is a filament's: a scene carrying a membrane (refused by
+    /// validation in a file, possible in code) is refused by its theory and its runs
+    /// before anything is computed, naming the key `membrane`.
+    #[test]
+    fn membrane_scene_is_refused_by_the_compression_model() {
+        let mut scene = crate::scene::builtin::find("compression-2d")
+            .expect("built in")
+            .load()
+            .expect("loads");
+        scene.membrane = Some(MembraneParams::default());
+        let comp = scene.compression.clone().expect("compression table");
+        let refusals = [
+            CompressionTheoryTable::new(&scene, &comp).err(),
+            CompressionRun::prepare(&scene, &comp, &scene.runs[0]).err(),
+        ];
+        for e in refusals {
+            let m = e.expect("refused").to_string();
+            assert!(
+                m.contains(
+                    "key `membrane`: the compression model is not yet supported for membranes"
+                ),
+                "{m}"
+            );
+        }
+    }
 }

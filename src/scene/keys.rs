@@ -10,10 +10,17 @@
 //! `runs[].<budget>.duration_tau1`. Arrays of values (`checks`, `two_time`) are one key.
 //!
 //! **Units.** Times are in units of the slowest relaxation time of the hinged filament,
-//! τ₁ = ξL⁴/(π⁴EI), wherever the key ends in `_tau1`; strains in units of the Euler strain
-//! ε_c0 = π²EI/(EA·L²); forces in units of the Euler load F_c0 = π²EI/L². The physical
-//! parameters of `[filament]` are in the scene's own consistent units (any unit system:
-//! e.g. µm, pN·µm² and pN·µm, or all 1).
+//! τ₁ = ξL⁴/(π⁴EI), wherever the key ends in `_tau1`; in a membrane scene, of the
+//! membrane's slowest mode, τ₁ = ξ/(κq₁⁴ + σq₁²) with q₁² = π²(1/a² + 1/b²) simply
+//! supported and (2π/max(a, b))² periodic ([`Scene::tau1`]); strains in units of the Euler
+//! strain ε_c0 = π²EI/(EA·L²); forces in units of the Euler load F_c0 = π²EI/L². The
+//! physical parameters of `[filament]` and `[membrane]` are in the scene's own consistent
+//! units (any unit system: e.g. µm, pN·µm² and pN·µm, or all 1).
+//!
+//! A row's [`Bounds`] are those of every scene with the key; for a key that filament and
+//! membrane scenes share but bound differently (`mesh.elements`, `mesh.grading`,
+//! `sampling.profile_points`) they are the filament's, and the range states the
+//! membrane's as well.
 //!
 //! Tests hold the table to the scenes and to the validator: every key of every built-in
 //! scene has a row, every row is a key the scene types accept, and every value just
@@ -147,18 +154,18 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "dims",
         "-",
-        "2 or 3",
+        "2 or 3; 3 for a membrane",
         "required",
         None,
-        "Transverse directions: 2 (deflection w only) or 3 (w and v).",
+        "Transverse directions: 2 (deflection w only) or 3 (w and v). A membrane scene has 3: a surface in 3D space with one height h(x, y).",
     ),
     key(
         "model",
         "-",
-        "\"fem\", \"spectral\" or \"compression\"",
+        "\"fem\", \"spectral\" or \"compression\"; a membrane: \"fem\" or \"spectral\"",
         "required",
         None,
-        "What is simulated: the linear filament of eq. (2) with Hermite-cubic finite elements (fem), the exact modal simulator of eq. (2) (spectral), or the finite-deflection (von Karman) filament under imposed end-shortening, the paper's Fig. 2 (compression).",
+        "What is simulated: the linear filament of eq. (2) with Hermite-cubic finite elements (fem), the exact modal simulator of eq. (2) (spectral), or the finite-deflection (von Karman) filament under imposed end-shortening, the paper's Fig. 2 (compression). A membrane scene: plate finite elements (fem) or the exact modal simulator of the membrane (spectral).",
     ),
     key(
         "checks",
@@ -274,18 +281,84 @@ pub const KEYS: &[KeyDoc] = &[
         None,
         "Temperature T; kT = k_B·T (4.142 pN·nm at 300 K).",
     ),
+    // [membrane]: the membrane of a membrane scene, in consistent units (the fields of
+    // crate::spectral::membrane::MembraneParams).
+    key(
+        "membrane.bending_rigidity",
+        SCENE_UNITS,
+        PHYSICAL,
+        "1",
+        closed(1e-30, 1e30),
+        "Membrane scenes: bending rigidity κ (an energy). With ξ, σ and the sides it sets τ₁ = ξ/(κq₁⁴ + σq₁²).",
+    ),
+    key(
+        "membrane.tension",
+        SCENE_UNITS,
+        "finite, in [-1e30, 1e30] and > the buckling tension -κ·q₁² (q₁² = π²(1/a² + 1/b²) simply supported, (2π/max(a, b))² periodic)",
+        "0",
+        None,
+        "Membrane scenes: tension σ (energy per area); negative down to (excluded) the buckling tension, where the slowest mode loses its restoring force.",
+    ),
+    key(
+        "membrane.drag",
+        SCENE_UNITS,
+        PHYSICAL,
+        "1",
+        closed(1e-30, 1e30),
+        "Membrane scenes: friction ξ per unit area (force x time / length³).",
+    ),
+    key(
+        "membrane.kt",
+        SCENE_UNITS,
+        PHYSICAL,
+        "1",
+        closed(1e-30, 1e30),
+        "Membrane scenes: thermal energy k_B T (an energy).",
+    ),
+    key(
+        "membrane.width",
+        SCENE_UNITS,
+        "in [1e-30, 1e30]; the aspect ratio is bounded at membrane.height",
+        "1",
+        closed(1e-30, 1e30),
+        "Membrane scenes: side a of the rectangle, along x (a length); positions x/a are fractions of it.",
+    ),
+    key(
+        "membrane.height",
+        SCENE_UNITS,
+        "in [1e-30, 1e30] and in [width/1e6, width x 1e6] (an aspect ratio of at most 1e6)",
+        "1",
+        None,
+        "Membrane scenes: side b of the rectangle, along y (a length).",
+    ),
+    key(
+        "membrane.boundary",
+        "-",
+        "\"simply-supported\" or \"periodic\"",
+        "\"simply-supported\"",
+        None,
+        "Membrane scenes: the edges: simply supported (h = ∇²h = 0 on all four; modes sin(mπx/a) sin(nπy/b)) or periodic in x and y (modes cos and sin of q·r, q = 2π(m/a, n/b) ≠ 0; the uniform displacement is not a mode).",
+    ),
     key(
         "mesh.elements",
         "-",
-        "a whole number in [1, 1000]",
+        "a whole number in [1, 1000]; a membrane: in [1, 256] ([2, 256] periodic) with mesh.elements x mesh.elements_y <= 4096",
         "required",
         count(1.0, 1000.0),
-        "Hermite-cubic elements (fem, compression), or modes (spectral).",
+        "Hermite-cubic elements (fem, compression), or modes (spectral). A membrane: plate elements along x (fem), or mode indices kept along x (spectral: m = 1..elements simply supported; periodic, the wavevectors of an elements x elements_y grid as its FFT has them).",
+    ),
+    key(
+        "mesh.elements_y",
+        "-",
+        "membrane scenes only: a whole number in [1, 256] ([2, 256] periodic), mesh.elements x mesh.elements_y <= 4096",
+        "mesh.elements",
+        count(1.0, 256.0),
+        "Membrane scenes: plate elements along y (fem), or mode indices kept along y (spectral). Refused in a filament scene.",
     ),
     key(
         "mesh.grading",
         "-",
-        "in [0.01, 100]; 1 for model = \"compression\"",
+        "in [0.01, 100]; 1 for model = \"compression\" and for a membrane",
         "1",
         closed(0.01, 100.0),
         "Ratio of the last to the first element length (geometric grading); 1 is a uniform mesh.",
@@ -301,26 +374,26 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "sampling.modes",
         "-",
-        "a whole number in [1, min(50, 2 x mesh.elements)] (fem) or [1, min(50, mesh.elements)] (spectral)",
+        "a whole number in [1, min(50, 2 x mesh.elements)] (fem) or [1, min(50, mesh.elements)] (spectral); a membrane: [1, min(50, mesh.elements x mesh.elements_y)], periodic [1, min(50, mesh.elements x mesh.elements_y - 1)] (the uniform displacement is not a mode)",
         "required in [sampling]",
         None,
         "Linear scenes: the number of lowest modes whose variance, distribution, decay rate and spectrum are checked.",
     ),
     key(
         "sampling.profile_points",
-        "x/L",
-        "at most 100 positions, each in (0, 1); non-empty when the checks have profile",
+        "x/L (membrane: x/a)",
+        "at most 100 positions, each in (0, 1); a periodic membrane: in [0, 1); non-empty when the checks have profile",
         "[]",
         open(0.0, 1.0),
-        "Linear scenes: positions where the equilibrium profile ⟨w²(x)⟩ is checked.",
+        "Linear scenes: positions where the equilibrium profile ⟨w²(x)⟩ is checked. A membrane: ⟨h²⟩ at x/a on the midline y = b/2.",
     ),
     key(
         "sampling.two_time",
-        "[x/L, y/L, t/τ₁, η/τ₁]",
-        "at most 100 points; x/L and y/L in (0, 1), 0 < t <= η <= sampling.burn_in_tau1; non-empty when the checks have two-time",
+        "[x/L, y/L, t/τ₁, η/τ₁] (membrane: [x/a, x'/a, t/τ₁, η/τ₁])",
+        "at most 100 points; x/L and y/L in (0, 1) (a periodic membrane: x/a, x'/a in [0, 1)), 0 < t <= η <= sampling.burn_in_tau1; non-empty when the checks have two-time",
         "[]",
         None,
-        "Linear scenes: points (x, y, t, η) of the two-time correlation ⟨w(x,t) w(y,η)⟩ from w(x, 0) = 0, eq. (4).",
+        "Linear scenes: points (x, y, t, η) of the two-time correlation ⟨w(x,t) w(y,η)⟩ from w(x, 0) = 0, eq. (4). A membrane: ⟨h(x,t) h(x',η)⟩ from h = 0, both points on the midline y = b/2.",
     ),
     key(
         "compression.strain_ratios",
@@ -515,16 +588,21 @@ pub fn key_paths(value: &Value) -> Vec<String> {
 }
 
 /// The scene as it will run, as TOML text: every key with its value, defaults filled
-/// in, in the order of the scene types.
+/// in, in the order of the scene types. A membrane scene is written with its
+/// `mesh.elements_y` filled in and without the `[filament]` table it does not have (and
+/// would be refused with).
 ///
 /// # Errors
 /// [`crate::Error::Numerical`] if the scene cannot be written as TOML (not for a valid
 /// scene).
 pub fn effective_toml(scene: &Scene) -> Result<String> {
-    toml::to_string(scene).map_err(|e| crate::Error::Numerical {
-        routine: "scene to TOML".to_string(),
-        detail: e.to_string(),
-    })
+    match membrane_as_run(scene) {
+        None => toml::to_string(scene).map_err(not_written),
+        Some(m) => Ok(without_table(
+            &toml::to_string(&m).map_err(not_written)?,
+            "filament",
+        )),
+    }
 }
 
 /// [`effective_toml`] as a TOML value.
@@ -532,10 +610,53 @@ pub fn effective_toml(scene: &Scene) -> Result<String> {
 /// # Errors
 /// As [`effective_toml`].
 pub fn effective_value(scene: &Scene) -> Result<Value> {
-    Value::try_from(scene).map_err(|e| crate::Error::Numerical {
+    match membrane_as_run(scene) {
+        None => Value::try_from(scene).map_err(not_written),
+        Some(m) => {
+            let mut v = Value::try_from(&m).map_err(not_written)?;
+            if let Value::Table(t) = &mut v {
+                t.remove("filament");
+            }
+            Ok(v)
+        }
+    }
+}
+
+/// A membrane scene with its defaults filled in where serde leaves them out
+/// (`mesh.elements_y`); `None` for a filament scene.
+fn membrane_as_run(scene: &Scene) -> Option<Scene> {
+    scene.is_membrane().then(|| {
+        let mut m = scene.clone();
+        m.mesh.elements_y = Some(m.mesh.elements_along_y());
+        m
+    })
+}
+
+/// The error of a scene that cannot be written as TOML.
+fn not_written(e: toml::ser::Error) -> crate::Error {
+    crate::Error::Numerical {
         routine: "scene to TOML".to_string(),
         detail: e.to_string(),
-    })
+    }
+}
+
+/// `text` (TOML as [`toml::to_string`] writes a scene) without the table `[name]`: its
+/// header line and every line up to the next header (its keys, then the blank line
+/// before that header). The tables of a scene hold no multi-line values, so every line
+/// starting with `[` is a header.
+fn without_table(text: &str, name: &str) -> String {
+    let header = format!("[{name}]");
+    let mut out = String::with_capacity(text.len());
+    let mut skipping = false;
+    for line in text.split_inclusive('\n') {
+        if line.starts_with('[') {
+            skipping = line.trim_end() == header;
+        }
+        if !skipping {
+            out.push_str(line);
+        }
+    }
+    out
 }
 
 /// The keys a scene uses, defaults included ([`effective_value`]).
@@ -580,11 +701,13 @@ any element of an array of tables and `<budget>` for any of `quick`, `standard`,
 
 /// The units of the keys, for the intro of the whole table ([`markdown`]).
 pub const UNITS_NOTE: &str = "Times are in units of the slowest relaxation time of the hinged \
-filament, τ₁ = ξL⁴/(π⁴EI), wherever the key ends in `_tau1`; strains in units of the Euler \
-strain ε_c0 = π²EI/(EA·L²); forces in units of the Euler load F_c0 = π²EI/L². The physical \
-parameters of `[filament]` are in the scene's own consistent units (any unit system: e.g. µm, \
-pN·µm² and pN·µm, or all 1), or in physical units by the keys that name their unit \
-(`contour_length_um`, …), converted to µm, s and pN.";
+filament, τ₁ = ξL⁴/(π⁴EI), wherever the key ends in `_tau1`; in a membrane scene, of the \
+membrane's slowest mode, τ₁ = ξ/(κq₁⁴ + σq₁²) with q₁² = π²(1/a² + 1/b²) simply supported and \
+(2π/max(a, b))² periodic. Strains are in units of the Euler strain ε_c0 = π²EI/(EA·L²); forces \
+in units of the Euler load F_c0 = π²EI/L². The physical parameters of `[filament]` are in the \
+scene's own consistent units (any unit system: e.g. µm, pN·µm² and pN·µm, or all 1), or in \
+physical units by the keys that name their unit (`contour_length_um`, …), converted to µm, s \
+and pN; those of `[membrane]` in consistent units.";
 
 /// The section of a scene file that the key `pattern` belongs to, as a heading: `Top
 /// level` for the keys before any table, else the table as a scene file writes it
@@ -624,7 +747,8 @@ pub fn sections() -> Vec<(String, Vec<&'static KeyDoc>)> {
 pub fn document_all() -> String {
     let mut out = String::from(
         "# Every scene key: [unit] allowed range; default, then the meaning. Times in units of \
-         tau1 = xi L^4/(pi^4 EI) where the key ends in _tau1; [filament] in the scene's own \
+         tau1 = xi L^4/(pi^4 EI) where the key ends in _tau1 (a membrane: tau1 = xi/(kappa \
+         q1^4 + sigma q1^2) of its slowest mode); [filament] and [membrane] in the scene's own \
          consistent units.\n",
     );
     for (heading, rows) in sections() {
@@ -689,16 +813,47 @@ mod tests {
         text.parse::<toml::Table>().map(Value::Table).expect("TOML")
     }
 
-    /// Every key of every built-in scene, as written and as it will run (defaults
-    /// filled in), has a row.
+    /// The membrane scenes the rows of membrane keys are probed in (no built-in scene is
+    /// a membrane yet: the pipeline cannot run one), as (name, text): one simply
+    /// supported, one periodic.
+    const MEMBRANES: &[(&str, &str)] = &[
+        (
+            "membrane-hinged",
+            include_str!("../../tests/scenes/good/membrane-hinged.toml"),
+        ),
+        (
+            "membrane-pbc",
+            include_str!("../../tests/scenes/good/membrane-pbc.toml"),
+        ),
+    ];
+
+    /// Whether `pattern` is a key of membrane scenes only (probed in [`MEMBRANES`]).
+    fn membrane_key(pattern: &str) -> bool {
+        pattern.starts_with("membrane.") || pattern == "mesh.elements_y"
+    }
+
+    /// Every scene the tests know, as (name, text, the scene): the built-in ones, then
+    /// [`MEMBRANES`].
+    fn every_scene() -> Vec<(&'static str, &'static str, Scene)> {
+        let builtin = BUILTIN.iter().map(|b| (b.name, b.text, b.load()));
+        let membranes = MEMBRANES
+            .iter()
+            .map(|(n, t)| (*n, *t, Scene::parse_named(t, Path::new(n), n)));
+        builtin
+            .chain(membranes)
+            .map(|(n, t, s)| (n, t, s.unwrap_or_else(|e| panic!("{n}: {e}"))))
+            .collect()
+    }
+
+    /// Every key of every built-in scene and of the membrane scenes, as written and as it
+    /// will run (defaults filled in), has a row.
     #[test]
     fn every_key_of_every_builtin_scene_is_documented() {
-        for b in BUILTIN {
-            let scene = b.load().expect("loads");
-            let mut keys = key_paths(&value_of(b.text));
+        for (name, text, scene) in every_scene() {
+            let mut keys = key_paths(&value_of(text));
             keys.extend(key_paths(&effective_value(&scene).unwrap()));
             for k in keys {
-                assert!(doc(&k).is_some(), "{}: key {k} has no row in KEYS", b.name);
+                assert!(doc(&k).is_some(), "{name}: key {k} has no row in KEYS");
             }
         }
     }
@@ -814,15 +969,20 @@ mod tests {
         assert!(err.contains("unknown field"), "{err}");
     }
 
-    /// The built-in scenes to probe the key `pattern` in, as (name, TOML value, the
-    /// key's concrete path): those that have it, else those that have its table.
+    /// The scenes to probe the key `pattern` in, as (name, TOML value, the key's concrete
+    /// path): those that have it, else those that have its table; among the built-in
+    /// scenes, or for a key of membranes only among [`MEMBRANES`].
     fn bases(pattern: &str) -> Vec<(&'static str, Value, Vec<String>)> {
+        let pool: Vec<(&'static str, &'static str)> = if membrane_key(pattern) {
+            MEMBRANES.to_vec()
+        } else {
+            BUILTIN.iter().map(|b| (b.name, b.text)).collect()
+        };
         let with = |pattern: &str| -> Vec<(&'static str, Value, Vec<String>)> {
-            BUILTIN
-                .iter()
-                .filter_map(|b| {
-                    let v = value_of(b.text);
-                    concrete(&v, pattern).map(|p| (b.name, v, p))
+            pool.iter()
+                .filter_map(|(name, text)| {
+                    let v = value_of(text);
+                    concrete(&v, pattern).map(|p| (*name, v, p))
                 })
                 .collect()
         };
@@ -941,21 +1101,48 @@ mod tests {
     }
 
     /// The scene as it will run reads back as the same scene (what `scene show` prints
-    /// can be saved and run).
+    /// can be saved and run), from its value and from its text; a membrane scene's has
+    /// no `[filament]` table (it would be refused) and its `mesh.elements_y` filled in.
     #[test]
     fn effective_scene_reads_back() {
-        for b in BUILTIN {
-            let scene = b.load().unwrap();
-            let text = toml::to_string(&effective_value(&scene).unwrap()).unwrap();
-            let again = Scene::parse_named(&text, Path::new("x"), b.name)
-                .unwrap_or_else(|e| panic!("{}: {e}\n{text}", b.name));
-            assert_eq!(
-                toml::to_string(&again).unwrap(),
-                toml::to_string(&scene).unwrap(),
-                "{}",
-                b.name
-            );
+        for (name, _, scene) in every_scene() {
+            let from_value = toml::to_string(&effective_value(&scene).unwrap()).unwrap();
+            for text in [from_value, effective_toml(&scene).unwrap()] {
+                let again = Scene::parse_named(&text, Path::new("x"), name)
+                    .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+                assert_eq!(
+                    toml::to_string(&again).unwrap(),
+                    toml::to_string(&scene).unwrap(),
+                    "{name}"
+                );
+                assert_eq!(text.contains("[filament]"), !scene.is_membrane(), "{name}");
+                assert_eq!(text.contains("elements_y"), scene.is_membrane(), "{name}");
+            }
         }
+        // Filament scenes are written as serde writes them, as before membranes existed.
+        let b = &BUILTIN[0];
+        let scene = b.load().unwrap();
+        assert_eq!(
+            effective_toml(&scene).unwrap(),
+            toml::to_string(&scene).unwrap()
+        );
+    }
+
+    /// [`without_table`] removes exactly the named table: its header and keys, up to the
+    /// next header, whatever follows.
+    #[test]
+    fn without_table_removes_one_table() {
+        let text = "a = 1\n\n[f]\nx = 1.0\ny = 2.0\n\n[m]\nx = 3.0\n\n[[runs]]\nn = 1\n";
+        assert_eq!(
+            without_table(text, "f"),
+            "a = 1\n\n[m]\nx = 3.0\n\n[[runs]]\nn = 1\n"
+        );
+        assert_eq!(
+            without_table(text, "m"),
+            "a = 1\n\n[f]\nx = 1.0\ny = 2.0\n\n[[runs]]\nn = 1\n"
+        );
+        assert_eq!(without_table(text, "g"), text);
+        assert_eq!(without_table("[f]\nx = 1\n", "f"), "");
     }
 
     /// The whole table, grouped: every section's rows are consecutive in [`KEYS`] (so
@@ -969,6 +1156,7 @@ mod tests {
             [
                 "Top level",
                 "`[filament]`",
+                "`[membrane]`",
                 "`[mesh]`",
                 "`[sampling]`",
                 "`[compression]`",

@@ -35,6 +35,43 @@
 //! full = { trajectories = 64, duration_tau1 = 400.0 }
 //! ```
 //!
+//! **Membrane scenes** (issue #27). A scene with a `[membrane]` table instead of
+//! `[filament]` describes a Helfrich membrane on an a × b rectangle, whose exact continuum
+//! theory is [`crate::spectral::membrane`] (a scene has one object: never both tables).
+//! Its time unit τ1 is the relaxation time ξ/(κq₁⁴ + σq₁²) of its slowest mode
+//! ([`Scene::tau1`]); positions are fractions x/a on the midline y = b/2:
+//!
+//! ```toml
+//! description = "Simply supported membrane, no tension"
+//! seed = 20270127
+//! dims = 3                       # always 3: a surface in 3D space, one height h(x, y)
+//! model = "fem"                  # "fem" (plate elements) or "spectral"; never "compression"
+//! checks = ["profile", "mode-variance", "two-time"]
+//!
+//! [membrane]                     # any MembraneParams field, consistent units; defaults:
+//! bending_rigidity = 1.0         # κ = ξ = kT = a = b = 1, σ = 0, simply supported
+//! tension = 0.0                  # σ > the buckling tension −κ·q₁² (may be negative)
+//! drag = 1.0                     # ξ, friction per area
+//! kt = 1.0
+//! width = 1.0                    # a, along x
+//! height = 1.0                   # b, along y
+//! boundary = "simply-supported"  # or "periodic"
+//!
+//! [mesh]                         # uniform only (grading = 1)
+//! elements = 8                   # fem: elements along x; spectral: mode indices along x
+//! elements_y = 8                 # along y (default: elements); at most 4096 in all
+//!
+//! [sampling]
+//! burn_in_tau1 = 2.0
+//! modes = 4                      # at most elements·elements_y (periodic: that − 1)
+//! profile_points = [0.25, 0.5]   # x/a on y = b/2: (0, 1) simply supported, [0, 1) periodic
+//! two_time = [[0.5, 0.5, 0.5, 1.0]]  # (x/a, x'/a, t/τ1, η/τ1) on y = b/2
+//! ```
+//!
+//! (`[[runs]]` as for the filament.) The simulation pipeline does not run membrane scenes
+//! yet: the commands that simulate or check data refuse them
+//! ([`Scene::refuse_membrane`]).
+//!
 //! An ensemble's keys (every budget: `quick`, `standard`, `full`):
 //!
 //! - `trajectories`: independent trajectories (per strain in a compression scene),
@@ -95,6 +132,7 @@ use crate::fem::noise::NoiseModel;
 use crate::output::provenance::{DescribeScene, SceneProvenance};
 use crate::params::FilamentParams;
 use crate::params::physical::{self, FilamentInput, PhysicalFilament};
+use crate::spectral::membrane::{Membrane, MembraneParams};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -291,12 +329,18 @@ pub struct CompressionSpec {
     pub halving: Option<[String; 2]>,
 }
 
-/// Discretization of the filament.
+/// Discretization of the filament or the membrane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
-    /// Element count (fem) or number of modes (spectral).
+    /// Element count (fem) or number of modes (spectral); of a membrane, the count along x
+    /// (fem) or the number of mode indices kept along x (spectral).
     pub elements: usize,
+    /// Membrane scenes only: the element count along y (fem) or the number of mode
+    /// indices kept along y (spectral); left out, the same as `elements`
+    /// ([`MeshSpec::elements_along_y`]). Refused in a filament scene.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements_y: Option<usize>,
     /// Ratio of the last to the first element length (geometric grading); 1 is uniform.
     #[serde(default = "one")]
     pub grading: f64,
@@ -307,6 +351,11 @@ fn one() -> f64 {
 }
 
 impl MeshSpec {
+    /// The count along y of a membrane mesh: `elements_y`, or `elements` if left out.
+    pub fn elements_along_y(&self) -> usize {
+        self.elements_y.unwrap_or(self.elements)
+    }
+
     /// The mesh of a filament of length `length`: uniform, or geometrically graded.
     ///
     /// # Errors
@@ -328,10 +377,11 @@ pub struct Sampling {
     pub burn_in_tau1: f64,
     /// Number of (lowest) modes checked.
     pub modes: usize,
-    /// Positions x/L of the profile check.
+    /// Positions x/L of the profile check (membrane: x/a on the midline y = b/2).
     #[serde(default)]
     pub profile_points: Vec<f64>,
-    /// (x/L, y/L, t/τ1, η/τ1) of the two-time check.
+    /// (x/L, y/L, t/τ1, η/τ1) of the two-time check (membrane: (x/a, x'/a, t/τ1, η/τ1),
+    /// both points on the midline y = b/2).
     #[serde(default)]
     pub two_time: Vec<[f64; 4]>,
 }
@@ -401,7 +451,8 @@ pub struct Scene {
     /// Master seed: every trajectory's generator derives from it, the run name and the
     /// trajectory index.
     pub seed: u64,
-    /// 2 (one transverse direction) or 3 (two).
+    /// 2 (one transverse direction) or 3 (two); a membrane scene: 3 (one height
+    /// component, [`Scene::components`]).
     pub dims: usize,
     /// What is simulated.
     pub model: ModelKind,
@@ -411,6 +462,15 @@ pub struct Scene {
     /// from physical units ([`crate::params::physical`]).
     #[serde(default, deserialize_with = "deserialize_filament")]
     pub filament: FilamentParams,
+    /// The membrane of a membrane scene (its `[membrane]` table, consistent units), or
+    /// `None` for a filament scene (see the module docs). A membrane scene leaves
+    /// `filament` at its defaults and never reads it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub membrane: Option<MembraneParams>,
+    /// Whether the file has a `[filament]` table (not in the file under this name: set
+    /// by [`Scene::parse`]); validation refuses it next to a `[membrane]` table.
+    #[serde(skip)]
+    pub(crate) filament_table: bool,
     /// The filament as given in physical units, if the scene gave it so (not in the
     /// file under this name: read from the `[filament]` keys).
     #[serde(skip)]
@@ -501,12 +561,68 @@ impl Scene {
     /// [`Error::Scene`] naming `path`, the key, value and allowed range.
     pub fn parse_named(text: &str, path: &Path, name: &str) -> Result<Scene> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| parse_error(text, path, &e))?;
-        scene.physical = FilamentTable::physical(text);
+        let table = FilamentTable::read(text);
+        scene.filament_table = table.as_ref().is_some_and(|t| t.filament.is_some());
+        scene.physical = table.and_then(FilamentTable::physical);
         scene.source_text = text.to_string();
         scene.path = path.to_path_buf();
         scene.name = name.to_string();
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// Whether this is a membrane scene (a `[membrane]` table; see the module docs).
+    pub fn is_membrane(&self) -> bool {
+        self.membrane.is_some()
+    }
+
+    /// The scene's time unit τ1, in its consistent units: every key ending in `_tau1` is
+    /// a multiple of it. A filament's slowest relaxation time ξL⁴/(π⁴EI)
+    /// ([`FilamentParams::tau1`], the same arithmetic); a membrane's, 1/λ = ξ/c_q of its
+    /// slowest mode ([`Membrane::modes`], c_q = κq⁴ + σq², [`Membrane::stiffness`]): with
+    /// q² = π²(1/a² + 1/b²) simply supported, (2π/max(a, b))² periodic. NaN for a membrane
+    /// whose parameters [`MembraneParams::validate`] refuses (validation refuses the
+    /// scene).
+    pub fn tau1(&self) -> f64 {
+        match &self.membrane {
+            None => self.filament.tau1(),
+            Some(p) => Membrane::new(*p)
+                .and_then(|m| Ok((m, m.modes(1)?)))
+                .map_or(f64::NAN, |(m, slowest)| p.drag / m.stiffness(slowest[0])),
+        }
+    }
+
+    /// The components of the displacement each node or mode carries: a filament's
+    /// transverse directions, `dims − 1` (w; or w and v); a membrane's one height h.
+    pub fn components(&self) -> usize {
+        if self.is_membrane() {
+            1
+        } else {
+            self.dims.saturating_sub(1)
+        }
+    }
+
+    /// Refuses a membrane scene where only filament scenes can go yet (issue #27: the
+    /// membrane is parsed, validated and has its exact theory, but nothing simulates or
+    /// checks it): `what` names the command or path, e.g. `verify`.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (exit 2) naming the scene file, the key `membrane` and the scene,
+    /// saying that `what` is not yet supported for membranes.
+    pub fn refuse_membrane(&self, what: &str) -> Result<()> {
+        if !self.is_membrane() {
+            return Ok(());
+        }
+        Err(Error::Scene {
+            file: self.path.clone(),
+            key: "membrane".to_string(),
+            message: format!(
+                "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
+                 (issue #27: membrane scenes are parsed and validated, but nothing simulates \
+                 or checks them yet); use a filament scene",
+                self.name
+            ),
+        })
     }
 
     /// Wraps an error raised while preparing or running run `run` of this scene so that
@@ -516,7 +632,7 @@ impl Scene {
     /// full precision (shortest round trip), so that "must be < a, got b" never shows
     /// a = b.
     pub fn run_error(&self, run: usize, what: &str, err: Error) -> Error {
-        let tau1 = self.filament.tau1();
+        let tau1 = self.tau1();
         let key = |k: &str| format!("runs[{run}].{k}");
         match err {
             Error::Scene { .. } | Error::Io { .. } => err,
@@ -605,19 +721,23 @@ fn deserialize_filament<'de, D: Deserializer<'de>>(
 }
 
 /// The `[filament]` table alone (every other key of the file ignored), to recover the
-/// physical filament once the scene has parsed.
+/// physical filament and whether the table was given once the scene has parsed.
 #[derive(Deserialize)]
 struct FilamentTable {
     #[serde(default)]
-    filament: FilamentInput,
+    filament: Option<FilamentInput>,
 }
 
 impl FilamentTable {
-    /// The physical filament `text` gives, if any (`None` also for text that does not
-    /// parse: [`Scene::parse`] has refused it before).
-    fn physical(text: &str) -> Option<PhysicalFilament> {
-        let table: FilamentTable = toml::from_str(text).ok()?;
-        table.filament.resolve().ok()?.1
+    /// The `[filament]` table of `text` (`None` for text that does not parse:
+    /// [`Scene::parse`] has refused it before).
+    fn read(text: &str) -> Option<FilamentTable> {
+        toml::from_str(text).ok()
+    }
+
+    /// The physical filament the table gives, if any.
+    fn physical(self) -> Option<PhysicalFilament> {
+        self.filament.unwrap_or_default().resolve().ok()?.1
     }
 }
 
@@ -877,4 +997,160 @@ fn value_key(text: &str, offset: usize) -> Option<String> {
     let (start, line) = line_at(text, offset);
     let eq = line.find('=')?;
     (header_name(line).is_none() && offset > start + eq).then(|| key_at(text, offset))
+}
+
+#[cfg(test)]
+mod tests {
+    //! The accessors of a scene that are not its filament's: τ1 and the displacement
+    //! components of a membrane against closed forms written out here (independent of
+    //! `crate::spectral::membrane`), and the same arithmetic as before for a filament.
+
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A membrane scene with `[membrane]` keys `table` (a valid sampling plan for any
+    /// simply supported or periodic 8 × 4 mesh).
+    fn membrane(table: &str) -> Scene {
+        let text = format!(
+            r#"description = "membrane"
+seed = 1
+dims = 3
+model = "fem"
+checks = ["mode-variance"]
+
+[membrane]
+{table}
+
+[mesh]
+elements = 8
+elements_y = 4
+
+[sampling]
+burn_in_tau1 = 1.0
+modes = 4
+
+[[runs]]
+name = "cn"
+dt_tau1 = 0.01
+quick = {{ trajectories = 4, duration_tau1 = 40.0 }}
+standard = {{ trajectories = 4, duration_tau1 = 40.0 }}
+full = {{ trajectories = 4, duration_tau1 = 40.0 }}
+"#
+        );
+        Scene::parse(&text, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    }
+
+    /// A filament scene in `dims` dimensions with `[filament]` keys `table`.
+    fn filament(dims: usize, table: &str) -> Scene {
+        let text = format!(
+            r#"description = "filament"
+seed = 1
+dims = {dims}
+model = "fem"
+checks = ["mode-variance"]
+
+[filament]
+{table}
+
+[mesh]
+elements = 4
+
+[sampling]
+burn_in_tau1 = 1.0
+modes = 2
+
+[[runs]]
+name = "cn"
+dt_tau1 = 0.01
+quick = {{ trajectories = 4, duration_tau1 = 40.0 }}
+standard = {{ trajectories = 4, duration_tau1 = 40.0 }}
+full = {{ trajectories = 4, duration_tau1 = 40.0 }}
+"#
+        );
+        Scene::parse(&text, Path::new("f.toml")).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    }
+
+    /// Relative difference.
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    /// τ1 of a simply supported membrane is ξ/(κq⁴ + σq²) of its slowest mode (1, 1),
+    /// q² = π²(1/a² + 1/b²), for a tension of either sign. Tolerance 1e-14: a handful of
+    /// roundings either way.
+    #[test]
+    fn membrane_tau1_simply_supported_is_the_slowest_mode_closed_form() {
+        let (kappa, xi, a, b) = (0.8, 2.5, 1.7, 1.1);
+        let q2 = PI * PI * (1.0 / (a * a) + 1.0 / (b * b));
+        for sigma in [0.0, 0.3, -0.9 * kappa * q2] {
+            let s = membrane(&format!(
+                "bending_rigidity = {kappa}\ntension = {sigma:e}\ndrag = {xi}\nwidth = {a}\nheight = {b}"
+            ));
+            let expected = xi / (kappa * q2 * q2 + sigma * q2);
+            assert!(
+                rel(s.tau1(), expected) < 1e-14,
+                "sigma {sigma}: {} vs {expected}",
+                s.tau1()
+            );
+        }
+        // κ = ξ = a = b = 1, σ = 0: τ1 = 1/(4π⁴).
+        let unit = membrane("boundary = \"simply-supported\"");
+        assert!(rel(unit.tau1(), 1.0 / (4.0 * PI.powi(4))) < 1e-14);
+    }
+
+    /// τ1 of a periodic membrane is that of its slowest modes, q = 2π/max(a, b) along the
+    /// longer side: ξ/(κq⁴ + σq²).
+    #[test]
+    fn membrane_tau1_periodic_is_the_longest_wavelength_closed_form() {
+        let (kappa, sigma, xi) = (1.3, 0.7, 0.4);
+        for (a, b) in [(2.0, 1.0), (1.0, 3.0)] {
+            let s = membrane(&format!(
+                "bending_rigidity = {kappa}\ntension = {sigma}\ndrag = {xi}\nwidth = {a}\nheight = {b}\nboundary = \"periodic\""
+            ));
+            let q = 2.0 * PI / f64::max(a, b);
+            let expected = xi / (kappa * q.powi(4) + sigma * q * q);
+            assert!(
+                rel(s.tau1(), expected) < 1e-14,
+                "{a} x {b}: {} vs {expected}",
+                s.tau1()
+            );
+        }
+    }
+
+    /// A filament's τ1 is its ξL⁴/(π⁴EI), bit for bit (the accessor replaced
+    /// `scene.filament.tau1()` at every call site outside the pipeline).
+    #[test]
+    fn filament_tau1_is_unchanged() {
+        let s = filament(2, "length = 1.7\nbending_rigidity = 0.3\ndrag = 2.9");
+        assert_eq!(s.tau1().to_bits(), s.filament.tau1().to_bits());
+        let expected = 2.9 * 1.7f64.powi(4) / (PI.powi(4) * 0.3);
+        assert!(rel(s.tau1(), expected) < 1e-14);
+    }
+
+    /// Components: a filament has dims − 1 transverse directions, a membrane one height.
+    #[test]
+    fn components_of_filaments_and_membranes() {
+        assert_eq!(filament(2, "kt = 1.0").components(), 1);
+        assert_eq!(filament(3, "kt = 1.0").components(), 2);
+        let m = membrane("kt = 1.0");
+        assert_eq!((m.dims, m.components()), (3, 1));
+        assert!(m.is_membrane() && !filament(3, "kt = 1.0").is_membrane());
+    }
+
+    /// A membrane scene is refused where only filaments can go, naming the file, the key
+    /// `membrane`, the scene and what was refused; a filament scene passes.
+    #[test]
+    fn membranes_are_refused_where_only_filaments_go() {
+        assert!(filament(2, "kt = 1.0").refuse_membrane("verify").is_ok());
+        let e = membrane("kt = 1.0").refuse_membrane("verify").unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        let m = e.to_string();
+        for needle in [
+            "m.toml: key `membrane`",
+            "verify is not yet supported for membranes",
+            "scene \"m\"",
+        ] {
+            assert!(m.contains(needle), "{needle}: {m}");
+        }
+    }
 }

@@ -5,7 +5,10 @@
 //!
 //! 1. the checks of every scene: its name (the file stem, a path component of the
 //!    outputs: [`is_path_name`], at most [`MAX_NAME_LEN`] characters), filament, `dims`,
-//!    `checks`, mesh and burn-in;
+//!    `checks`, mesh and burn-in; of a membrane scene, instead of the filament and its
+//!    mesh: one object only (no `[filament]` table), a linear model, `dims = 3`, the
+//!    membrane's parameters and its uniform mesh ([`MAX_MEMBRANE_ELEMENTS_PER_SIDE`],
+//!    [`MAX_MEMBRANE_ELEMENTS`]);
 //! 2. the model's own tables: `[sampling]` of a linear scene, `[compression]` of a
 //!    compression scene;
 //! 3. ONE per-run check shared by both kinds of scene ([`Scene::validate`] →
@@ -34,6 +37,7 @@ use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
 use crate::params::physical;
+use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
 use crate::work::{Origin, Part, RunWork};
 use std::fmt::Display;
 
@@ -56,6 +60,17 @@ pub const MIN_LINEAR_DURATION_TAU1: f64 = 16.0;
 /// The most elements (or spectral modes) of a mesh: `mesh.elements` is in
 /// [1, `MAX_ELEMENTS`], and so is a data sidecar's `discretization.elements`.
 pub const MAX_ELEMENTS: usize = 1000;
+
+/// The most elements (or mode indices kept) along either side of a membrane:
+/// `mesh.elements` and `mesh.elements_y` are in [1, 256] ([2, 256] periodic).
+pub const MAX_MEMBRANE_ELEMENTS_PER_SIDE: usize = 256;
+
+/// The most elements (or modes kept) of a membrane mesh in all:
+/// `mesh.elements × mesh.elements_y` is at most 4096.
+pub const MAX_MEMBRANE_ELEMENTS: usize = 4096;
+
+/// The most modes a linear scene checks (`sampling.modes`).
+pub const MAX_CHECKED_MODES: usize = 50;
 
 /// Fewest sampled steps of a linear run per trajectory (`duration_tau1 / dt_tau1`): below
 /// this the series of the stiff modes, sampled every step, are too short for their
@@ -85,6 +100,11 @@ const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distri
 /// The allowed positions x/L of the profile and two-time checks, for messages: the
 /// hinges x/L = 0 and 1 have w = 0 exactly, so nothing fluctuates there to check.
 const INTERIOR: &str = "in (0, 1) (inside the filament: w = 0 at the hinges x/L = 0 and 1)";
+/// The allowed positions x/a of a simply supported membrane, for messages.
+const MEMBRANE_INTERIOR: &str = "in (0, 1) (x/a on the midline y = b/2, inside the membrane: h = 0 on the simply supported edges x/a = 0 and 1)";
+/// The allowed positions x/a of a periodic membrane, for messages.
+const MEMBRANE_PERIOD: &str =
+    "in [0, 1) (x/a on the midline y = b/2 of a periodic membrane, where x/a = 1 is x/a = 0)";
 /// The allowed checks of a compression scene, for messages.
 const COMPRESSION_CHECKS: &str =
     "force-strain, force-distribution or dt-halving for model = \"compression\"";
@@ -276,15 +296,35 @@ impl Scene {
         }
     }
 
-    /// The checks of every scene: filament, `dims`, `checks` non-empty, mesh, burn-in.
+    /// The checks of every scene: filament (or membrane), `dims`, `checks` non-empty,
+    /// mesh, burn-in.
     fn validate_common(&self) -> Result<()> {
-        self.validate_filament()?;
-        if self.dims != 2 && self.dims != 3 {
-            return Err(bad(self, "dims", &self.dims, "2 or 3"));
+        match &self.membrane {
+            Some(m) => self.validate_membrane(m)?,
+            None => {
+                self.validate_filament()?;
+                if self.dims != 2 && self.dims != 3 {
+                    return Err(bad(self, "dims", &self.dims, "2 or 3"));
+                }
+            }
         }
         if self.checks.is_empty() {
             return Err(bad(self, "checks", &"[]", "a non-empty list"));
         }
+        match &self.membrane {
+            Some(m) => self.validate_membrane_mesh(m)?,
+            None => self.validate_filament_mesh()?,
+        }
+        let b = self.sampling.burn_in_tau1;
+        if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
+            return Err(bad(self, "sampling.burn_in_tau1", &Num(b), "in [0, 1e4]"));
+        }
+        Ok(())
+    }
+
+    /// The mesh of a filament: `elements` in [1, [`MAX_ELEMENTS`]], no `elements_y`,
+    /// `grading` in [0.01, 100].
+    fn validate_filament_mesh(&self) -> Result<()> {
         if !(1..=MAX_ELEMENTS).contains(&self.mesh.elements) {
             return Err(bad(
                 self,
@@ -293,13 +333,137 @@ impl Scene {
                 &format!("in [1, {MAX_ELEMENTS}]"),
             ));
         }
+        if let Some(ny) = self.mesh.elements_y {
+            let allowed = "left out of a filament scene (elements_y is the element count along y of a [membrane] scene)";
+            return Err(bad(self, "mesh.elements_y", &ny, allowed));
+        }
         let g = self.mesh.grading;
         if !(g.is_finite() && (0.01..=100.0).contains(&g)) {
             return Err(bad(self, "mesh.grading", &Num(g), "in [0.01, 100]"));
         }
-        let b = self.sampling.burn_in_tau1;
-        if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
-            return Err(bad(self, "sampling.burn_in_tau1", &Num(b), "in [0, 1e4]"));
+        Ok(())
+    }
+
+    /// A membrane scene's object and parameters: no `[filament]` table beside it, model
+    /// `fem` or `spectral`, `dims = 3`; κ, ξ, kT, a, b in [1e-30, 1e30] and σ finite with
+    /// |σ| ≤ 1e30 (bounds that keep τ1, the rates and the variances inside f64), then
+    /// [`MembraneParams::validate`] (the aspect ratio, σ above the buckling tension), its
+    /// error named as the key `membrane.<field>`.
+    fn validate_membrane(&self, m: &MembraneParams) -> Result<()> {
+        if self.filament_table {
+            let allowed = "left out of a membrane scene (a scene describes one object, and this one has a [membrane] table)";
+            return Err(bad(self, "filament", &"a [filament] table", allowed));
+        }
+        if self.model == ModelKind::Compression {
+            let allowed = "\"fem\" or \"spectral\" for a membrane scene (compression is the filament's Fig. 2: a filament under imposed end-shortening)";
+            return Err(bad(self, "model", &"\"compression\"", allowed));
+        }
+        if self.dims != 3 {
+            let allowed = "3 for a membrane scene (a surface in 3D space with one height component h(x, y) normal to its x-y rectangle; dims = 2 would hold a curve, the filament)";
+            return Err(bad(self, "dims", &self.dims, allowed));
+        }
+        for (key, v) in [
+            ("bending_rigidity", m.bending_rigidity),
+            ("drag", m.drag),
+            ("kt", m.kt),
+            ("width", m.width),
+            ("height", m.height),
+        ] {
+            if !(v.is_finite() && (1e-30..=1e30).contains(&v)) {
+                let key = format!("membrane.{key}");
+                return Err(bad(self, &key, &Num(v), "in [1e-30, 1e30]"));
+            }
+        }
+        let t = m.tension;
+        if !(t.is_finite() && t.abs() <= 1e30) {
+            let allowed = format!(
+                "finite, in [-1e30, 1e30] and > the buckling tension -kappa q_min^2 = {}",
+                Num(m.buckling_tension())
+            );
+            return Err(bad(self, "membrane.tension", &Num(t), &allowed));
+        }
+        m.validate().map_err(|e| match e {
+            Error::InvalidParameter { name, allowed, .. } => {
+                let value = match name.as_str() {
+                    "bending_rigidity" => m.bending_rigidity,
+                    "drag" => m.drag,
+                    "kt" => m.kt,
+                    "width" => m.width,
+                    "height" => m.height,
+                    _ => m.tension,
+                };
+                bad(self, &format!("membrane.{name}"), &Num(value), &allowed)
+            }
+            other => other,
+        })?;
+        let tau1 = self.tau1();
+        if !(tau1.is_finite() && tau1 > 0.0) {
+            // Not reached within the bounds above (tau1 stays below about 1e194): a guard
+            // of the arithmetic.
+            let allowed = format!(
+                "a tension that gives the slowest mode a finite relaxation time (got tau1 = {}; the buckling tension is {})",
+                Num(tau1),
+                Num(m.buckling_tension())
+            );
+            return Err(bad(self, "membrane.tension", &Num(t), &allowed));
+        }
+        Ok(())
+    }
+
+    /// The mesh of a membrane: `elements` and `elements_y` each in
+    /// [1, [`MAX_MEMBRANE_ELEMENTS_PER_SIDE`]] ([2, …] periodic: one element would join
+    /// its own opposite edges), their product at most [`MAX_MEMBRANE_ELEMENTS`], and a
+    /// uniform mesh (`grading = 1`).
+    fn validate_membrane_mesh(&self, m: &MembraneParams) -> Result<()> {
+        let (lo, allowed) = match m.boundary {
+            MembraneBoundary::SimplySupported => (
+                1,
+                format!("in [1, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a membrane"),
+            ),
+            MembraneBoundary::Periodic => (
+                2,
+                format!(
+                    "in [2, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a periodic membrane (one element would join its own opposite edges, leaving only the uniform displacement, which is not a mode)"
+                ),
+            ),
+        };
+        let (nx, ny) = (self.mesh.elements, self.mesh.elements_along_y());
+        let range = lo..=MAX_MEMBRANE_ELEMENTS_PER_SIDE;
+        if !range.contains(&nx) {
+            return Err(bad(self, "mesh.elements", &nx, &allowed));
+        }
+        if let Some(ny) = self.mesh.elements_y
+            && !range.contains(&ny)
+        {
+            return Err(bad(self, "mesh.elements_y", &ny, &allowed));
+        }
+        if nx * ny > MAX_MEMBRANE_ELEMENTS {
+            let (key, value, allowed) = match self.mesh.elements_y {
+                Some(ny) => (
+                    "mesh.elements_y",
+                    ny,
+                    format!(
+                        "at most {} (a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: mesh.elements x mesh.elements_y = {nx} x {ny} = {})",
+                        MAX_MEMBRANE_ELEMENTS / nx,
+                        nx * ny
+                    ),
+                ),
+                None => (
+                    "mesh.elements",
+                    nx,
+                    format!(
+                        "at most {} when mesh.elements_y is left out (it defaults to mesh.elements, and a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: {nx} x {nx} = {})",
+                        MAX_MEMBRANE_ELEMENTS.isqrt(),
+                        nx * nx
+                    ),
+                ),
+            };
+            return Err(bad(self, key, &value, &allowed));
+        }
+        let g = self.mesh.grading;
+        if g != 1.0 {
+            let allowed = "1 for a membrane scene (membrane meshes are uniform)";
+            return Err(bad(self, "mesh.grading", &Num(g), allowed));
         }
         Ok(())
     }
@@ -413,12 +577,13 @@ impl Scene {
     /// and the points the requested checks need.
     fn validate_sampling(&self) -> Result<()> {
         let s = &self.sampling;
-        let max_modes = match self.model {
-            ModelKind::Fem => 2 * self.mesh.elements,
-            ModelKind::Spectral | ModelKind::Compression => self.mesh.elements,
-        };
-        if s.modes < 1 || s.modes > max_modes.min(50) {
-            let allowed = format!("in [1, {}]", max_modes.min(50));
+        let (max_modes, why) = self.mode_count();
+        let most = max_modes.min(MAX_CHECKED_MODES);
+        if s.modes < 1 || s.modes > most {
+            let allowed = match why {
+                None => format!("in [1, {most}]"),
+                Some(why) => format!("in [1, {most}] ({why})"),
+            };
             return Err(bad(self, "sampling.modes", &s.modes, &allowed));
         }
         for (key, n) in [
@@ -430,10 +595,11 @@ impl Scene {
                 return Err(bad(self, key, &format!("{n} points"), &allowed));
             }
         }
+        let (inside, allowed) = self.positions();
         for (i, &x) in s.profile_points.iter().enumerate() {
-            if !(x.is_finite() && x > 0.0 && x < 1.0) {
+            if !inside(x) {
                 let key = format!("sampling.profile_points[{i}]");
-                return Err(bad(self, &key, &Num(x), INTERIOR));
+                return Err(bad(self, &key, &Num(x), allowed));
             }
         }
         for (i, p) in s.two_time.iter().enumerate() {
@@ -455,13 +621,19 @@ impl Scene {
         Ok(())
     }
 
-    /// Two-time point `i`, `(x/L, y/L, t/τ1, η/τ1)`: positions inside (0, 1) (w = 0 at
-    /// the hinges), 0 < t ≤ η ≤ burn-in.
+    /// Two-time point `i`, `(x/L, y/L, t/τ1, η/τ1)` (membrane: `(x/a, x'/a, t/τ1,
+    /// η/τ1)`): positions as [`Self::positions`] allows them, 0 < t ≤ η ≤ burn-in.
     fn validate_two_time_point(&self, i: usize, p: &[f64; 4]) -> Result<()> {
-        for (j, name) in ["x/L", "y/L"].iter().enumerate() {
-            if !(p[j].is_finite() && p[j] > 0.0 && p[j] < 1.0) {
+        let (inside, allowed) = self.positions();
+        let names = if self.is_membrane() {
+            ["x/a", "x'/a"]
+        } else {
+            ["x/L", "y/L"]
+        };
+        for (j, name) in names.iter().enumerate() {
+            if !inside(p[j]) {
                 let key = format!("sampling.two_time[{i}][{j}] ({name})");
-                return Err(bad(self, &key, &Num(p[j]), INTERIOR));
+                return Err(bad(self, &key, &Num(p[j]), allowed));
             }
         }
         if !(p[3].is_finite() && p[3] > 0.0) {
@@ -484,6 +656,56 @@ impl Scene {
             return Err(bad(self, &key, &Num(p[3]), &allowed));
         }
         Ok(())
+    }
+
+    /// The modes the scene's discretization has, the most `sampling.modes` may check
+    /// below [`MAX_CHECKED_MODES`], and for a membrane why: a filament's finite elements
+    /// have `2·elements` (w and its slope at every node), its spectral model `elements`
+    /// modes; a membrane mesh of nx × ny elements (or mode indices kept) has nx·ny of its
+    /// lowest modes, less the uniform displacement (not a mode) if periodic.
+    fn mode_count(&self) -> (usize, Option<String>) {
+        let Some(m) = &self.membrane else {
+            let n = match self.model {
+                ModelKind::Fem => 2 * self.mesh.elements,
+                ModelKind::Spectral | ModelKind::Compression => self.mesh.elements,
+            };
+            return (n, None);
+        };
+        let (nx, ny) = (self.mesh.elements, self.mesh.elements_along_y());
+        let n = nx * ny;
+        match m.boundary {
+            MembraneBoundary::SimplySupported => (
+                n,
+                Some(format!(
+                    "at most {MAX_CHECKED_MODES}, and at most mesh.elements x mesh.elements_y = {nx} x {ny} = {n}, the modes a membrane mesh resolves"
+                )),
+            ),
+            MembraneBoundary::Periodic => (
+                n - 1,
+                Some(format!(
+                    "at most {MAX_CHECKED_MODES}, and at most mesh.elements x mesh.elements_y - 1 = {nx} x {ny} - 1 = {}, the modes a periodic membrane mesh resolves (its {n} heights less the uniform displacement, which is not a mode)",
+                    n - 1
+                )),
+            ),
+        }
+    }
+
+    /// The allowed positions of the profile and two-time checks (fractions x/L of the
+    /// filament, x/a on the midline y = b/2 of a membrane), as a test and the message:
+    /// inside (0, 1) where the ends or edges hold w = 0 (hinges, simply supported edges),
+    /// [0, 1) on a periodic membrane (x/a = 1 is x/a = 0).
+    fn positions(&self) -> (fn(f64) -> bool, &'static str) {
+        fn interior(x: f64) -> bool {
+            x.is_finite() && x > 0.0 && x < 1.0
+        }
+        fn period(x: f64) -> bool {
+            x.is_finite() && (0.0..1.0).contains(&x)
+        }
+        match self.membrane.map(|m| m.boundary) {
+            None => (interior, INTERIOR),
+            Some(MembraneBoundary::SimplySupported) => (interior, MEMBRANE_INTERIOR),
+            Some(MembraneBoundary::Periodic) => (period, MEMBRANE_PERIOD),
+        }
     }
 
     /// The `[compression]` table of a compression scene: strains, uniform mesh, burn-in
@@ -789,11 +1011,20 @@ impl Scene {
     /// The unknowns one step of `run` updates, over all components: `components × n`
     /// (n = 2·elements for the finite elements, the number of modes for the spectral
     /// model), `components × n²` for the dense exact modal update of the finite elements.
+    /// A membrane of nx × ny elements: n = nx·ny modes (spectral), and for the plate
+    /// elements, not written yet, the provisional 4·(nx + 1)·(ny + 1) of a C¹ rectangle
+    /// mesh (h, h_x, h_y and h_xy at every node).
     pub fn step_cost(&self, run: &RunSpec) -> f64 {
-        let components = self.dims.saturating_sub(1) as f64;
-        let n = match self.model {
-            ModelKind::Spectral => self.mesh.elements as f64,
-            ModelKind::Fem | ModelKind::Compression => 2.0 * self.mesh.elements as f64,
+        let components = self.components() as f64;
+        let (nx, ny) = (
+            self.mesh.elements as f64,
+            self.mesh.elements_along_y() as f64,
+        );
+        let n = match (self.model, self.is_membrane()) {
+            (ModelKind::Spectral, false) => nx,
+            (ModelKind::Fem | ModelKind::Compression, false) => 2.0 * nx,
+            (ModelKind::Spectral, true) => nx * ny,
+            (ModelKind::Fem | ModelKind::Compression, true) => 4.0 * (nx + 1.0) * (ny + 1.0),
         };
         let dense = self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal;
         components * if dense { n * n } else { n }
@@ -820,7 +1051,7 @@ impl Scene {
         let Some(run) = self.runs.get(i) else {
             return RunWork::default();
         };
-        let components = self.dims.saturating_sub(1) as f64;
+        let components = self.components() as f64;
         let dt = run.dt_tau1;
         let traj = e.trajectories as f64;
         let (trajectory_steps, samples) = match &self.compression {
@@ -970,8 +1201,13 @@ impl Scene {
                         ));
                     }
                 }
+                let elements_y = if self.is_membrane() {
+                    format!(", mesh.elements_y = {}", self.mesh.elements_along_y())
+                } else {
+                    String::new()
+                };
                 keys.push(format!(
-                    "mesh.elements = {}, dims = {}{}",
+                    "mesh.elements = {}{elements_y}, dims = {}{}",
                     self.mesh.elements,
                     self.dims,
                     if self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal
@@ -1072,6 +1308,123 @@ full = { trajectories = 4, duration_tau1 = 10.0 }
         let m = message(&text, "c.toml");
         assert!(m.contains("key `runs[0].checks[1]`"), "{m}");
         assert!(m.contains("got Profile"), "{m}");
+    }
+
+    /// A membrane scene: `MEMBRANE`, `MESH` and `POINTS` stand for the `[membrane]`
+    /// keys, the `[mesh]` keys and the profile points.
+    const MEMBRANE_SCENE: &str = r#"
+description = "membrane scene"
+seed = 1
+dims = 3
+model = "fem"
+checks = ["profile", "mode-variance"]
+
+[membrane]
+MEMBRANE
+
+[mesh]
+MESH
+
+[sampling]
+burn_in_tau1 = 1.0
+modes = 3
+profile_points = POINTS
+
+[[runs]]
+name = "cn"
+dt_tau1 = 0.01
+quick = { trajectories = 4, duration_tau1 = 40.0 }
+standard = { trajectories = 4, duration_tau1 = 40.0 }
+full = { trajectories = 4, duration_tau1 = 40.0 }
+"#;
+
+    /// The message of parsing [`MEMBRANE_SCENE`] with these keys (empty if accepted).
+    fn membrane(table: &str, mesh: &str, points: &str) -> String {
+        let text = MEMBRANE_SCENE
+            .replace("MEMBRANE", table)
+            .replace("MESH", mesh)
+            .replace("POINTS", points);
+        message(&text, "m.toml")
+    }
+
+    /// The membrane mesh at the ends of its ranges: each side in [1, 256] ([2, 256]
+    /// periodic), at most 4096 elements in all (also when `elements_y` defaults to
+    /// `elements`); the ends themselves accepted, one past them refused naming the key.
+    #[test]
+    fn membrane_mesh_bounds_at_their_ends() {
+        let ss = |mesh: &str| membrane("kt = 1.0", mesh, "[0.5]");
+        let periodic = |mesh: &str| membrane("boundary = \"periodic\"", mesh, "[0.5]");
+        assert_eq!(ss("elements = 16\nelements_y = 256"), "");
+        assert_eq!(ss("elements = 4\nelements_y = 1"), "");
+        assert_eq!(ss("elements = 64"), "");
+        assert_eq!(periodic("elements = 2\nelements_y = 2"), "");
+        let m = ss("elements = 16\nelements_y = 257");
+        assert!(
+            m.contains("key `mesh.elements_y`: must be in [1, 256] for a membrane, got 257"),
+            "{m}"
+        );
+        let m = ss("elements = 17\nelements_y = 241");
+        assert!(m.contains("key `mesh.elements_y`: must be at most 240 (a membrane mesh has at most 4096 elements: mesh.elements x mesh.elements_y = 17 x 241 = 4097), got 241"), "{m}");
+        let m = ss("elements = 65");
+        assert!(
+            m.contains("key `mesh.elements`: must be at most 64 when mesh.elements_y is left out"),
+            "{m}"
+        );
+        let m = periodic("elements = 1\nelements_y = 2");
+        assert!(
+            m.contains("key `mesh.elements`: must be in [2, 256] for a periodic membrane"),
+            "{m}"
+        );
+        let m = ss("elements = 4\ngrading = 1.5");
+        assert!(
+            m.contains("key `mesh.grading`: must be 1 for a membrane scene"),
+            "{m}"
+        );
+    }
+
+    /// The membrane's parameters at the ends of their ranges: a side up to 1e30 (within
+    /// the aspect ratio), the tension just above the buckling tension −κq₁² (accepted)
+    /// and at it (refused).
+    #[test]
+    fn membrane_parameter_bounds_at_their_ends() {
+        let with = |table: &str| membrane(table, "elements = 4", "[0.5]");
+        assert_eq!(with("width = 1e27\nheight = 1e30"), "");
+        let m = with("width = 1e27\nheight = 1.000000001e30");
+        assert!(
+            m.contains("key `membrane.height`: must be in [1e-30, 1e30], got 1.000000001e30"),
+            "{m}"
+        );
+        let buckling = -2.0 * std::f64::consts::PI.powi(2);
+        assert_eq!(with(&format!("tension = {:e}", buckling.next_up())), "");
+        let m = with(&format!("tension = {buckling:e}"));
+        assert!(m.contains("key `membrane.tension`: must be finite and > -1.9739208802178716e1, the buckling tension"), "{m}");
+    }
+
+    /// Sampling positions x/a: the simply supported edges (h = 0) are refused, a periodic
+    /// membrane takes x/a = 0 (the same point as x/a = 1, which it refuses).
+    #[test]
+    fn membrane_positions_by_boundary() {
+        let ss = |points: &str| membrane("kt = 1.0", "elements = 4", points);
+        let periodic = |points: &str| membrane("boundary = \"periodic\"", "elements = 4", points);
+        assert_eq!(periodic("[0.0, 0.5]"), "");
+        assert!(
+            periodic("[0.5, 1.0]").contains("key `sampling.profile_points[1]`: must be in [0, 1)")
+        );
+        assert!(ss("[0.0]").contains("key `sampling.profile_points[0]`: must be in (0, 1)"));
+        assert_eq!(ss("[0.5]"), "");
+    }
+
+    /// A filament scene refuses `mesh.elements_y` (the count along y of a membrane).
+    #[test]
+    fn filament_refuses_elements_y() {
+        let text = COMPRESSION
+            .replace("NAME", "cn")
+            .replace("elements = 4", "elements = 4\nelements_y = 4");
+        let m = message(&text, "c.toml");
+        assert!(
+            m.contains("key `mesh.elements_y`: must be left out of a filament scene"),
+            "{m}"
+        );
     }
 
     #[test]

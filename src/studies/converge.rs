@@ -393,7 +393,7 @@ fn prepare(scene: &Scene, run: usize, over: Over, value: f64) -> Result<(Scene, 
     let spec = s.runs[run].clone();
     let lr = LinearRun::prepare(&s, &spec).map_err(|e| match e {
         Error::UnstableTimeStep { limit, .. } => {
-            let limit_tau1 = limit / s.filament.tau1();
+            let limit_tau1 = limit / s.tau1();
             match over {
                 Over::Dt => Error::invalid(
                     "--values",
@@ -1007,9 +1007,9 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 /// `<scene>-<run>-<over>.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
-/// diverges, or whose estimators fail, is recorded in [`ConvergeSummary::failed`], not
-/// fatal.
+/// Bad input (exit 2) naming the flag, or a membrane scene ([`Scene::refuse_membrane`]);
+/// run failures (exit 3). A value whose run diverges, or whose estimators fail, is
+/// recorded in [`ConvergeSummary::failed`], not fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
     let setup = setup(opts)?;
@@ -1053,6 +1053,8 @@ pub(crate) struct Setup {
 /// # Errors
 /// Bad input (exit 2) naming the flag.
 fn setup(opts: &ConvergeOptions) -> Result<Setup> {
+    opts.scene
+        .refuse_membrane("the convergence study (converge)")?;
     let run = select_run(&opts.scene, opts.run.as_deref())?;
     let mut scene = opts.scene.clone();
     let mut label = scene.runs[run].name.clone();
@@ -1128,7 +1130,7 @@ fn linear_study(
         let t0 = Instant::now();
         let refp = reference_point(s, lr, over, v, limit_dt.as_deref());
         let seed = derive_seed(s.seed, &seed_label(&spec.name, over, v));
-        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1());
+        let steps = lr.sampled_steps(ensemble.duration_tau1 * s.tau1());
         let outcome = source.linear(
             (scene, &spec.name, over, v),
             (&ensemble, lr),

@@ -301,6 +301,8 @@ pub struct StabilitySummary {
 
 /// Validates the options (exit code 2 on bad input, naming the flag).
 fn validate(opts: &StabilityOptions) -> Result<()> {
+    opts.scene
+        .refuse_membrane("the stability study (stability)")?;
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
             "--scene",
@@ -710,8 +712,9 @@ fn classify(cell: &mut Cell, biased: bool) {
 /// ([`super::output`]); a rerun removes the maps of integrators it left out.
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag), a projected work or memory above
-/// `opts.limits`; numerical or I/O failures.
+/// Bad options (exit 2, naming the flag), a membrane scene (exit 2,
+/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`;
+/// numerical or I/O failures.
 pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let start = Instant::now();
     let provenance = Provenance::begin(&[&opts.scene]);

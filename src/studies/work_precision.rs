@@ -254,6 +254,8 @@ pub struct WorkPrecisionSummary {
 }
 
 fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
+    opts.scene
+        .refuse_membrane("the work-precision study (work-precision)")?;
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
             "--scene",
@@ -368,8 +370,9 @@ type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 /// `work-precision.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag), a projected work or memory above
-/// `opts.limits`; run failures.
+/// Bad options (exit 2, naming the flag), a membrane scene (exit 2,
+/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`; run
+/// failures.
 pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
     let start = Instant::now();
     let provenance = Provenance::begin(&[&opts.scene]);
@@ -442,7 +445,7 @@ fn method_dts(
     Ok(if method.0 == IntegratorKind::EulerMaruyama {
         let s = point_scene(opts, method, 1.0);
         let beam = crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
-        let limit = beam.explicit_euler_dt_limit()? / s.filament.tau1();
+        let limit = beam.explicit_euler_dt_limit()? / s.tau1();
         opts.em_fractions.iter().map(|f| f * limit).collect()
     } else {
         opts.dt_tau1.clone()
@@ -461,7 +464,7 @@ fn run_point(opts: &WorkPrecisionOptions, (method, dt, s, lr): &PreparedPoint) -
         ),
     );
     let duration = s.runs[0].quick.duration_tau1;
-    let steps = lr.sampled_steps(duration * s.filament.tau1());
+    let steps = lr.sampled_steps(duration * s.tau1());
     let t0 = Instant::now();
     let records = lr.simulate_ensemble(seed, 0, opts.trajectories as u64, steps, |_| {})?;
     let wall = t0.elapsed().as_secs_f64();

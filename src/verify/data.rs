@@ -86,7 +86,7 @@ pub fn prepare_data_check(
     let rate1 = continuum.mode_rate(1);
     let profile_every = every(4.0 * rate1);
     let max_rate = modes.last().map_or(rate1, |m| m.rate_continuum);
-    let components = scene.dims - 1;
+    let components = scene.components();
     let reference = LinearReference {
         modes,
         profile_x: profile.0,
@@ -1124,6 +1124,28 @@ mod tests {
 
     /// Valid data are read; too few rows after the burn-in are still refused naming
     /// `runs[k].files`; a two-time point beyond the rows names the file.
+    /// A membrane scene is refused against any data before the data are read: its
+    /// message names the scene file, the key `membrane`, the scene and "not yet supported
+    /// for membranes" (the data directory here does not even exist).
+    #[test]
+    fn membrane_scene_against_data_is_refused() {
+        let dir = temp("membrane");
+        let missing = dir.join("no-data");
+        for name in ["membrane-hinged", "membrane-pbc"] {
+            let r = crate::verify::check_data(&scene(name), &missing, &dir.join("out"), 0.01, CAP);
+            refusal(
+                r,
+                &[
+                    &format!("tests/scenes/good/{name}.toml: key `membrane`"),
+                    "checking trajectory data (check) is not yet supported for membranes",
+                    &format!("scene \"{name}\""),
+                ],
+            );
+        }
+        assert!(!dir.join("out").exists(), "nothing written");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn linear_data_are_read_and_short_ones_refused() {
         let dir = temp("linear");

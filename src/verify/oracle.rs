@@ -329,7 +329,7 @@ fn compression_oracle_with(
     let mut o = Oracle::default();
     let p = scene.filament;
     let dims = Dims::from_u32(scene.dims as u32)?;
-    let d = (scene.dims - 1) as f64;
+    let d = scene.components() as f64;
     let ne = scene.mesh.elements;
     let h = p.length / ne as f64;
     let sigma2 = p.kt / p.bending_rigidity;

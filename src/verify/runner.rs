@@ -123,13 +123,15 @@ pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
 /// invalidated only once the input has passed every check.
 ///
 /// # Errors
-/// Input (exit 2): bad scene files, a projected work or memory above `opts.limits`, a
-/// time step above a stability limit, a budget that gives a check fewer samples than its
+/// Input (exit 2): bad scene files, a membrane scene (not yet simulated:
+/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`, a time
+/// step above a stability limit, a budget that gives a check fewer samples than its
 /// estimator needs ([`Error::Scene`]). Run failures (exit 3): diverging runs
 /// ([`Error::Diverged`]), estimator or set-up failures ([`Error::RunFailed`]), I/O
 /// failures.
 pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
     let scenes = &opts.scenes;
+    refuse_membranes(scenes)?;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     // The total work and memory, from the scene files alone, before anything is prepared.
     let mut work = projected_work(scenes, opts.budget);
@@ -171,6 +173,17 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         provenance: report.provenance_ref(),
     };
     Ok((summary, report))
+}
+
+/// Refuses, before anything is projected or prepared, a membrane scene among `scenes`:
+/// the runs of a scene are a filament's ([`Scene::refuse_membrane`]).
+///
+/// # Errors
+/// [`Error::Scene`] naming the first membrane scene (exit 2).
+pub(super) fn refuse_membranes(scenes: &[Scene]) -> Result<()> {
+    scenes
+        .iter()
+        .try_for_each(|s| s.refuse_membrane("simulation (verify)"))
 }
 
 /// Prepares every run of every scene and checks, before any long work, that the budget
@@ -259,7 +272,7 @@ fn prepare_error(scene: &Scene, k: usize, err: Error) -> Error {
 fn check_sample_counts(scene: &Scene, k: usize, run: &LinearRun, budget: Budget) -> Result<()> {
     let e = run.spec.ensemble(budget);
     let checks = run.spec.checks(scene);
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let dt_tau1 = run.reference.dt / tau1;
     let steps = run.sampled_steps(e.duration_tau1 * tau1);
     let key = |k2: &str| format!("runs[{k}].{}.{k2}", budget.name());
@@ -652,7 +665,7 @@ pub(super) fn simulate_compression(
     let (steps, plan) = match e.precision_target() {
         None => {
             let steps: Vec<u64> = (0..run.points())
-                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.filament.tau1()))
+                .map(|i| run.sampled_steps_at(i, e.duration_tau1 * scene.tau1()))
                 .collect();
             (steps, None)
         }
@@ -726,7 +739,7 @@ fn targeted_plan(
     budget: Budget,
     bar: &Progress,
 ) -> Result<TargetedPlan> {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let name = &run.spec.name;
     let tick = tick_work(scene, k, budget, run, e);
     let (search, adapted) = match target.step_search {
@@ -843,7 +856,7 @@ fn compression_run_note(
     est: &ForceEstimates,
     slope: Option<RmsSlope>,
 ) -> String {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let dts: Vec<f64> = (0..run.points()).map(|i| run.dt_at(i) / tau1).collect();
     let dt = if dts.iter().all(|&d| d == run.spec.dt_tau1) {
         format!("{:.3e} tau1", run.spec.dt_tau1)
@@ -1125,7 +1138,8 @@ fn apply_linear_checks(
 /// `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is read.
 ///
 /// # Errors
-/// Input (exit 2): a bad sidecar or trajectory file, data of the other kind than the
+/// Input (exit 2): a membrane scene (not yet supported: [`Scene::refuse_membrane`]), a
+/// bad sidecar or trajectory file, data of the other kind than the
 /// scene's or that cannot serve it, files larger than `max_bytes` together; run failures
 /// (exit 3): an estimator that finds no answer in the data.
 pub fn check_data(
@@ -1135,6 +1149,7 @@ pub fn check_data(
     alpha: f64,
     max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
+    scene.refuse_membrane("checking trajectory data (check)")?;
     let sidecar = crate::data::DataSidecar::load(data_dir)?;
     crate::verify::data::check_data_kind(scene, &sidecar, data_dir)?;
     crate::verify::data::require_data_size(&sidecar, data_dir, max_bytes)?;
@@ -1297,7 +1312,7 @@ pub(super) fn simulate_linear(
     shard: Shard,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let seed = derive_seed(scene.seed, &run.spec.name);
-    let steps = run.sampled_steps(e.duration_tau1 * scene.filament.tau1());
+    let steps = run.sampled_steps(e.duration_tau1 * scene.tau1());
     let full = e.trajectories as u64;
     // The work of one full trajectory and of one extra two-time trajectory (much
     // shorter), from the run's projection.
@@ -1665,7 +1680,7 @@ fn write_two_time(
 
 /// The two-time figure of [`write_two_time`] from the rows of `<run>-two-time.csv`.
 fn two_time_figure(scene: &Scene, units: AxisUnits, name: &str, rows: &[Vec<f64>]) -> Figure {
-    let tau1 = scene.filament.tau1();
+    let tau1 = scene.tau1();
     let length = scene.filament.length;
     let beam = HingedBeam::new(scene.filament).ok();
     let eta_max = 1.25 * rows.iter().map(|r| r[3]).fold(0.0, f64::max);

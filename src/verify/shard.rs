@@ -16,7 +16,7 @@
 
 use super::runner::{
     Prepared, TargetedPlan, VerifyOptions, begin_run, for_compression_runs, prepare_all,
-    projected_work, simulate_compression, simulate_linear,
+    projected_work, refuse_membranes, simulate_compression, simulate_linear,
 };
 use crate::error::{Error, Result};
 use crate::output::Provenance;
@@ -79,6 +79,7 @@ pub fn write_shard(
     plan_from: Option<&Path>,
 ) -> Result<ShardManifest> {
     let scenes = &opts.scenes;
+    refuse_membranes(scenes)?;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     let work = projected_work(scenes, opts.budget).scaled(shard.fraction());
     opts.limits.check(&work)?;
@@ -188,7 +189,7 @@ fn write_compression(
             let common = entry
                 .map(|f| &f.common)
                 .ok_or_else(|| refuse("no plan of this run".to_string()))?;
-            let tau1 = scene.filament.tau1();
+            let tau1 = scene.tau1();
             Some(decode_plan(common, target, run, tau1).map_err(refuse)?)
         }
         _ => None,
@@ -302,7 +303,7 @@ pub(super) fn merged_compression(
     let plan = match e.precision_target() {
         None => None,
         Some(target) => Some(
-            decode_plan(&files[0].file.common, target, run, scene.filament.tau1())
+            decode_plan(&files[0].file.common, target, run, scene.tau1())
                 .map_err(|m| incomplete(set, scene, name, m))?,
         ),
     };

@@ -339,7 +339,7 @@ fn prepare(
                 "a step below the stability limit of {} with {} elements ({:.4e} tau1), or a stable integrator such as metropolis-crank-nicolson",
                 spec.integrator,
                 s.mesh.elements,
-                limit / s.filament.tau1()
+                limit / s.tau1()
             ),
         ),
         other => other,
@@ -550,7 +550,7 @@ fn value_records(
     ensemble: Ensemble,
     source: &mut Source<'_>,
 ) -> Result<Outcome<Vec<Vec<ForceRecord>>>> {
-    let steps = vec![cr.sampled_steps(ensemble.duration_tau1 * s.filament.tau1()); cr.points()];
+    let steps = vec![cr.sampled_steps(ensemble.duration_tau1 * s.tau1()); cr.points()];
     let label = super::seed_label(run_name, over, v);
     source.force((scene, run_name, over, v), (&ensemble, cr), |range| {
         cr.simulate_share_per_point(
