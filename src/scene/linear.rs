@@ -23,6 +23,7 @@ use crate::fem::noise::NoiseModel;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
+use crate::spectral::membrane::Membrane;
 use crate::spectral::simulator::ModalSimulator;
 use crate::stats;
 use nalgebra::{DMatrix, DVector};
@@ -577,12 +578,22 @@ impl Setup<'_> {
     /// ([`DiscreteLaw`]: the same law whichever object assembled the system).
     fn fem(&self) -> Result<Prepared> {
         let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
-        let kt = p.kt;
-        let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
-        #[cfg(any(test, feature = "faults"))]
-        let beam = crate::fault::shared_model(self.scene.fault, beam)?;
-        let object = FemObject::Beam(Box::new(beam));
+        let object = match &self.continuum {
+            Continuum::Filament(_) => {
+                let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
+                #[cfg(any(test, feature = "faults"))]
+                let beam = crate::fault::shared_model(self.scene.fault, beam)?;
+                FemObject::Beam(Box::new(beam))
+            }
+            Continuum::Membrane { membrane, modes } => FemObject::plate(
+                membrane,
+                self.scene.mesh.elements,
+                self.scene.mesh.elements_along_y(),
+                modes.clone(),
+            )?,
+        };
         let system = object.system();
+        let kt = system.kt();
         // An explicit step above its limit fails at once (λ_max by an O(n)
         // inertia bisection), before the O(n³) eigen-decomposition.
         if spec.integrator.stability_limit(1.0).is_some() {
@@ -626,13 +637,20 @@ impl Setup<'_> {
         let two_time = self.fem_two_time(&law, &probe)?;
         let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
-        let scale = (2.0 / (p.drag * p.length)).sqrt();
-        let amplitude_scale = (1..=self.scene.sampling.modes)
-            .map(|n| {
-                let at = probe(p.length / (2.0 * n as f64))[n - 1];
-                if at < 0.0 { -scale } else { scale }
-            })
-            .collect();
+        // The trajectory data format's sine-basis amplitudes are the filament's; a
+        // membrane's modal amplitudes stay C-normalized (its data format is to come).
+        let amplitude_scale = match &object {
+            FemObject::Beam(_) => {
+                let scale = (2.0 / (p.drag * p.length)).sqrt();
+                (1..=self.scene.sampling.modes)
+                    .map(|n| {
+                        let at = probe(p.length / (2.0 * n as f64))[n - 1];
+                        if at < 0.0 { -scale } else { scale }
+                    })
+                    .collect()
+            }
+            FemObject::Plate { .. } => vec![1.0; self.scene.sampling.modes],
+        };
         Ok(Prepared {
             amplitude_scale,
             model: Model::Fem {
@@ -656,7 +674,7 @@ impl Setup<'_> {
         law: &DiscreteLaw,
         probe: &dyn Fn(f64) -> DVector<f64>,
     ) -> Result<Vec<TwoTimeReference>> {
-        let (length, dt, tau1) = (self.scene.filament.length, self.dt, self.tau1);
+        let (length, dt, tau1) = (self.continuum.line_length(), self.dt, self.tau1);
         let mut tt = Vec::new();
         for q in &self.scene.sampling.two_time {
             let (x, y) = (q[0] * length, q[1] * length);
@@ -688,9 +706,11 @@ impl LinearRun {
     /// [`Error::UnstableTimeStep`] for an explicit integrator above its limit; numerical
     /// failures of the reference computations.
     pub fn prepare(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
-        let p = scene.filament;
-        let continuum = Continuum::Filament(HingedBeam::new(p)?);
-        let tau1 = p.tau1();
+        let continuum = match scene.membrane {
+            Some(m) => Continuum::membrane(Membrane::new(m)?, scene.sampling.modes)?,
+            None => Continuum::Filament(HingedBeam::new(scene.filament)?),
+        };
+        let tau1 = scene.tau1();
         let dt = spec.dt_tau1 * tau1;
         let length = continuum.line_length();
         let profile_x: Vec<f64> = scene

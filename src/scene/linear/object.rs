@@ -29,7 +29,6 @@ pub(crate) enum Continuum {
     Filament(HingedBeam),
     /// The Helfrich membrane of (M1) on its midline, with its checked modes (slowest
     /// first, [`Membrane::modes`]).
-    #[allow(dead_code)] // built by the membrane scenes (issue #27), next to be wired
     Membrane {
         /// The membrane.
         membrane: Membrane,
@@ -43,7 +42,6 @@ impl Continuum {
     ///
     /// # Errors
     /// As [`Membrane::modes`].
-    #[allow(dead_code)] // called by the membrane scenes (issue #27), next to be wired
     pub(crate) fn membrane(membrane: Membrane, count: usize) -> Result<Self> {
         let modes = membrane.modes(count)?;
         Ok(Continuum::Membrane { membrane, modes })
@@ -133,7 +131,6 @@ impl FemObject {
     /// # Errors
     /// As [`PlateModel::new`] and [`PlateModes::new`]; [`crate::Error::InvalidParameter`]
     /// naming `sampling.modes` if a checked mode is not resolved by the mesh.
-    #[allow(dead_code)] // built by the membrane scenes (issue #27), next to be wired
     pub(crate) fn plate(
         membrane: &Membrane,
         nx: usize,
