@@ -23,7 +23,7 @@ use crate::fem::noise::NoiseModel;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
-use crate::spectral::membrane::Membrane;
+use crate::spectral::membrane::{Membrane, MembraneMode, MembraneSimulator};
 use crate::spectral::simulator::ModalSimulator;
 use crate::stats;
 use nalgebra::{DMatrix, DVector};
@@ -309,6 +309,36 @@ impl Observables for SpectralSampler {
     }
 }
 
+/// The membrane's exact modal simulator as a sampler: one component, the checked modes'
+/// amplitudes, the height on the midline y = b/2.
+struct MembraneSampler {
+    sim: MembraneSimulator,
+    checked: Vec<usize>,
+}
+
+impl Trajectory for MembraneSampler {
+    fn step(&mut self, rng: &mut TrajectoryRng) {
+        self.sim.step(rng);
+    }
+    fn is_finite(&self) -> bool {
+        self.sim.amplitudes().iter().all(|a| a.is_finite())
+    }
+}
+
+impl Observables for MembraneSampler {
+    fn modes(&self, out: &mut [f64]) {
+        for (o, &j) in out.iter_mut().zip(&self.checked) {
+            *o = self.sim.amplitudes()[j];
+        }
+    }
+    fn deflections(&self, xs: &[f64], out: &mut [f64]) {
+        let y = 0.5 * self.sim.membrane().params.height;
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o = self.sim.height(x, y);
+        }
+    }
+}
+
 /// The observer of [`LinearRun::trace`]: every sample, the checked modal amplitudes and
 /// the profile deflections (component-major).
 struct TraceObserver<'r> {
@@ -479,6 +509,12 @@ enum Model {
         beam: HingedBeam,
         n_modes: usize,
     },
+    /// The membrane's exact modal simulator ([`MembraneSimulator`], at rest), reporting
+    /// the amplitudes of its modes `checked` (indices into its mode list).
+    SpectralMembrane {
+        simulator: Box<MembraneSimulator>,
+        checked: Vec<usize>,
+    },
     /// No model: the references of another program's data ([`LinearRun::for_data`]).
     Data,
 }
@@ -512,12 +548,11 @@ impl Setup<'_> {
     /// The exact modal simulator of eq. (2): its references are the continuum's, the
     /// profile truncated to the simulated modes.
     fn spectral(&self) -> Result<Prepared> {
-        let Continuum::Filament(continuum) = &self.continuum else {
-            return Err(Error::invalid(
-                "model",
-                "spectral",
-                "fem for a membrane (its spectral reference scene is not wired yet)",
-            ));
+        let continuum = match &self.continuum {
+            Continuum::Filament(beam) => beam,
+            Continuum::Membrane { membrane, modes } => {
+                return self.spectral_membrane(membrane, modes);
+            }
         };
         let dt = self.dt;
         let n_modes = self.scene.mesh.elements;
@@ -570,6 +605,87 @@ impl Setup<'_> {
             profile_discrete,
             two_time: tt,
             max_rate: continuum.mode_rate(n_modes),
+        })
+    }
+
+    /// The membrane's exact modal simulator over the index rectangle `mesh.elements` ×
+    /// `mesh.elements_y`: its references are the continuum's per mode, and the exact sums
+    /// over its own modes for the profile and the two-time points.
+    fn spectral_membrane(
+        &self,
+        membrane: &Membrane,
+        checked_modes: &[MembraneMode],
+    ) -> Result<Prepared> {
+        let dt = self.dt;
+        let list = MembraneSimulator::index_rectangle(
+            membrane,
+            self.scene.mesh.elements,
+            self.scene.mesh.elements_along_y(),
+        )?;
+        let simulator = MembraneSimulator::new(*membrane, list, dt)?;
+        let mut checked = Vec::with_capacity(checked_modes.len());
+        let mut refs = Vec::with_capacity(checked_modes.len());
+        for (i, m) in checked_modes.iter().enumerate() {
+            let j = simulator.modes().iter().position(|s| s == m).ok_or_else(|| {
+                Error::invalid(
+                    "sampling.modes",
+                    checked_modes.len(),
+                    format!(
+                        "at most the modes the simulator carries (mode ({}, {}) is beyond mesh.elements x mesh.elements_y)",
+                        m.m, m.n
+                    ),
+                )
+            })?;
+            checked.push(j);
+            let (rate, var) = (membrane.mode_rate(*m), membrane.mode_variance(*m));
+            refs.push(ModeReference {
+                n: i + 1,
+                variance_discrete: var,
+                variance_equipartition: var,
+                variance_continuum: var,
+                multiplier: (-rate * dt).exp(),
+                rate_discrete: Some(rate),
+                rate_continuum: rate,
+            });
+        }
+        let y = 0.5 * membrane.params.height;
+        let profile_discrete = self
+            .profile_x
+            .iter()
+            .map(|&x| simulator.covariance((x, y), (x, y)))
+            .collect();
+        let length = membrane.params.width;
+        let mut two_time = Vec::new();
+        for q in &self.scene.sampling.two_time {
+            let (x, x2) = (q[0] * length, q[1] * length);
+            let (ts, es) = (self.steps(q[2] * self.tau1), self.steps(q[3] * self.tau1));
+            let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+            two_time.push(TwoTimeReference {
+                x,
+                y: x2,
+                t,
+                eta,
+                t_step: ts,
+                eta_step: es,
+                discrete: simulator.correlation_from_rest((x, y), (x2, y), t, eta)?,
+                continuum: self.continuum.correlation(x, x2, t, eta)?,
+            });
+        }
+        let max_rate = simulator
+            .modes()
+            .iter()
+            .map(|m| membrane.mode_rate(*m))
+            .fold(0.0, f64::max);
+        Ok(Prepared {
+            amplitude_scale: vec![1.0; checked.len()],
+            model: Model::SpectralMembrane {
+                simulator: Box::new(simulator),
+                checked,
+            },
+            modes: refs,
+            profile_discrete,
+            two_time,
+            max_rate,
         })
     }
 
@@ -779,7 +895,10 @@ impl LinearRun {
     /// with consistent noise (the paper's element-uniform noise is not proportional to
     /// the damping matrix, and its modes are driven by correlated noise).
     pub fn reversible(&self) -> bool {
-        matches!(self.model, Model::Spectral { .. }) || self.spec.noise == NoiseModel::Consistent
+        matches!(
+            self.model,
+            Model::Spectral { .. } | Model::SpectralMembrane { .. }
+        ) || self.spec.noise == NoiseModel::Consistent
     }
 
     /// Number of sampling steps for a sampled duration (physical time units).
@@ -818,7 +937,7 @@ impl LinearRun {
     fn n_nodes(&self) -> usize {
         match &self.model {
             Model::Fem { object, .. } => object.beam().map_or(0, |b| b.mesh().n_nodes()),
-            Model::Spectral { .. } | Model::Data => 0,
+            Model::Spectral { .. } | Model::SpectralMembrane { .. } | Model::Data => 0,
         }
     }
 
@@ -929,6 +1048,14 @@ impl LinearRun {
                     object,
                     projector,
                     filament: Components::at_rest(stepper, self.components, n),
+                })
+            }
+            Model::SpectralMembrane { simulator, checked } => {
+                let mut sim = (**simulator).clone();
+                sim.set_rest();
+                Box::new(MembraneSampler {
+                    sim,
+                    checked: checked.clone(),
                 })
             }
             Model::Spectral { beam, n_modes } => {

@@ -43,7 +43,7 @@ impl LinearRun {
         let length = scene.filament.length;
         let mut positions: Vec<f64> = match &self.model {
             Model::Fem { object, .. } => object.line_nodes(),
-            Model::Spectral { .. } | Model::Data => {
+            Model::Spectral { .. } | Model::SpectralMembrane { .. } | Model::Data => {
                 let n = scene.mesh.elements;
                 (0..=n).map(|k| length * k as f64 / n as f64).collect()
             }
