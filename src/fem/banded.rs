@@ -140,6 +140,18 @@ impl SymBanded {
         x.iter().zip(&y).map(|(a, b)| a * b).sum()
     }
 
+    /// The ∞-norm `max_i Σ_j |A_ij|` (largest absolute row sum).
+    pub fn inf_norm(&self) -> f64 {
+        let (n, bw) = (self.n, self.bw);
+        (0..n)
+            .map(|i| {
+                (i.saturating_sub(bw)..(i + bw + 1).min(n))
+                    .map(|j| self.get(i, j).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The dense symmetric matrix.
     pub fn to_dense(&self) -> DMatrix<f64> {
         let mut m = DMatrix::zeros(self.n, self.n);

@@ -3,10 +3,11 @@
 use super::banded::SymBanded;
 use super::hermite;
 use super::mesh::Mesh;
+use super::modal::symmetric_pencil;
 use super::system::{ElementLoad, LinearSystem};
 use crate::error::{Error, Result};
 use crate::params::FilamentParams;
-use nalgebra::{Cholesky, DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Half-bandwidth of the assembled free-DOF matrices (DOFs of one element span at most
 /// 4 consecutive free indices).
@@ -273,22 +274,7 @@ fn element_rate_factor() -> Result<f64> {
     let ce = hermite::damping_matrix(1.0, 1.0);
     let k = DMatrix::from_fn(4, 4, |i, j| ke[i][j]);
     let c = DMatrix::from_fn(4, 4, |i, j| ce[i][j]);
-    let ch = Cholesky::new(c).ok_or_else(|| Error::Numerical {
-        routine: "element_rate_factor".into(),
-        detail: "element damping matrix not positive definite".into(),
-    })?;
-    let l = ch.l();
-    let numerical = |what: &str| Error::Numerical {
-        routine: "element_rate_factor".into(),
-        detail: format!("triangular solve failed ({what})"),
-    };
-    let y = l
-        .solve_lower_triangular(&k)
-        .ok_or_else(|| numerical("L^-1 K"))?;
-    let a = l
-        .solve_lower_triangular(&y.transpose())
-        .ok_or_else(|| numerical("L^-1 K L^-T"))?;
-    let a = (&a + a.transpose()) * 0.5;
+    let (_, a) = symmetric_pencil(&k, c, "element_rate_factor")?;
     Ok(SymmetricEigen::new(a).eigenvalues.max())
 }
 

@@ -62,16 +62,7 @@ pub fn generalized_modes_signed(
     let k = system.stiffness().to_dense();
     let c = system.damping().to_dense();
     let n = k.nrows();
-    let l = Cholesky::new(c)
-        .ok_or_else(|| numerical("generalized_modes", "damping matrix not positive definite"))?
-        .l();
-    let y = l
-        .solve_lower_triangular(&k)
-        .ok_or_else(|| numerical("generalized_modes", "triangular solve L^-1 K failed"))?;
-    let a = l
-        .solve_lower_triangular(&y.transpose())
-        .ok_or_else(|| numerical("generalized_modes", "triangular solve L^-1 K L^-T failed"))?;
-    let a = (&a + a.transpose()) * 0.5;
+    let (l, a) = symmetric_pencil(&k, c, "generalized_modes")?;
     let eig = SymmetricEigen::try_new(a, f64::EPSILON, 1000 * n.max(10)).ok_or_else(|| {
         numerical(
             "generalized_modes",
@@ -101,6 +92,30 @@ pub fn generalized_modes_signed(
         rates,
         vectors: phi,
     })
+}
+
+/// The symmetric form of the pencil `K φ = λ C φ`: the Cholesky factor `L` of `C = LLᵀ`
+/// and `A = L⁻¹ K L⁻ᵀ` (symmetrized), whose eigenpairs `(λ, y)` are the generalized ones
+/// with `φ = L⁻ᵀ y` (`ΦᵀCΦ = I`). Dense; `routine` names the caller in errors.
+///
+/// # Errors
+/// [`Error::Numerical`] if `C` is not positive definite or a triangular solve fails.
+pub(crate) fn symmetric_pencil(
+    k: &DMatrix<f64>,
+    c: DMatrix<f64>,
+    routine: &str,
+) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
+    let l = Cholesky::new(c)
+        .ok_or_else(|| numerical(routine, "damping matrix not positive definite"))?
+        .l();
+    let y = l
+        .solve_lower_triangular(k)
+        .ok_or_else(|| numerical(routine, "triangular solve L^-1 K failed"))?;
+    let a = l
+        .solve_lower_triangular(&y.transpose())
+        .ok_or_else(|| numerical(routine, "triangular solve L^-1 K L^-T failed"))?;
+    let a = (&a + a.transpose()) * 0.5;
+    Ok((l, a))
 }
 
 /// The beam's sign rule for mode `i` with C-normalized vector `col` (see

@@ -71,18 +71,6 @@ fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// The ∞-norm (largest absolute row sum) of a symmetric banded matrix.
-fn inf_norm(m: &super::SymBanded) -> f64 {
-    let (n, bw) = (m.n(), m.bandwidth());
-    (0..n)
-        .map(|i| {
-            (i.saturating_sub(bw)..(i + bw + 1).min(n))
-                .map(|j| m.get(i, j).abs())
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Adds the nodal vector of `deflection·s_k + rotation·c_k` to `out` (free DOFs of `beam`,
 /// `ne` elements): `deflection·sin(kπj/N)` to the deflection and `rotation·cos(kπj/N)` to
 /// the rotation of every node j that has them.
@@ -246,7 +234,7 @@ impl PairedModes {
             return false;
         }
         let (km, cm, gm) = (beam.stiffness(), beam.damping(), beam.geometric());
-        let (kn, cn, gn) = (inf_norm(km), inf_norm(cm), inf_norm(gm));
+        let (kn, cn, gn) = (km.inf_norm(), cm.inf_norm(), gm.inf_norm());
         let (mut kphi, mut cphi, mut gphi) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let mut cphi_other = vec![0.0; n];
         let blocks = self

@@ -97,10 +97,11 @@
 use super::banded::SymBanded;
 use super::beam::UNIFORM_RATE_FACTOR;
 use super::hermite::{self, ElementMatrix};
+use super::modal::symmetric_pencil;
 use super::system::{ElementLoad, LinearSystem};
 use crate::error::{Error, Result};
 use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
-use nalgebra::{Cholesky, DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Largest number of free DOFs [`PlateModel::new`] accepts.
 pub const MAX_PLATE_DOFS: usize = 4_000_000;
@@ -690,16 +691,7 @@ fn element_rate_bound(params: &MembraneParams, hx: f64, hy: f64) -> Result<f64> 
         routine: "plate element_rate_bound".into(),
         detail: what.into(),
     };
-    let l = Cholesky::new(c)
-        .ok_or_else(|| numerical("element damping matrix not positive definite"))?
-        .l();
-    let y = l
-        .solve_lower_triangular(&k)
-        .ok_or_else(|| numerical("triangular solve L^-1 K failed"))?;
-    let a = l
-        .solve_lower_triangular(&y.transpose())
-        .ok_or_else(|| numerical("triangular solve L^-1 K L^-T failed"))?;
-    let a = (&a + a.transpose()) * 0.5;
+    let (_, a) = symmetric_pencil(&k, c, "plate element_rate_bound")?;
     let top = SymmetricEigen::new(a).eigenvalues.max();
     if top.is_finite() && top > 0.0 {
         Ok(top)

@@ -80,14 +80,13 @@
 //! refuses the form. The integration tests compare the rates with the dense generalized
 //! eigenvalues of the assembled banded `K` and `C`.
 
-use super::banded::SymBanded;
 use super::hermite::{GAUSS5, shape};
-use super::modal::GeneralizedModes;
+use super::modal::{GeneralizedModes, symmetric_pencil};
 use super::plate::{Axis, AxisMatrices, PlateModel, stiffness_entry};
 use crate::error::{Error, Result};
 use crate::spectral::membrane::{MembraneMode, MembraneParams, ModeShape};
 use crate::spectral::sin_pi;
-use nalgebra::{Cholesky, DMatrix, DVector, SymmetricEigen};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::collections::BTreeMap;
 use std::f64::consts::FRAC_1_SQRT_2;
 
@@ -352,16 +351,8 @@ fn numerical(detail: impl Into<String>) -> Error {
 /// The pencil `K y = λ C y` of size ≤ 4: `(λ, y)` ascending, `yᵀCy = 1`.
 fn solve_small(k: DMatrix<f64>, c: DMatrix<f64>) -> Result<Vec<(f64, [f64; 4])>> {
     let d = k.nrows();
-    let l = Cholesky::new(c)
-        .ok_or_else(|| numerical("block damping matrix not positive definite"))?
-        .l();
-    let y = l
-        .solve_lower_triangular(&k)
-        .ok_or_else(|| numerical("block solve L^-1 K failed"))?;
-    let a = l
-        .solve_lower_triangular(&y.transpose())
-        .ok_or_else(|| numerical("block solve L^-1 K L^-T failed"))?;
-    let eig = SymmetricEigen::new((&a + a.transpose()) * 0.5);
+    let (l, a) = symmetric_pencil(&k, c, "PlateModes block")?;
+    let eig = SymmetricEigen::new(a);
     let phi = l
         .tr_solve_lower_triangular(&eig.eigenvectors)
         .ok_or_else(|| numerical("block solve L^-T Y failed"))?;
@@ -393,18 +384,6 @@ fn transposed(solutions: &[(f64, [f64; 4])], sq: usize, sp: usize) -> Vec<(f64, 
             (*rate, t)
         })
         .collect()
-}
-
-/// The ∞-norm (largest absolute row sum) of a symmetric banded matrix.
-fn inf_norm(m: &SymBanded) -> f64 {
-    let (n, bw) = (m.n(), m.bandwidth());
-    (0..n)
-        .map(|i| {
-            (i.saturating_sub(bw)..(i + bw + 1).min(n))
-                .map(|j| m.get(i, j).abs())
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max)
 }
 
 impl PlateModes {
@@ -593,7 +572,7 @@ impl PlateModes {
     /// Checks every block solution's backward error (module docs); the waves of the
     /// shorter axis are tabulated once, those of the longer one once per wave.
     fn verify(&self, model: &PlateModel, blocks: &[Block]) -> Result<()> {
-        let (kn, cn) = (inf_norm(model.stiffness()), inf_norm(model.damping()));
+        let (kn, cn) = (model.stiffness().inf_norm(), model.damping().inf_norm());
         let mats = model.axis_matrices();
         let long = usize::from(self.axes[1].n_free() > self.axes[0].n_free());
         let short = 1 - long;
