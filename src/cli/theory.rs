@@ -255,12 +255,10 @@ fn membrane_fem(
     // continuum's convention.
     let variance = mb.mode_variance(mode) * exact / rate;
     let gm = modes.generalized_modes()?;
-    let index = (0..gm.len())
-        .find(|&i| gm.rates[i] == rate)
-        .ok_or_else(|| Error::Numerical {
-            routine: "theory membrane".into(),
-            detail: "the mode's column is missing from the dense modes".into(),
-        })?;
+    let index = modes.dense_column(mode).ok_or_else(|| Error::Numerical {
+        routine: "theory membrane".into(),
+        detail: "the mode's column is missing from the dense modes".into(),
+    })?;
     let ratios = element_uniform_ratios(&plate, &gm, gm.len())?;
     let mut out = json!({
         "elements": [nx, ny],

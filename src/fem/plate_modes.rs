@@ -846,6 +846,15 @@ impl PlateModes {
         self.modes.iter().find(|m| m.continuum == Some(mode))
     }
 
+    /// The column of the acoustic mode of `mode` in [`Self::generalized_modes`] (its index
+    /// among the modes, less one past the periodic zero mode, which the dense modes leave
+    /// out), if the mesh resolves it. By label, so that equal rates (a square's (1, 2) and
+    /// (2, 1)) are told apart.
+    pub fn dense_column(&self, mode: MembraneMode) -> Option<usize> {
+        let i = self.modes.iter().position(|m| m.continuum == Some(mode))?;
+        Some(i - usize::from(self.zero_mode().is_some_and(|z| z < i)))
+    }
+
     /// Index of the periodic zero mode (label `(0, 0, Cosine, 0)`, rate 0); `None`
     /// simply supported.
     pub fn zero_mode(&self) -> Option<usize> {

@@ -113,6 +113,9 @@ pub(crate) enum FemObject {
         modes: Box<PlateModes>,
         /// The checked continuum modes, slowest first.
         checked: Vec<MembraneMode>,
+        /// Periodic: `b/(ab)` (`b = ∫N`, the assembled loads), so that the spatial mean
+        /// height of a state `x` is `meanᵀx`; `None` simply supported.
+        mean: Option<Vec<f64>>,
     },
 }
 
@@ -149,10 +152,17 @@ impl FemObject {
                 ),
             ));
         }
+        let area = membrane.params.area();
+        let mean = plate.zero_mode().map(|_| {
+            let mut b = plate.assembled_load_vector();
+            b.iter_mut().for_each(|v| *v /= area);
+            b
+        });
         Ok(FemObject::Plate {
             plate: Box::new(plate),
             modes: Box::new(modes),
             checked,
+            mean,
         })
     }
 
@@ -181,21 +191,15 @@ impl FemObject {
                 // The checked modes' acoustic columns first, in the continuum's order,
                 // then every other column in rate order (the periodic zero mode is not
                 // among them: PlateModes::generalized_modes leaves it out).
-                // Column of a plate mode: its index among the modes, less one past the
-                // periodic zero mode (left out of the dense modes). By label, so that a
-                // square's equal-rate (1, 2) and (2, 1) are told apart.
-                let zero = modes.zero_mode();
                 let mut order: Vec<usize> = Vec::with_capacity(all.len());
                 for m in checked {
-                    let i = modes
-                        .modes()
-                        .iter()
-                        .position(|p| p.continuum == Some(*m))
+                    let j = modes
+                        .dense_column(*m)
                         .ok_or_else(|| crate::Error::Numerical {
                             routine: "FemObject::modes".into(),
                             detail: format!("mode ({}, {}) is not resolved", m.m, m.n),
                         })?;
-                    order.push(i - usize::from(zero.is_some_and(|z| z < i)));
+                    order.push(j);
                 }
                 let rest: Vec<usize> = (0..all.len()).filter(|j| !order.contains(j)).collect();
                 order.extend(rest);
@@ -213,13 +217,12 @@ impl FemObject {
     pub(crate) fn value_at(&self, state: &[f64], x: f64) -> f64 {
         match self {
             FemObject::Beam(b) => b.deflection_at(state, x),
-            FemObject::Plate { plate, .. } => {
+            FemObject::Plate { plate, mean, .. } => {
                 let h = plate.height_at(state, x, 0.5 * plate.params().height);
-                match plate.zero_mode() {
-                    // Periodic: the height relative to the spatial mean (the q = 0 mode,
-                    // a free translation, is excluded as in the continuum): the mean is
-                    // bᵀx/A with b the assembled load vector.
-                    Some(_) => h - mean_height(plate, state),
+                // Periodic: the height relative to the spatial mean (the q = 0 mode, a
+                // free translation, is excluded as in the continuum).
+                match mean {
+                    Some(m) => h - m.iter().zip(state).map(|(a, b)| a * b).sum::<f64>(),
                     None => h,
                 }
             }
@@ -246,20 +249,6 @@ impl FemObject {
             FemObject::Plate { .. } => None,
         }
     }
-}
-
-/// The spatial mean height `bᵀx/(ab)` of a plate state (`b = ∫N`, the assembled loads).
-fn mean_height(plate: &PlateModel, state: &[f64]) -> f64 {
-    let area = plate.params().width * plate.params().height;
-    let mut sum = 0.0;
-    for l in plate.element_loads() {
-        for (v, d) in l.load.iter().zip(&l.dofs) {
-            if let Some(i) = d {
-                sum += v * state[*i];
-            }
-        }
-    }
-    sum / area
 }
 
 #[cfg(test)]
