@@ -34,11 +34,13 @@ use crate::dynamics::{Integrator, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::banded::{BandedCholesky, SymBanded};
 use crate::fem::beam::BeamModel;
-use crate::fem::modal::{GeneralizedModes, generalized_modes};
+use crate::fem::modal::{GeneralizedModes, generalized_modes_signed};
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::fem::system::LinearSystem;
 use crate::rng::TrajectoryRng;
 use crate::scene::{ModelKind, Scene};
 use crate::spectral::HingedBeam;
+use crate::spectral::membrane::{Membrane, MembraneParams};
 use nalgebra::{DMatrix, DVector};
 
 /// The catalogue of injected simulator bugs. Each entry states the bug it models, where
@@ -219,9 +221,22 @@ impl FaultKind {
             .collect()
     }
 
-    /// Whether the fault has a hook in a scene of model `model` with `dims` dimensions (a
-    /// scene without one runs unchanged).
-    pub fn applies_to(self, model: ModelKind, dims: usize) -> bool {
+    /// Whether the fault has a hook in a scene of model `model` with `dims` dimensions, a
+    /// membrane's if `membrane` (a scene without one runs unchanged). On a membrane the
+    /// noise, stiffness (κ) and drag faults act as on the filament (finite elements: on
+    /// the plate's integrator; spectral: on the modal simulator's kT, κ, ξ), the shared
+    /// stiffness fault scales κ of the plate the integrator and the references are built
+    /// from; the hinge and component faults have nothing to act on.
+    pub fn applies_to(self, model: ModelKind, dims: usize, membrane: bool) -> bool {
+        if membrane {
+            // A membrane has one height field (no second component) and no hinge.
+            return !matches!(
+                self,
+                FaultKind::IntegratorHinge
+                    | FaultKind::SharedHinge
+                    | FaultKind::ComponentNoiseSharing
+            ) && self.applies_to(model, dims, false);
+        }
         match self {
             FaultKind::NoiseVariance | FaultKind::IntegratorStiffness => true,
             FaultKind::IntegratorDrag => matches!(model, ModelKind::Fem | ModelKind::Spectral),
@@ -371,7 +386,10 @@ pub(crate) struct IntegratorParts<'a> {
     /// The integrator kind.
     pub kind: IntegratorKind,
     /// The model of the references (the integrator's too, without a fault).
-    pub beam: &'a BeamModel,
+    pub system: &'a LinearSystem,
+    /// The beam that assembled `system`, if the object is a filament (the hinge faults
+    /// rebuild it; they leave a plate unchanged).
+    pub beam: Option<&'a BeamModel>,
     /// The noise model.
     pub noise: NoiseModel,
     /// The time step.
@@ -394,28 +412,27 @@ pub(crate) fn linear_integrator(
         return Ok(default);
     };
     let s = fault.size;
-    let beam = parts.beam;
+    let system = parts.system;
+    let scaled = |k: f64, c: f64| -> Result<LinearSystem> {
+        let mut d = system.clone();
+        d.scale_matrices(k, c)?;
+        Ok(d)
+    };
     // The drift's model and the noise's model.
-    let (drift, noise_beam) = match fault.kind {
-        FaultKind::IntegratorStiffness => (
-            beam.clone().with_scaled_matrices(1.0 + s, 1.0, 1.0)?,
-            beam.clone(),
-        ),
-        FaultKind::IntegratorDrag => (
-            beam.clone().with_scaled_matrices(1.0, 1.0 + s, 1.0)?,
-            beam.clone(),
-        ),
-        FaultKind::IntegratorHinge if s != 0.0 => {
+    let (drift, noise_system) = match (fault.kind, parts.beam) {
+        (FaultKind::IntegratorStiffness, _) => (scaled(1.0 + s, 1.0)?, system.clone()),
+        (FaultKind::IntegratorDrag, _) => (scaled(1.0, 1.0 + s)?, system.clone()),
+        (FaultKind::IntegratorHinge, Some(beam)) if s != 0.0 => {
             let hinge = rotation_hinged(beam)?;
-            (hinge.clone(), hinge)
+            (LinearSystem::clone(&hinge), LinearSystem::clone(&hinge))
         }
-        _ => (beam.clone(), beam.clone()),
+        _ => (system.clone(), system.clone()),
     };
     let filter = NoiseFilter::new(fault, drift.n_dofs(), parts.components);
-    let noise = NoiseGenerator::new(parts.noise, &noise_beam)?;
+    let noise = NoiseGenerator::new(parts.noise, &noise_system)?;
     let variance = size_of(Some(fault), FaultKind::NoiseVariance).map_or(1.0, |s| 1.0 + s);
     let time = size_of(Some(fault), FaultKind::NoiseTimeScaling).map_or(1.0, |s| 1.0 + s);
-    let kt = beam.params().kt;
+    let kt = system.kt();
     Ok(match parts.kind.theta() {
         Some(theta) => Box::new(FaultyTheta::new(
             &drift,
@@ -426,7 +443,8 @@ pub(crate) fn linear_integrator(
             filter,
         )?),
         None => {
-            let modes = generalized_modes(&drift)?;
+            // The update Φ diag(m) ΦᵀC is the same whatever the modes' signs.
+            let modes = generalized_modes_signed(&drift, |_, _| false)?;
             Box::new(FaultyExactModal::new(
                 &drift,
                 &modes,
@@ -454,6 +472,35 @@ pub(crate) fn spectral_simulator(fault: Option<Fault>, beam: HingedBeam) -> Resu
         _ => return Ok(beam),
     }
     HingedBeam::new(p)
+}
+
+/// Hook of the membrane's spectral scenes: the membrane its modal simulator is built from
+/// (kT, κ or ξ × (1 + s)); `membrane` unchanged for other faults.
+///
+/// # Errors
+/// Invalid faulty parameters.
+pub(crate) fn spectral_membrane(fault: Option<Fault>, membrane: Membrane) -> Result<Membrane> {
+    let mut p = membrane.params;
+    match fault.map(|f| (f.kind, 1.0 + f.size)) {
+        Some((FaultKind::NoiseVariance, f)) => p.kt *= f,
+        Some((FaultKind::IntegratorStiffness, f)) => p.bending_rigidity *= f,
+        Some((FaultKind::IntegratorDrag, f)) => p.drag *= f,
+        _ => return Ok(membrane),
+    }
+    Membrane::new(p)
+}
+
+/// Hook of the membrane's finite-element scenes: the membrane whose plate the integrator
+/// and the exact discrete references are built from ([`FaultKind::SharedStiffness`]: κ ×
+/// (1 + s)); `params` unchanged otherwise.
+pub(crate) fn shared_membrane(fault: Option<Fault>, params: MembraneParams) -> MembraneParams {
+    match size_of(fault, FaultKind::SharedStiffness) {
+        Some(s) => MembraneParams {
+            bending_rigidity: params.bending_rigidity * (1.0 + s),
+            ..params
+        },
+        None => params,
+    }
 }
 
 /// Hook of the compression scenes: the beam of the chain's model (the filaments at every
@@ -561,7 +608,7 @@ pub struct FaultyTheta {
 
 impl FaultyTheta {
     fn new(
-        drift: &BeamModel,
+        drift: &LinearSystem,
         noise: NoiseGenerator,
         theta: f64,
         dt: f64,
@@ -571,7 +618,7 @@ impl FaultyTheta {
         let (k, c) = (drift.stiffness(), drift.damping());
         let n = drift.n_dofs();
         // As ThetaOperators: sqrt(2kT·dt), the faults' factors applied to dt and after.
-        let base = (2.0 * drift.params().kt * (dt * factors.time)).sqrt();
+        let base = (2.0 * drift.kt() * (dt * factors.time)).sqrt();
         Ok(FaultyTheta {
             lhs: SymBanded::linear_combination(1.0, c, theta * dt, k)?.cholesky()?,
             rhs: SymBanded::linear_combination(1.0, c, -(1.0 - theta) * dt, k)?,
@@ -619,7 +666,7 @@ pub struct FaultyExactModal {
 
 impl FaultyExactModal {
     fn new(
-        drift: &BeamModel,
+        drift: &LinearSystem,
         modes: &GeneralizedModes,
         noise: NoiseGenerator,
         dt: f64,
@@ -680,6 +727,7 @@ mod tests {
     use crate::FilamentParams;
     use crate::dynamics::{ExactModal, ThetaScheme, build_integrator};
     use crate::fem::Mesh;
+    use crate::fem::modal::generalized_modes;
     use crate::rng::trajectory_rng;
     use crate::scene::builtin;
     use crate::scene::linear::LinearRun;
@@ -707,7 +755,8 @@ mod tests {
     ) -> IntegratorParts<'_> {
         IntegratorParts {
             kind,
-            beam,
+            system: beam,
+            beam: Some(beam),
             noise: NoiseModel::Consistent,
             dt,
             components,

@@ -65,13 +65,19 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
             t("spectral-reference", ALL),
             t("compression-2d", ALL),
             t("compression-3d", ALL),
+            t("membrane-hinged", CN),
+            t("membrane-periodic", CN),
+            t("membrane-spectral", ALL),
         ],
         FaultKind::NoiseTimeScaling => vec![t("hinged-linear-3d", &["exact-modal"])],
-        FaultKind::IntegratorDrag
-        | FaultKind::CorrelatedNoise
+        FaultKind::IntegratorDrag | FaultKind::SharedStiffness => vec![
+            t("hinged-linear-3d", CN),
+            t("membrane-hinged", CN),
+            t("membrane-periodic", CN),
+        ],
+        FaultKind::CorrelatedNoise
         | FaultKind::IntegratorHinge
         | FaultKind::ComponentNoiseSharing
-        | FaultKind::SharedStiffness
         | FaultKind::SharedHinge => vec![t("hinged-linear-3d", CN)],
         FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
             vec![t("compression-2d", ALL)]
@@ -586,7 +592,7 @@ mod tests {
             for t in targets(kind) {
                 let scene = faulty_scene(&t, Fault::stated(kind), 1).unwrap();
                 assert!(
-                    kind.applies_to(scene.model, scene.dims),
+                    kind.applies_to(scene.model, scene.dims, scene.is_membrane()),
                     "{kind} in {}",
                     t.scene
                 );

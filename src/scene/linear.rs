@@ -13,7 +13,7 @@
 use crate::dynamics::discrete::DiscreteLaw;
 use crate::dynamics::{
     BatchTrajectory, ComponentBatch, Components, Driver, Integrator, IntegratorKind, LaneOf,
-    Observer, ThetaBatch, Trajectory, build_integrator, par_indexed,
+    ModalStep, Observer, ThetaBatch, Trajectory, build_integrator, par_indexed,
 };
 use crate::error::{Error, Result};
 use crate::fem::banded::LANES;
@@ -56,6 +56,9 @@ pub struct ModeReference {
     pub rate_discrete: Option<f64>,
     /// The continuum relaxation rate λ_n = π⁴n⁴EI/(ξL⁴).
     pub rate_continuum: f64,
+    /// The membrane's mode this is (its lattice indices and shape); `None` for a
+    /// filament's mode n.
+    pub label: Option<MembraneMode>,
 }
 
 /// Exact references for the two-time correlation at one point.
@@ -270,6 +273,42 @@ impl Observables for FemSampler<'_> {
         if let Some(beam) = self.object.beam() {
             for s in &self.filament.states {
                 add_slope_squares(beam, s, acc);
+            }
+        }
+    }
+}
+
+/// A finite-element object stepped in its generalized modes ([`ModalPath`]): the state
+/// of each component is the vector of modal amplitudes, the checked modes first.
+struct ModalSampler<'a> {
+    path: &'a ModalPath,
+    n_modes: usize,
+    filament: Components<ModalStep>,
+}
+
+impl Trajectory for ModalSampler<'_> {
+    fn step(&mut self, rng: &mut TrajectoryRng) {
+        self.filament.step(rng);
+    }
+    fn is_finite(&self) -> bool {
+        self.filament.is_finite()
+    }
+}
+
+impl Observables for ModalSampler<'_> {
+    fn modes(&self, out: &mut [f64]) {
+        let m = self.n_modes;
+        for (c, s) in self.filament.states.iter().enumerate() {
+            out[c * m..(c + 1) * m].copy_from_slice(&s[..m]);
+        }
+    }
+    fn deflections(&self, xs: &[f64], out: &mut [f64]) {
+        for (c, s) in self.filament.states.iter().enumerate() {
+            for (j, &x) in xs.iter().enumerate() {
+                out[c * xs.len() + j] = self
+                    .path
+                    .probe(x)
+                    .map_or(f64::NAN, |p| p.iter().zip(s).map(|(a, q)| a * q).sum());
             }
         }
     }
@@ -504,6 +543,9 @@ enum Model {
         projector: DMatrix<f64>,
         noise: NoiseModel,
         integrator: IntegratorKind,
+        /// The O(n) path in modal coordinates, where the object's modes come without a
+        /// dense transform and the noise is consistent (the plate).
+        modal: Option<ModalPath>,
     },
     Spectral {
         beam: HingedBeam,
@@ -517,6 +559,22 @@ enum Model {
     },
     /// No model: the references of another program's data ([`LinearRun::for_data`]).
     Data,
+}
+
+/// The O(n) path of a run ([`ModalStep`]: the integrator in the generalized modes with
+/// consistent noise): the rates of every mode (the checked ones first) and, at every
+/// position an observer reads, the modal image of the probe, so that the field there is
+/// `probeᵀq`.
+struct ModalPath {
+    rates: Vec<f64>,
+    probes: Vec<(f64, DVector<f64>)>,
+}
+
+impl ModalPath {
+    /// The modal probe at position `x` (one of the prepared positions).
+    fn probe(&self, x: f64) -> Option<&DVector<f64>> {
+        self.probes.iter().find(|(p, _)| *p == x).map(|(_, v)| v)
+    }
 }
 
 /// What the preparation of a model yields besides the sampling plan.
@@ -568,6 +626,7 @@ impl Setup<'_> {
                 multiplier: (-rate * dt).exp(),
                 rate_discrete: Some(rate),
                 rate_continuum: rate,
+                label: None,
             });
         }
         // The simulator carries n_modes modes: its exact profile is the truncated sum.
@@ -646,6 +705,7 @@ impl Setup<'_> {
                 multiplier: (-rate * dt).exp(),
                 rate_discrete: Some(rate),
                 rate_continuum: rate,
+                label: Some(*m),
             });
         }
         let y = 0.5 * membrane.params.height;
@@ -702,6 +762,12 @@ impl Setup<'_> {
                 FemObject::Beam(Box::new(beam))
             }
             Continuum::Membrane { membrane, modes } => FemObject::plate(
+                #[cfg(any(test, feature = "faults"))]
+                &Membrane::new(crate::fault::shared_membrane(
+                    self.scene.fault,
+                    membrane.params,
+                ))?,
+                #[cfg(not(any(test, feature = "faults")))]
                 membrane,
                 self.scene.mesh.elements,
                 self.scene.mesh.elements_along_y(),
@@ -738,6 +804,7 @@ impl Setup<'_> {
                 multiplier: law.multipliers[i],
                 rate_discrete: law.decay_rate(i),
                 rate_continuum: self.continuum.mode_rate(n),
+                label: self.continuum.mode_label(n),
             });
         }
         // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
@@ -751,6 +818,20 @@ impl Setup<'_> {
             })
             .collect();
         let two_time = self.fem_two_time(&law, &probe)?;
+        // The plate's modes are separable: with consistent noise its runs step in modal
+        // coordinates, O(n) per step (the banded nodal path stays the general one and,
+        // for the element-uniform load, the path).
+        let modal = (matches!(object, FemObject::Plate { .. })
+            && spec.noise == NoiseModel::Consistent)
+            .then(|| {
+                let mut xs = self.profile_x.clone();
+                xs.extend(two_time.iter().flat_map(|q| [q.x, q.y]));
+                xs.dedup();
+                ModalPath {
+                    rates: gm.rates.iter().copied().collect(),
+                    probes: xs.into_iter().map(|x| (x, probe(x))).collect(),
+                }
+            });
         let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
         // The trajectory data format's sine-basis amplitudes are the filament's; a
@@ -775,6 +856,7 @@ impl Setup<'_> {
                 projector,
                 noise: spec.noise,
                 integrator: spec.integrator,
+                modal,
             },
             modes: refs,
             profile_discrete,
@@ -870,7 +952,7 @@ impl LinearRun {
         let burn_in_steps = setup.steps(scene.sampling.burn_in_tau1 * tau1);
         Ok(LinearRun {
             spec: spec.clone(),
-            components: scene.dims - 1,
+            components: scene.components(),
             reference: LinearReference {
                 modes,
                 profile_x: setup.profile_x,
@@ -1010,7 +1092,39 @@ impl LinearRun {
         largest_rms_slope(beam, &sums, n)
     }
 
+    /// The O(n) modal path of this run, if it has one and no injected fault replaces its
+    /// integrator (a faulty integrator steps the nodal state).
+    fn modal_path(&self) -> Option<&ModalPath> {
+        let Model::Fem { modal, .. } = &self.model else {
+            return None;
+        };
+        #[cfg(any(test, feature = "faults"))]
+        if crate::fault::replaces_integrator(self.fault) {
+            return None;
+        }
+        modal.as_ref()
+    }
+
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {
+        if let (
+            Some(path),
+            Model::Fem {
+                object, integrator, ..
+            },
+        ) = (self.modal_path(), &self.model)
+        {
+            let stepper = ModalStep::new(
+                *integrator,
+                &path.rates,
+                self.reference.dt,
+                object.system().kt(),
+            )?;
+            return Ok(Box::new(ModalSampler {
+                path,
+                n_modes: self.reference.modes.len(),
+                filament: Components::at_rest(stepper, self.components, path.rates.len()),
+            }));
+        }
         Ok(match &self.model {
             Model::Fem {
                 object,
@@ -1018,6 +1132,7 @@ impl LinearRun {
                 projector,
                 noise,
                 integrator,
+                ..
             } => {
                 let stepper = build_integrator(
                     *integrator,
@@ -1027,22 +1142,19 @@ impl LinearRun {
                     self.reference.max_rate,
                     modes.as_ref(),
                 )?;
-                // The fault catalogue's integrator faults are the beam's.
                 #[cfg(any(test, feature = "faults"))]
-                let stepper = match object.beam() {
-                    Some(beam) => crate::fault::linear_integrator(
-                        self.fault,
-                        stepper,
-                        crate::fault::IntegratorParts {
-                            kind: *integrator,
-                            beam,
-                            noise: *noise,
-                            dt: self.reference.dt,
-                            components: self.components,
-                        },
-                    )?,
-                    None => stepper,
-                };
+                let stepper = crate::fault::linear_integrator(
+                    self.fault,
+                    stepper,
+                    crate::fault::IntegratorParts {
+                        kind: *integrator,
+                        system: object.system(),
+                        beam: object.beam(),
+                        noise: *noise,
+                        dt: self.reference.dt,
+                        components: self.components,
+                    },
+                )?;
                 let n = object.system().n_dofs();
                 Box::new(FemSampler {
                     object,
@@ -1051,6 +1163,15 @@ impl LinearRun {
                 })
             }
             Model::SpectralMembrane { simulator, checked } => {
+                #[cfg(any(test, feature = "faults"))]
+                let faulty = crate::fault::spectral_membrane(self.fault, *simulator.membrane())?;
+                #[cfg(any(test, feature = "faults"))]
+                let mut sim = if faulty == *simulator.membrane() {
+                    (**simulator).clone()
+                } else {
+                    MembraneSimulator::new(faulty, simulator.modes().to_vec(), self.reference.dt)?
+                };
+                #[cfg(not(any(test, feature = "faults")))]
                 let mut sim = (**simulator).clone();
                 sim.set_rest();
                 Box::new(MembraneSampler {
@@ -1242,6 +1363,9 @@ impl LinearRun {
         else {
             return Ok(None);
         };
+        if self.modal_path().is_some() {
+            return Ok(None);
+        }
         // A fault that replaces the integrator steps one trajectory at a time.
         #[cfg(any(test, feature = "faults"))]
         if crate::fault::replaces_integrator(self.fault) {

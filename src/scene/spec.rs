@@ -291,6 +291,15 @@ pub enum CheckKind {
     Spectrum,
     /// Two-time correlation eq. (4) from w(x, 0) = 0 at `two_time` points.
     TwoTime,
+    /// The stationary variances of all checked modes pooled: per independent series the
+    /// weighted mean of (time average of q²)/(exact discrete variance) over the modes,
+    /// t-tested against 1 over the series. Sensitive to a global error (a temperature,
+    /// a drag, a stiffness) that each mode alone is too noisy to see.
+    PooledVariance,
+    /// A membrane on a square patch (a = b, as many elements along x as along y): the
+    /// variances of the modes (m, n) and (n, m) are equal; per independent series the
+    /// pooled difference of their normalized time averages, t-tested against 0.
+    XySymmetry,
     /// Compression: ⟨F⟩ at every strain against the exact discrete equilibrium theory
     /// (per-point z-tests and a χ² over all points).
     ForceStrain,

@@ -96,7 +96,7 @@ impl Display for Num {
 }
 
 /// The allowed checks of a linear scene, for messages.
-const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time) for model \"fem\" or \"spectral\"";
+const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance; xy-symmetry for a membrane) for model \"fem\" or \"spectral\"";
 /// The allowed positions x/L of the profile and two-time checks, for messages: the
 /// hinges x/L = 0 and 1 have w = 0 exactly, so nothing fluctuates there to check.
 const INTERIOR: &str = "in (0, 1) (inside the filament: w = 0 at the hinges x/L = 0 and 1)";
@@ -552,6 +552,14 @@ impl Scene {
         Ok(())
     }
 
+    /// Whether this is a membrane scene on a square patch with a square mesh (where the
+    /// x ↔ y symmetry check applies).
+    fn is_square_membrane(&self) -> bool {
+        self.membrane.is_some_and(|m| {
+            m.width == m.height && self.mesh.elements_along_y() == self.mesh.elements
+        })
+    }
+
     /// Every check in `kinds` (the scene's list under `key = "checks"`, or a run's) is of
     /// the scene's model: linear checks for `fem`/`spectral`, compression checks for
     /// `compression`.
@@ -562,7 +570,16 @@ impl Scene {
         } else {
             LINEAR_CHECKS
         };
-        match kinds.iter().position(|k| k.is_compression() != compression) {
+        let misplaced = |k: &CheckKind| {
+            k.is_compression() != compression
+                || (*k == CheckKind::XySymmetry && !self.is_square_membrane())
+        };
+        let allowed = if kinds.contains(&CheckKind::XySymmetry) && !self.is_square_membrane() {
+            "xy-symmetry only for a membrane on a square patch (width = height, elements_y = elements); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"
+        } else {
+            allowed
+        };
+        match kinds.iter().position(misplaced) {
             Some(i) => Err(bad(
                 self,
                 &format!("{key}[{i}]"),

@@ -219,6 +219,8 @@ fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
         CheckKind::DecayRate => Step::PerMode(2, decay_rate_check),
         CheckKind::Spectrum => Step::PerMode(3, spectrum_checks),
         CheckKind::TwoTime => Step::AfterModes(two_time_check),
+        CheckKind::PooledVariance => Step::AfterModes(pooled_variance_check),
+        CheckKind::XySymmetry => Step::AfterModes(xy_symmetry_check),
         CheckKind::ForceStrain | CheckKind::ForceDistribution | CheckKind::DtHalving => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
@@ -298,6 +300,8 @@ fn kind_name(kind: CheckKind) -> &'static str {
         CheckKind::DecayRate => "decay-rate",
         CheckKind::Spectrum => "spectrum",
         CheckKind::TwoTime => "two-time",
+        CheckKind::PooledVariance => "pooled-variance",
+        CheckKind::XySymmetry => "xy-symmetry",
         CheckKind::ForceStrain => "force-strain",
         CheckKind::ForceDistribution => "force-distribution",
         CheckKind::DtHalving => "dt-halving",
@@ -623,6 +627,140 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// Per independent series (trajectory and component), the time average of q² of mode
+/// `i` over its exact discrete variance (1 in expectation).
+fn normalized_variances(ctx: &LinearContext<'_>, i: usize) -> Vec<f64> {
+    let reference = ctx.run.reference.modes[i].variance_discrete;
+    mode_data(ctx.run, ctx.records, i)
+        .series
+        .iter()
+        .map(|s| s.iter().map(|q| q * q).sum::<f64>() / s.len().max(1) as f64 / reference)
+        .collect()
+}
+
+/// The effective samples of mode `i` per series, `n(1 − ρ²)/(1 + ρ²)` for `n` samples
+/// with lag-one correlation ρ (the variance of the time average of q² of an AR(1)
+/// sequence is `2σ⁴(1 + ρ²)/(n(1 − ρ²))`): the weight of the mode in the pooled checks,
+/// fixed by the sampling plan, not by the data.
+fn effective_samples(ctx: &LinearContext<'_>, i: usize) -> f64 {
+    let run = ctx.run;
+    let n = ctx
+        .records
+        .first()
+        .map_or(0, |r| r.modes.get(i).map_or(0, Vec::len)) as f64;
+    let rho = run.reference.modes[i]
+        .multiplier
+        .abs()
+        .powf(run.mode_every[i] as f64);
+    n * (1.0 - rho * rho) / (1.0 + rho * rho)
+}
+
+/// [`CheckKind::PooledVariance`]: per independent series the weighted mean over the
+/// checked modes of (time average of q²)/(exact discrete variance), weights the modes'
+/// effective samples ([`effective_samples`]), t-tested against 1 over the series (the
+/// error from their spread, so that correlations between modes — the element-uniform
+/// load drives the modes with correlated noise — are accounted for). Skipped (noted)
+/// with fewer than [`MIN_SERIES_FOR_T`] series.
+fn pooled_variance_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let r = &ctx.run.reference;
+    let name = format!("{}/pooled-variance", ctx.run.spec.name);
+    let nm = r.modes.len();
+    let weights: Vec<f64> = (0..nm).map(|i| effective_samples(ctx, i)).collect();
+    let total: f64 = weights.iter().sum();
+    let per_mode: Vec<Vec<f64>> = (0..nm).map(|i| normalized_variances(ctx, i)).collect();
+    let n_series = per_mode.first().map_or(0, Vec::len);
+    if n_series < MIN_SERIES_FOR_T || !(total > 0.0) {
+        ctx.est.skipped.push(SkippedCheck {
+            name,
+            reason: format!(
+                "needs at least {MIN_SERIES_FOR_T} independent series with samples, the data have {n_series}"
+            ),
+        });
+        return Ok(());
+    }
+    let values: Vec<f64> = (0..n_series)
+        .map(|j| {
+            (0..nm)
+                .map(|i| weights[i] / total * per_mode[i][j])
+                .sum::<f64>()
+        })
+        .collect();
+    let continuum: f64 = (0..nm)
+        .map(|i| weights[i] / total * r.modes[i].variance_continuum / r.modes[i].variance_discrete)
+        .sum();
+    let m = stats::ensemble_mean(&values)?;
+    let o = stats::t_test(m.mean, 1.0, m.std_error, values.len())?;
+    ctx.out.push(check(
+        name,
+        "t-test",
+        (m.mean, 1.0, m.std_error),
+        &o,
+        Some(continuum),
+        format!(
+            "weighted mean over {nm} modes of (time average of q^2)/(discrete variance), weights their effective samples; {} independent series, Student t with {} dof",
+            values.len(),
+            values.len() - 1
+        ),
+    ));
+    Ok(())
+}
+
+/// [`CheckKind::XySymmetry`]: on a square patch the modes (m, n) and (n, m) of the same
+/// shape have equal variances. Per independent series the weighted sum over the checked
+/// pairs of the difference of their normalized time averages, t-tested against 0
+/// ([`zero_mean_check`]); skipped (noted) without a checked pair.
+fn xy_symmetry_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let r = &ctx.run.reference;
+    let name = format!("{}/xy-symmetry", ctx.run.spec.name);
+    let labels: Vec<_> = r.modes.iter().map(|m| m.label).collect();
+    let mut pairs = Vec::new();
+    for (i, a) in labels.iter().enumerate() {
+        let Some(a) = a else { continue };
+        if a.m >= a.n {
+            continue;
+        }
+        let mirror = labels
+            .iter()
+            .position(|b| b.is_some_and(|b| b.m == a.n && b.n == a.m && b.shape == a.shape));
+        if let Some(k) = mirror {
+            pairs.push((i, k));
+        }
+    }
+    if pairs.is_empty() {
+        ctx.est.skipped.push(SkippedCheck {
+            name,
+            reason: "no pair of checked modes (m, n) and (n, m): raise sampling.modes".into(),
+        });
+        return Ok(());
+    }
+    let weight = |(i, k): (usize, usize)| effective_samples(ctx, i).min(effective_samples(ctx, k));
+    let total: f64 = pairs.iter().map(|&p| weight(p)).sum();
+    let mut values: Vec<f64> = Vec::new();
+    for &(i, k) in &pairs {
+        let w = weight((i, k)) / total;
+        let (a, b) = (normalized_variances(ctx, i), normalized_variances(ctx, k));
+        if values.is_empty() {
+            values = vec![0.0; a.len()];
+        }
+        for (v, (x, y)) in values.iter_mut().zip(a.iter().zip(&b)) {
+            *v += w * (x - y);
+        }
+    }
+    let described: Vec<String> = pairs
+        .iter()
+        .filter_map(|&(i, _)| labels[i].map(|l| format!("({0}, {1})-({1}, {0})", l.m, l.n)))
+        .collect();
+    zero_mean_check(
+        ctx,
+        name,
+        &values,
+        &format!(
+            "weighted difference of the normalized variances of the mirror pairs {}",
+            described.join(", ")
+        ),
+    )
 }
 
 /// Spectrum of mode `i` against the exact expectation of the Welch estimator for the

@@ -50,7 +50,9 @@ fn compression_step(
         | CheckKind::ModeDistribution
         | CheckKind::DecayRate
         | CheckKind::Spectrum
-        | CheckKind::TwoTime => {
+        | CheckKind::TwoTime
+        | CheckKind::PooledVariance
+        | CheckKind::XySymmetry => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
                 format!("{kind:?}"),

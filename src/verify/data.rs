@@ -289,6 +289,7 @@ fn mode_references(
                     multiplier: (-rate_c * dts).exp(),
                     rate_discrete: Some(rate_c),
                     rate_continuum: rate_c,
+                    label: None,
                 });
                 scale.push(1.0);
             }

@@ -35,6 +35,9 @@
 //!   the strain, `⟨F⟩_continuum(ε) = ⟨F⟩ₕ(ε − δ)` up to `EA·σ_r` (σ_r its standard
 //!   deviation, `σ_r² = d·N·(11/6300)(kT/EI)²h⁴/(4L²)`).
 //!
+//! A membrane's references are checked the same way against its own closed forms
+//! ([`membrane`]).
+//!
 //! Round-off of the dense eigensolver is allowed for (`1000 ε λ_max/λ` relative). Each
 //! comparison is a deterministic check (kind `oracle`, no p-value): it is not part of the
 //! Holm family and fails the scene on its own. A run whose references fail the oracle is
@@ -48,6 +51,8 @@ use crate::scene::{CompressionSpec, ModelKind, Scene};
 use crate::theory::compression::{CompressionTheory, Dims, StoredLengthLaw};
 use crate::verify::summary::CheckResult;
 use std::f64::consts::PI;
+
+mod membrane;
 
 /// The kind of every oracle check in `summary.json`.
 pub const ORACLE_KIND: &str = "oracle";
@@ -156,6 +161,10 @@ pub fn linear_oracle(scene: &Scene, run: &LinearRun) -> Oracle {
             "run {name}: the oracle's error bounds hold on uniform meshes; this mesh is graded (ratio {}), so its references are not checked against the continuum",
             scene.mesh.grading
         ));
+        return o;
+    }
+    if let Some(params) = scene.membrane {
+        membrane::membrane_oracle(scene, params, run, &mut o);
         return o;
     }
     match scene.model {

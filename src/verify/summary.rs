@@ -84,6 +84,8 @@ pub fn unit_of_check(check: &str) -> &'static str {
         "force" | "force-mean-bias" | "oracle-force" => "F_c0",
         "spectrum-low"
         | "spectrum-high"
+        | "pooled-variance"
+        | "xy-symmetry"
         | "oracle-eigenvalue"
         | "oracle-variance"
         | "oracle-multiplier"

@@ -63,6 +63,14 @@ impl Continuum {
         }
     }
 
+    /// The membrane's checked mode `n` (1-based); `None` for the filament.
+    pub(crate) fn mode_label(&self, n: usize) -> Option<MembraneMode> {
+        match self {
+            Continuum::Filament(_) => None,
+            Continuum::Membrane { modes, .. } => modes.get(n - 1).copied(),
+        }
+    }
+
     /// The continuum ⟨w²(x)⟩ at position `x` of the sampling line.
     ///
     /// # Errors
