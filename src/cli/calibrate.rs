@@ -143,9 +143,6 @@ pub fn run(args: CalibrateArgs, verbosity: Verbosity) -> Result<i32> {
             "a directory containing at least one scene (*.toml)",
         ));
     }
-    for scene in &scenes {
-        scene.refuse_membrane("calibration (calibrate)")?;
-    }
     let limits = args.limits.limits();
     limits.check(&total_work(&scenes, budget, n))?;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());

@@ -26,6 +26,10 @@ pub struct PowerArgs {
     /// axial-stretch-rigidity, shared-stiffness or shared-hinge.
     #[arg(long = "fault", value_name = "NAME")]
     faults: Vec<String>,
+    /// Target scene to measure (repeatable; default: every target scene of each fault):
+    /// a built-in scene that is a target of a measured fault, e.g. membrane-hinged.
+    #[arg(long = "scene", value_name = "NAME")]
+    scenes: Vec<String>,
     /// Seeds per fault, scene and size (the same fixed seeds 16000, 16001, ... for all).
     #[arg(long, default_value_t = 20, allow_negative_numbers = true, value_parser = super::count_in::<1, 100_000>)]
     seeds: u64,
@@ -54,8 +58,32 @@ pub fn run(args: PowerArgs, verbosity: Verbosity) -> Result<i32> {
             .map(|f| f.parse::<FaultKind>())
             .collect::<Result<Vec<_>>>()?
     };
+    if let Some(s) = args.scenes.iter().find(|s| {
+        !faults.iter().any(|k| {
+            langevin_fem::fault::targets(*k)
+                .iter()
+                .any(|t| t.scene == s.as_str())
+        })
+    }) {
+        let mut names: Vec<&str> = faults
+            .iter()
+            .flat_map(|k| langevin_fem::fault::targets(*k))
+            .map(|t| t.scene)
+            .collect();
+        names.sort_unstable();
+        names.dedup();
+        return Err(Error::invalid(
+            "--scene",
+            s,
+            format!(
+                "a target scene of the measured faults: {}",
+                names.join(", ")
+            ),
+        ));
+    }
     let report = run_power(&PowerOptions {
         faults,
+        scenes: args.scenes.clone(),
         seeds: args.seeds,
         budget: args.budget.budget(),
         alpha: args.alpha,

@@ -75,6 +75,13 @@ impl ModalStep {
     pub fn gains(&self) -> &[f64] {
         &self.gains
     }
+
+    /// This step with every noise gain × `factor` (an injected fault, [`crate::fault`]).
+    #[cfg(any(test, feature = "faults"))]
+    pub(crate) fn with_scaled_gains(mut self, factor: f64) -> Self {
+        self.gains.iter_mut().for_each(|g| *g *= factor);
+        self
+    }
 }
 
 impl Integrator for ModalStep {

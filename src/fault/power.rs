@@ -90,6 +90,8 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
 pub struct PowerOptions {
     /// The faults measured.
     pub faults: Vec<FaultKind>,
+    /// The target scenes measured (by name; empty: every target of each fault).
+    pub scenes: Vec<String>,
     /// Seeds per size.
     pub seeds: u64,
     /// The verification budget.
@@ -401,7 +403,10 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
     ));
     let mut rows = Vec::new();
     for &kind in &opts.faults {
-        for target in targets(kind) {
+        let chosen = targets(kind)
+            .into_iter()
+            .filter(|t| opts.scenes.is_empty() || opts.scenes.iter().any(|s| s == t.scene));
+        for target in chosen {
             for size in kind.ladder() {
                 // Detection grows with the size: once a size is detected in every seed,
                 // the larger ones are not run (saves most of the study's time).

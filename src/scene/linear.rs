@@ -1092,33 +1092,43 @@ impl LinearRun {
         largest_rms_slope(beam, &sums, n)
     }
 
-    /// The O(n) modal path of this run, if it has one and no injected fault replaces its
-    /// integrator (a faulty integrator steps the nodal state).
-    fn modal_path(&self) -> Option<&ModalPath> {
+    /// The O(n) modal path of this run, if it has one and an injected fault, if any, has
+    /// an exact modal form ([`crate::fault::modal_form`]; the others step the nodal
+    /// state): the path and the factors of the rates and the noise gains.
+    fn modal_path(&self) -> Option<(&ModalPath, f64, f64)> {
         let Model::Fem { modal, .. } = &self.model else {
             return None;
         };
         #[cfg(any(test, feature = "faults"))]
-        if crate::fault::replaces_integrator(self.fault) {
-            return None;
-        }
-        modal.as_ref()
+        let (rate, gain) = crate::fault::modal_form(self.fault)?;
+        #[cfg(not(any(test, feature = "faults")))]
+        let (rate, gain) = (1.0, 1.0);
+        modal.as_ref().map(|p| (p, rate, gain))
     }
 
     fn sampler(&self) -> Result<Box<dyn Sampler + '_>> {
         if let (
-            Some(path),
+            Some((path, rate, gain)),
             Model::Fem {
                 object, integrator, ..
             },
         ) = (self.modal_path(), &self.model)
         {
-            let stepper = ModalStep::new(
-                *integrator,
-                &path.rates,
-                self.reference.dt,
-                object.system().kt(),
-            )?;
+            let rates: Vec<f64> = if rate == 1.0 {
+                path.rates.clone()
+            } else {
+                path.rates.iter().map(|r| r * rate).collect()
+            };
+            let stepper =
+                ModalStep::new(*integrator, &rates, self.reference.dt, object.system().kt())?;
+            #[cfg(any(test, feature = "faults"))]
+            let stepper = if gain == 1.0 {
+                stepper
+            } else {
+                stepper.with_scaled_gains(gain)
+            };
+            #[cfg(not(any(test, feature = "faults")))]
+            let _ = gain;
             return Ok(Box::new(ModalSampler {
                 path,
                 n_modes: self.reference.modes.len(),

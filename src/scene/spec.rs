@@ -611,9 +611,10 @@ impl Scene {
         }
     }
 
-    /// Refuses a membrane scene where only filament scenes can go yet (issue #27: the
-    /// membrane is parsed, validated and has its exact theory, but nothing simulates or
-    /// checks it): `what` names the command or path, e.g. `verify`.
+    /// Refuses a membrane scene where only filament scenes can go yet (issue #27:
+    /// membranes are verified, calibrated and sharded like filaments, but trajectory
+    /// files, the stability map and the work-precision study are the filament's):
+    /// `what` names the command or path, e.g. `run`.
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the scene file, the key `membrane` and the scene,
@@ -627,8 +628,8 @@ impl Scene {
             key: "membrane".to_string(),
             message: format!(
                 "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
-                 (issue #27: membrane scenes are parsed and validated, but nothing simulates \
-                 or checks them yet); use a filament scene",
+                 (membranes run through verify, verify --shard, merge and calibrate); use a \
+                 filament scene here",
                 self.name
             ),
         })

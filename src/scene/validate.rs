@@ -1043,8 +1043,16 @@ impl Scene {
             (ModelKind::Spectral, true) => nx * ny,
             (ModelKind::Fem | ModelKind::Compression, true) => 4.0 * (nx + 1.0) * (ny + 1.0),
         };
-        let dense = self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal;
-        components * if dense { n * n } else { n }
+        components * if self.dense_step(run) { n * n } else { n }
+    }
+
+    /// Whether a step of `run` costs a dense n × n product: the exact modal update of a
+    /// finite-element object, except a plate with consistent noise (stepped in its
+    /// separable modes, O(n)).
+    fn dense_step(&self, run: &RunSpec) -> bool {
+        self.model == ModelKind::Fem
+            && run.integrator == IntegratorKind::ExactModal
+            && !(self.is_membrane() && run.noise == NoiseModel::Consistent)
     }
 
     /// The projected work of run `i` with ensemble `e` (an upper bound, from the scene
@@ -1227,8 +1235,7 @@ impl Scene {
                     "mesh.elements = {}{elements_y}, dims = {}{}",
                     self.mesh.elements,
                     self.dims,
-                    if self.model == ModelKind::Fem && run.integrator == IntegratorKind::ExactModal
-                    {
+                    if self.dense_step(run) {
                         " (exact-modal: n^2 per step)"
                     } else {
                         ""

@@ -123,8 +123,7 @@ pub const ENTRY_POINTS: [&str; 2] = ["summary.json", "index.html"];
 /// invalidated only once the input has passed every check.
 ///
 /// # Errors
-/// Input (exit 2): bad scene files, a membrane scene (not yet simulated:
-/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`, a time
+/// Input (exit 2): bad scene files, a projected work or memory above `opts.limits`, a time
 /// step above a stability limit, a budget that gives a check fewer samples than its
 /// estimator needs ([`Error::Scene`]). Run failures (exit 3): diverging runs
 /// ([`Error::Diverged`]), estimator or set-up failures ([`Error::RunFailed`]), I/O
@@ -172,17 +171,6 @@ pub fn run_verification(opts: &VerifyOptions) -> Result<(Summary, ReportRun)> {
         provenance: report.provenance_ref(),
     };
     Ok((summary, report))
-}
-
-/// Refuses, before anything is projected or prepared, a membrane scene among `scenes`:
-/// the runs of a scene are a filament's ([`Scene::refuse_membrane`]).
-///
-/// # Errors
-/// [`Error::Scene`] naming the first membrane scene (exit 2).
-pub(super) fn refuse_membranes(scenes: &[Scene]) -> Result<()> {
-    scenes
-        .iter()
-        .try_for_each(|s| s.refuse_membrane("simulation (verify)"))
 }
 
 /// Prepares every run of every scene and checks, before any long work, that the budget

@@ -16,7 +16,7 @@
 
 use super::runner::{
     Prepared, TargetedPlan, VerifyOptions, begin_run, for_compression_runs, prepare_all,
-    projected_work, refuse_membranes, simulate_compression, simulate_linear,
+    projected_work, simulate_compression, simulate_linear,
 };
 use crate::error::{Error, Result};
 use crate::output::Provenance;
@@ -79,7 +79,6 @@ pub fn write_shard(
     plan_from: Option<&Path>,
 ) -> Result<ShardManifest> {
     let scenes = &opts.scenes;
-    refuse_membranes(scenes)?;
     let provenance = Provenance::begin(&scenes.iter().collect::<Vec<_>>());
     let work = projected_work(scenes, opts.budget).scaled(shard.fraction());
     opts.limits.check(&work)?;

@@ -250,3 +250,77 @@ fn spectral_oracle(scene: &Scene, lattice: &Lattice, run: &LinearRun, o: &mut Or
         ));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fault::{Fault, FaultKind};
+    use crate::scene::load_scene;
+
+    /// The built-in membrane scene `name` with an `n × n` mesh (or `n × n` modes).
+    fn scene(name: &str, n: usize) -> Scene {
+        let mut s = load_scene(name, None).expect("built-in scene");
+        s.mesh.elements = n;
+        s.mesh.elements_y = Some(n);
+        s.sampling.modes = 6;
+        s
+    }
+
+    /// The oracle accepts the plate's references for both boundaries, with and without
+    /// tension, for every integrator of the scenes, on coarse to fine meshes, and checks
+    /// the eigenvalue and multiplier of every mode; and the spectral simulator's.
+    #[test]
+    fn accepts_the_references_over_meshes() {
+        for name in ["membrane-hinged", "membrane-periodic", "membrane-bilayer"] {
+            for n in [4, 8, 12] {
+                let sc = scene(name, n);
+                for spec in &sc.runs {
+                    let run = LinearRun::prepare(&sc, spec).expect("prepares");
+                    let o = crate::verify::oracle::linear_oracle(&sc, &run);
+                    let failed: Vec<_> = o.checks.iter().filter(|c| !c.passed).collect();
+                    assert!(
+                        failed.is_empty(),
+                        "{name} {n}x{n} {}: {failed:#?}",
+                        spec.name
+                    );
+                    assert!(o.checks.len() >= 2 * run.reference.modes.len());
+                }
+            }
+        }
+        let sc = scene("membrane-spectral", 8);
+        let run = LinearRun::prepare(&sc, &sc.runs[0]).unwrap();
+        let o = crate::verify::oracle::linear_oracle(&sc, &run);
+        assert!(o.passed(), "{:#?}", o.checks);
+        assert_eq!(o.checks.len(), 2 * 6 + sc.sampling.profile_points.len());
+    }
+
+    /// A 2 % error of κ in the shared plate fails the eigenvalue check of every mode,
+    /// stiffer or softer (Rayleigh–Ritz: the plate cannot be softer than the continuum;
+    /// 2 % is far above the (qh)⁴/720 band at 8 × 8); the spectral references with a
+    /// 1e-6 error of a variance fail.
+    #[test]
+    fn rejects_a_wrong_shared_plate() {
+        for name in ["membrane-hinged", "membrane-periodic"] {
+            let sc = scene(name, 8);
+            let spec = &sc.runs[0];
+            for s in [0.02, -0.02] {
+                let bad = sc
+                    .clone()
+                    .with_fault(Fault::new(FaultKind::SharedStiffness, s).unwrap());
+                let run = LinearRun::prepare(&bad, spec).unwrap();
+                let o = crate::verify::oracle::linear_oracle(&bad, &run);
+                let eig: Vec<bool> = o
+                    .checks
+                    .iter()
+                    .filter(|c| c.name.contains("oracle-eigenvalue"))
+                    .map(|c| c.passed)
+                    .collect();
+                assert_eq!(eig, vec![false; 6], "{name} kappa x {}", 1.0 + s);
+            }
+        }
+        let sc = scene("membrane-spectral", 8);
+        let mut run = LinearRun::prepare(&sc, &sc.runs[0]).unwrap();
+        run.reference.modes[2].variance_discrete *= 1.0 + 1e-6;
+        assert!(!crate::verify::oracle::linear_oracle(&sc, &run).passed());
+    }
+}
