@@ -675,10 +675,10 @@ fn theory_overflow_is_not_reported_as_success_with_null() {
 /// `scenes[].{name, passed, wall_seconds, figures, tables, checks[].{name, kind, passed,
 /// p_value, estimate, reference, std_error}}`) with consistent pass flags, `index.html`
 /// naming the scene, and exactly the CSV/SVG files listed in `figures`/`tables`. The
-/// membrane scenes there (a `[membrane]` table, issue #27) are valid but not simulated
-/// yet: `verify` refuses them with exit 2 naming the file, the key `membrane` and "not
-/// yet supported for membranes", and writes nothing (until the pipeline runs them, when
-/// they join the others here).
+/// membrane scenes there (a `[membrane]` table, issue #27) are valid but not verified
+/// yet (only `converge` runs them, tests/converge.rs): `verify` refuses them with exit 2
+/// naming the file, the key `membrane` and "not yet supported for membranes", and writes
+/// nothing (until verify runs them, when they join the others here).
 /// Reference: `src/verify/summary.rs`, `src/verify/runner.rs`, `Scene::refuse_membrane`.
 /// Tolerance: exact (structure).
 #[test]

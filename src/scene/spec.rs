@@ -68,9 +68,9 @@
 //! two_time = [[0.5, 0.5, 0.5, 1.0]]  # (x/a, x'/a, t/τ1, η/τ1) on y = b/2
 //! ```
 //!
-//! (`[[runs]]` as for the filament.) The simulation pipeline does not run membrane scenes
-//! yet: the commands that simulate or check data refuse them
-//! ([`Scene::refuse_membrane`]).
+//! (`[[runs]]` as for the filament.) Of the commands that simulate, only the convergence
+//! study (`converge`, finite-element membranes) runs membrane scenes yet: the others, and
+//! those that check data, refuse them ([`Scene::refuse_membrane`]).
 //!
 //! An ensemble's keys (every budget: `quick`, `standard`, `full`):
 //!
@@ -603,8 +603,8 @@ impl Scene {
     }
 
     /// Refuses a membrane scene where only filament scenes can go yet (issue #27: the
-    /// membrane is parsed, validated and has its exact theory, but nothing simulates or
-    /// checks it): `what` names the command or path, e.g. `verify`.
+    /// membrane is parsed, validated and has its exact theory, but only the convergence
+    /// study simulates it): `what` names the command or path, e.g. `verify`.
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the scene file, the key `membrane` and the scene,
@@ -618,8 +618,8 @@ impl Scene {
             key: "membrane".to_string(),
             message: format!(
                 "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
-                 (issue #27: membrane scenes are parsed and validated, but nothing simulates \
-                 or checks them yet); use a filament scene",
+                 (issue #27: membrane scenes are parsed and validated, and only the \
+                 convergence study (converge) simulates them yet); use a filament scene",
                 self.name
             ),
         })
