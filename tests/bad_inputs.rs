@@ -17,7 +17,8 @@
 //! Set-up: three small valid scenes ([`LINEAR`], [`COMPRESSION`], [`MEMBRANE`]; a test
 //! checks that they parse) and one edit per case, so that each case has exactly one
 //! fault (a membrane scene, valid, is refused by the commands that do not take membranes
-//! yet: run, check, stability, work-precision).
+//! yet: run, check, stability, work-precision; `converge` refuses its element counts
+//! above the membrane's cap).
 //! Tolerance: exact substrings; 100 % of the corpus must pass (the pass fraction is
 //! printed). Cases run on two threads; the corpus takes a few seconds because every
 //! refusal comes before any simulation.
@@ -113,8 +114,8 @@ full = { trajectories = 4, target_std_error = 0.05, pilot_tau1 = 2.0, max_durati
 "#;
 
 /// A small valid membrane scene (issue #27: simply supported 2 x 1 rectangle under
-/// tension, 8 x 4 elements): each case edits one line. Valid, but not simulated yet: the
-/// commands that simulate refuse it (the `membrane-refused-*` cases).
+/// tension, 8 x 4 elements): each case edits one line. Valid; the commands that simulate
+/// refuse it (the `membrane-refused-*` cases) but `converge`.
 const MEMBRANE: &str = r#"description = "bad-input corpus: membrane"
 seed = 13
 dims = 3
@@ -651,7 +652,8 @@ fn corpus() -> Vec<Case> {
 
 /// A membrane scene (issue #27): its parameters, its mesh, its sampling positions, the
 /// keys of the filament it cannot have, and every command that cannot simulate or check
-/// it yet (refused naming the scene and "not yet supported for membranes").
+/// it yet (refused naming the scene and "not yet supported for membranes"; `converge`
+/// runs it, and refuses element counts above its cap).
 fn membrane_cases() -> Vec<Case> {
     const REFUSED: &[&str] = &["key `membrane`", "not yet supported for membranes"];
     let refused = |name: &'static str, a: &'static [&'static str]| Case {
@@ -877,10 +879,17 @@ fn membrane_cases() -> Vec<Case> {
             &["key `sampling.two_time[0][1] (x'/a)`", "got 0", "in (0, 1)"],
         ),
         refused("membrane-refused-run", &["run", "--scene", "SCENE"]),
-        refused(
-            "membrane-refused-converge",
-            &["converge", "--scene", "SCENE", "--over", "elements"],
-        ),
+        // converge runs a membrane's plate (issue #27) within its element cap.
+        Case {
+            name: "membrane-converge-values-above-cap",
+            input: Input::Args(
+                &[
+                    "converge", "--scene", "SCENE", "--over", "elements", "--values", "4,30",
+                ],
+                Some((Base::Membrane, &[])),
+            ),
+            expect: &["--values", "got 30", "integer element counts in [2, 24]"],
+        },
         refused(
             "membrane-refused-stability",
             &["stability", "--scene", "SCENE"],

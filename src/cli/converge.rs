@@ -25,6 +25,7 @@ Examples:
   langevin-fem converge -s hinged-linear-2d --over dt --run crank-nicolson -b standard
   langevin-fem converge -s compression-2d --over elements --values 5,10,20 --strain-ratios 0 \\
       --trajectories 16 --duration-tau1 200 -o reports/convergence
+  langevin-fem converge -s my-membrane.toml --over elements --values 4,8,12,16
   langevin-fem converge -s hinged-linear-2d --over dt --shard 1/2 -o cv/1   (and 2/2), then:
   langevin-fem merge cv/1 cv/2 -o reports/convergence
 
@@ -36,15 +37,17 @@ The fitted orders go to stdout, progress to stderr; the exit code is 3 if every 
 pub struct ConvergeArgs {
     /// Scene: a built-in scene's name (finite-element scenes: hinged-linear-2d,
     /// hinged-linear-3d, compression-2d, compression-3d, ...; see `langevin-fem list`), a
-    /// name in --scene-dir, or a path to a .toml file.
+    /// name in --scene-dir, or a path to a .toml file (also a membrane with model = "fem").
     #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// What is refined: the element count or the time step dt/tau1.
     #[arg(long, value_enum)]
     over: OverArg,
-    /// Comma-separated values (element counts, or dt/tau1); default 5,10,20,40 elements,
-    /// or dt/tau1 4e-3,2e-3,1e-3,5e-4 (euler-maruyama: 0.9,0.5,0.25,0.125 of its
-    /// stability limit; compression with metropolis-crank-nicolson: 0.04,0.02,0.01,0.005).
+    /// Comma-separated values (element counts, or dt/tau1); default 5,10,20,40 elements
+    /// (a membrane: 4,8,16 along x, at most 24 a side, the y count at the scene's aspect
+    /// ratio of elements), or dt/tau1 4e-3,2e-3,1e-3,5e-4 (euler-maruyama:
+    /// 0.9,0.5,0.25,0.125 of its stability limit; compression with
+    /// metropolis-crank-nicolson: 0.04,0.02,0.01,0.005).
     #[arg(long, value_name = "V1,V2,...", allow_hyphen_values = true)]
     values: Option<String>,
     /// Run of the scene (default: its first run).
@@ -257,7 +260,11 @@ fn print_observable(o: &ObservableSummary) {
     println!(
         "  {:<8} observed {}; exact-error order {}; expected {}; sampling floor at {:?}",
         o.observable,
-        fmt_fit(&o.observed),
+        if o.unsampled {
+            "- (exact observable, no sampling)".to_string()
+        } else {
+            fmt_fit(&o.observed)
+        },
         if o.exact.is_none() && !o.exact_at_rounding.is_empty() {
             format!("- (exact at {:?})", o.exact_at_rounding)
         } else {

@@ -110,7 +110,11 @@ pub fn modal_probe(beam: &BeamModel, vectors: &DMatrix<f64>, x: f64) -> DVector<
 
 /// The probe vector `Φᵀ p` of the linear functional `value` of a state of `n` DOFs
 /// (`value(e_k)` for every unit vector `e_k` gives `p`).
-fn probe_of(n: usize, vectors: &DMatrix<f64>, value: impl Fn(&[f64]) -> f64) -> DVector<f64> {
+pub(crate) fn probe_of(
+    n: usize,
+    vectors: &DMatrix<f64>,
+    value: impl Fn(&[f64]) -> f64,
+) -> DVector<f64> {
     let mut e = vec![0.0; n];
     let mut v = DVector::zeros(n);
     for k in 0..n {
@@ -1014,6 +1018,15 @@ impl LinearRun {
             }
         }
         Ok(stats::combine_independent(&parts))
+    }
+
+    /// The finite-element object this run simulates (its linear system, modes and field
+    /// on the sampling line); `None` for the spectral models and for data.
+    pub(crate) fn fem_object(&self) -> Option<&FemObject> {
+        match &self.model {
+            Model::Fem { object, .. } => Some(object),
+            _ => None,
+        }
     }
 
     fn n_nodes(&self) -> usize {

@@ -68,9 +68,9 @@
 //! two_time = [[0.5, 0.5, 0.5, 1.0]]  # (x/a, x'/a, t/τ1, η/τ1) on y = b/2
 //! ```
 //!
-//! (`[[runs]]` as for the filament.) The simulation pipeline does not run membrane scenes
-//! yet: the commands that simulate or check data refuse them
-//! ([`Scene::refuse_membrane`]).
+//! (`[[runs]]` as for the filament.) `verify` (with `--shard` and `merge`), `calibrate`
+//! and `converge` (finite-element membranes) run membrane scenes; `run`, `check`,
+//! `stability` and `work-precision` refuse them yet ([`Scene::refuse_membrane`]).
 //!
 //! An ensemble's keys (every budget: `quick`, `standard`, `full`):
 //!
@@ -612,7 +612,7 @@ impl Scene {
     }
 
     /// Refuses a membrane scene where only filament scenes can go yet (issue #27:
-    /// membranes are verified, calibrated and sharded like filaments, but trajectory
+    /// membranes are verified, calibrated, sharded and converged like filaments, but trajectory
     /// files, the stability map and the work-precision study are the filament's):
     /// `what` names the command or path, e.g. `run`.
     ///
@@ -628,7 +628,7 @@ impl Scene {
             key: "membrane".to_string(),
             message: format!(
                 "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
-                 (membranes run through verify, verify --shard, merge and calibrate); use a \
+                 (membranes run through verify, verify --shard, merge, calibrate and converge); use a \
                  filament scene here",
                 self.name
             ),

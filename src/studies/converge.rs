@@ -6,7 +6,13 @@
 //! the scene is rebuilt with that value, the run is prepared ([`LinearRun::prepare`]) and
 //! its ensemble simulated (rayon over trajectories, one PCG stream per trajectory, so the
 //! result does not depend on the thread count). The observables are ⟨w²(L/2)⟩ and the
-//! stationary variances of discrete modes 1–3. For each one and each value:
+//! stationary variances of discrete modes 1–3. A membrane scene (plate elements, issue
+//! #27) goes through the same code, branching only where the object differs
+//! ([`StudyObject`]): its profile observable is ⟨h²⟩ at the centre (a/2, b/2), its modes
+//! 1–3 are its slowest continuum modes (named with their (m, n)), both directions are
+//! refined together (h = a/elements), and over elements it has one more, exact
+//! observable: the plate's eigenvalue of mode 1 relative to the continuum's, λ_h/λ, with
+//! no sampling. For each one and each value:
 //!
 //! - the ensemble estimate and its standard error (per trajectory and component:
 //!   autocorrelation-aware errors from [`stats::variance_with_error`] /
@@ -19,14 +25,16 @@
 //! - the total error |estimate − limit| with the estimate's standard error, and the exact
 //!   discretization/integrator error |discrete − limit| (no sampling).
 //!
-//! The observed order p of error ∝ h^p (h = L/elements or Δt/τ1) is fitted by weighted
-//! least squares on ln error against ln h ([`fit_order`]), using only points whose total
-//! error exceeds [`FLOOR_SIGMAS`] standard errors; the others are flagged "sampling floor".
-//! The order of the exact error is fitted on all points whose exact error is above
+//! The observed order p of error ∝ h^p (h = L/elements, a/elements or Δt/τ1) is fitted by
+//! weighted least squares on ln error against ln h ([`fit_order`]), using only points whose
+//! total error exceeds [`FLOOR_SIGMAS`] standard errors; the others are flagged "sampling
+//! floor". The order of the exact error is fitted on all points whose exact error is above
 //! round-off ([`ROUNDING_FACTOR`]). Confidence intervals use Student's t with n − 2 degrees of
 //! freedom (residual scale), so at least three points are needed for an interval. The
 //! observed order *agrees* with the expected one when its interval holds it
-//! ([`ObservableSummary::agrees`]); a disagreement is stated in the observable's note.
+//! ([`ObservableSummary::agrees`]); a disagreement is stated in the observable's note. An
+//! exact observable (no sampling: its rows have a zero standard error) has no observed
+//! order: its exact-error order is compared with the expected one instead.
 //!
 //! A value whose run diverges (a non-finite state, e.g. an explicit stretching force at a
 //! too-large Δt) is recorded with the step it failed at, and one whose estimators fail
@@ -38,16 +46,17 @@ use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 
 use super::output::StudyReport;
-use crate::fem::modal::{
-    continuous_stationary_covariance, generalized_modes, modal_noise_covariance,
-};
+use crate::fem::modal::{continuous_stationary_covariance, modal_noise_covariance};
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
+use crate::fem::plate::PlateModel;
+use crate::fem::plate_modes::PlateModes;
 use crate::output::io::CsvWriter;
 use crate::output::{AxisUnits, Figure, Provenance, Series};
 use crate::rng::derive_seed;
-use crate::scene::linear::{LinearRun, TrajectoryRecord, modal_probe, small_slope_warning};
+use crate::scene::linear::{LinearRun, TrajectoryRecord, probe_of, small_slope_warning};
 use crate::scene::validate::Num;
 use crate::scene::{Budget, Ensemble, ModelKind, RunSpec, Scene};
+use crate::spectral::membrane::{Membrane, MembraneMode, ModeShape};
 use crate::stats;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Deserializer, Serialize};
@@ -78,6 +87,16 @@ pub const DEFAULT_DT_TAU1: [f64; 4] = [4e-3, 2e-3, 1e-3, 5e-4];
 pub const DEFAULT_EM_FRACTIONS: [f64; 4] = [0.9, 0.5, 0.25, 0.125];
 /// Allowed element counts (the references use a dense eigen-decomposition).
 pub const ELEMENTS_RANGE: (usize, usize) = (2, 200);
+/// Default element counts along x of `--over elements` for a membrane scene whose
+/// coarsest of them resolves its modes 1–3 (along y the scene's aspect ratio of elements
+/// is kept, [`rebuild`]; else multiplied, [`default_values`]). Even counts put the centre
+/// (a/2, b/2) of a square mesh on a node in every mesh.
+pub const DEFAULT_MEMBRANE_ELEMENTS: [usize; 3] = [4, 8, 16];
+/// Allowed element counts of a membrane, along x and along y: the references decompose
+/// the plate's 4(nx + 1)(ny + 1) unknowns densely (at 24 × 24 about 2500, seconds per
+/// value). A mesh must also resolve the study's modes 1–3 (a simply supported mode
+/// (m, n) needs m < nx and n < ny).
+pub const MEMBRANE_ELEMENTS_RANGE: (usize, usize) = (2, 24);
 
 /// Reads a number of a study's JSON summary back (`#[serde(deserialize_with)]`): the
 /// JSON writer stores a non-finite `f64` as `null`, read back as NaN.
@@ -220,11 +239,63 @@ pub fn sampling_floor(err: &[f64], std_errors: &[f64]) -> Vec<bool> {
         .collect()
 }
 
-/// The observables: `0` is ⟨w²(L/2)⟩, `1..=3` the variances of modes 1–3.
-pub fn observable_names() -> Vec<String> {
-    std::iter::once("w2(L/2)".to_string())
-        .chain((1..=N_MODES).map(|n| format!("mode{n}")))
-        .collect()
+/// Number of sampled observables: the profile point and modes 1–3. Those after them
+/// (the membrane's eigenvalue over elements) are exact, without sampling.
+const SAMPLED: usize = 1 + N_MODES;
+
+/// The object of a linear study, where the expected orders differ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StudyObject {
+    /// The filament (Hermite-cubic beam elements).
+    Filament {
+        /// Whether x = L/2 is a mesh node for every value studied.
+        node_at_mid: bool,
+    },
+    /// The membrane (Bogner–Fox–Schmit plate elements).
+    Membrane {
+        /// Whether the centre (a/2, b/2) sits alike in every mesh studied (the parities
+        /// of nx and ny the same for every value: a node, or inside an element, for all).
+        centre_alike: bool,
+    },
+}
+
+/// A membrane mode's label: `(m,n)`, with `cos`/`sin` for the two real modes of a
+/// periodic lattice point.
+fn mode_label(m: MembraneMode) -> String {
+    let shape = match m.shape {
+        ModeShape::SineSine => "",
+        ModeShape::Cosine => "cos",
+        ModeShape::Sine => "sin",
+    };
+    format!("({},{}){shape}", m.m, m.n)
+}
+
+/// The observables of a study of `scene` over `over`. A filament: `0` is ⟨w²(L/2)⟩,
+/// `1..=3` the variances of modes 1–3 (`w2(L/2)`, `mode1`, …). A membrane: `0` is ⟨h²⟩ at
+/// the centre (`h2(a/2,b/2)`), `1..=3` the variances of its three slowest modes, named
+/// with their indices (`mode1(1,1)`, …), and over elements `4`, exact (no sampling), the
+/// plate's eigenvalue of mode 1 over the continuum's (`lambda_h/lambda(1,1)`, limit 1).
+///
+/// # Errors
+/// A membrane's invalid parameters ([`Membrane::new`], [`Membrane::modes`]).
+pub fn observable_names(scene: &Scene, over: Over) -> Result<Vec<String>> {
+    let Some(p) = scene.membrane else {
+        return Ok(std::iter::once("w2(L/2)".to_string())
+            .chain((1..=N_MODES).map(|n| format!("mode{n}")))
+            .collect());
+    };
+    let modes = Membrane::new(p)?.modes(N_MODES)?;
+    let mut names = vec!["h2(a/2,b/2)".to_string()];
+    names.extend(
+        modes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| format!("mode{}{}", i + 1, mode_label(*m))),
+    );
+    if over == Over::Elements {
+        names.push(format!("lambda_h/lambda{}", mode_label(modes[0])));
+    }
+    Ok(names)
 }
 
 /// The exact references of one value of the refined parameter.
@@ -232,7 +303,7 @@ pub fn observable_names() -> Vec<String> {
 pub struct PointReference {
     /// The value (element count or Δt/τ1).
     pub value: f64,
-    /// h: L/elements, or Δt/τ1.
+    /// h: L/elements (a membrane: a/elements), or Δt/τ1.
     pub h: f64,
     /// Exact discrete value per observable (order of [`observable_names`]).
     pub discrete: Vec<f64>,
@@ -255,9 +326,10 @@ pub struct Expected {
 }
 
 /// The expected order of the error of observable `obs` (index into
-/// [`observable_names`]) when refining `over` with this run's integrator and noise.
-/// `node_at_mid` tells whether x = L/2 is a mesh node for every value studied.
-pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool) -> Expected {
+/// [`observable_names`]) when refining `over` with this run's integrator and noise, on
+/// `object` (a filament, with whether x = L/2 is a mesh node for every value studied, or
+/// a membrane).
+pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, object: StudyObject) -> Expected {
     let exact_stationary = matches!(
         spec.integrator,
         IntegratorKind::CrankNicolson | IntegratorKind::ExactModal
@@ -267,8 +339,16 @@ pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool)
         exact,
         why: why.to_string(),
     };
+    let membrane = matches!(object, StudyObject::Membrane { .. });
     match over {
         Over::Elements => {
+            if obs >= SAMPLED {
+                return e(
+                    Some(4.0),
+                    false,
+                    "the plate's eigenvalue of the mode: Bogner-Fox-Schmit (bicubic Hermite) elements are a conforming Rayleigh-Ritz discretization, so lambda_h >= lambda, and the error lambda_h/lambda - 1 > 0 is O(h^4) (2(k+1-m), k = 3, m = 2); exact (no sampling), whatever the integrator, noise and dt",
+                );
+            }
             if !exact_stationary {
                 return e(
                     None,
@@ -276,31 +356,56 @@ pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool)
                     "the integrator's stationary bias at fixed dt (O(lambda dt) per mode) does not vanish as h -> 0, and grows with lambda_max for sums over modes: no order in h",
                 );
             }
-            match (spec.noise, obs) {
-                (NoiseModel::Consistent, 0) if node_at_mid => e(
+            match (spec.noise, obs, object) {
+                (NoiseModel::Consistent, 0, StudyObject::Filament { node_at_mid: true }) => e(
                     None,
                     true,
                     "consistent noise with an exact-stationary integrator gives the covariance kT K^-1, whose nodal values are exact for Hermite cubics (the beam's Green's function is piecewise cubic): zero error, no order",
                 ),
-                (NoiseModel::Consistent, 0) => e(
+                (NoiseModel::Consistent, 0, StudyObject::Filament { .. }) => e(
                     None,
                     false,
                     "kT K^-1 is exact at nodes (zero error there); where x = L/2 lies inside an element (odd element counts) the interpolated variance falls below the continuum by the energy-norm error of the point-load response, about h^3: no single order over these meshes",
                 ),
-                (NoiseModel::Consistent, _) => e(
+                (NoiseModel::Consistent, 0, StudyObject::Membrane { centre_alike: true }) => e(
+                    Some(2.0),
+                    false,
+                    "consistent noise with an exact-stationary integrator gives the covariance kT K^-1: the centre variance is the plate's energy of its response to a point load there, below the continuum by the energy-norm error of that response (Galerkin); the biharmonic point-load response (r^2 ln r) makes this O(h^2), as does the modal tail sum 4kT/(ab kappa q^4) over the 2D modes beyond q ~ pi/h. Unlike the beam's, the plate's nodal values are not exact. Measured from the exact references (simply supported square, kappa = kT = 1): error/h^2 -> 0.0021 with the centre on a node, 0.0058 inside an element",
+                ),
+                (NoiseModel::Consistent, 0, StudyObject::Membrane { .. }) => e(
+                    None,
+                    false,
+                    "the centre variance converges as h^2 from below (the energy-norm error of the point-load response), but with a different constant where (a/2, b/2) is a node (even counts; simply supported square: about 0.0021 h^2 kT/kappa) and where it lies inside an element (odd counts: about 0.0058 h^2 kT/kappa): no single power law over meshes of both kinds",
+                ),
+                (NoiseModel::Consistent, _, StudyObject::Filament { .. }) => e(
                     Some(4.0),
                     false,
                     "the variance is kT/lambda_i^h; Hermite-cubic generalized eigenvalues converge as h^4 (2(k+1-m), k = 3, m = 2)",
                 ),
-                (NoiseModel::ElementUniform, 0) => e(
+                (NoiseModel::Consistent, _, StudyObject::Membrane { .. }) => e(
+                    Some(4.0),
+                    false,
+                    "the variance is kT/lambda_h of the plate's mode; Bogner-Fox-Schmit (bicubic Hermite) eigenvalues converge as h^4 from above (2(k+1-m), k = 3, m = 2), so the variance converges as h^4 from below",
+                ),
+                (NoiseModel::ElementUniform, 0, StudyObject::Filament { .. }) => e(
                     Some(2.0),
                     false,
                     "the element-uniform noise (eq. 5) under-excites every mode by about (i pi h/L)^2/12; the profile sums these h^2 deficits (plus the h^4 eigenvalue error)",
                 ),
-                (NoiseModel::ElementUniform, _) => e(
+                (NoiseModel::ElementUniform, 0, StudyObject::Membrane { .. }) => e(
+                    None,
+                    false,
+                    "element-uniform noise under-excites every mode by about (q_x^2 h_x^2 + q_y^2 h_y^2)/12; summed over the 2D modes at the centre (sum 1/q^2 up to q ~ pi/h) these deficits give about h^2 ln(1/h)/(24 pi) kT/kappa (simply supported square; measured from the exact references: 0.0134 h^2 ln(1/h)): no pure power law, the fitted order over 4-24 elements is about 1.6-1.75, tending to 2 only logarithmically",
+                ),
+                (NoiseModel::ElementUniform, _, StudyObject::Filament { .. }) => e(
                     Some(2.0),
                     false,
                     "element-uniform noise (eq. 5): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (i pi h/L)^2/12, order h^2 (dominates the h^4 eigenvalue error)",
+                ),
+                (NoiseModel::ElementUniform, _, StudyObject::Membrane { .. }) => e(
+                    Some(2.0),
+                    false,
+                    "element-uniform noise (a uniform load per element area): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (q_x^2 h_x^2 + q_y^2 h_y^2)/12, order h^2 (dominates the h^4 eigenvalue error)",
                 ),
             }
         }
@@ -320,6 +425,11 @@ pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool)
                 false,
                 "exact OU update with element-uniform noise: the modal variances are exact, but the cross-covariances of modes (correlated by eq. 5 noise) are not, by O((lambda dt)^2) for resolved modes: no single order",
             ),
+            IntegratorKind::EulerMaruyama if obs == 0 && membrane => e(
+                Some(1.0),
+                false,
+                "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the error at the profile point is dt kT/2 sum_i phi_i(a/2, b/2)^2 + O(dt^2): order 1",
+            ),
             IntegratorKind::EulerMaruyama if obs == 0 => e(
                 Some(1.0),
                 false,
@@ -329,6 +439,11 @@ pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool)
                 Some(1.0),
                 false,
                 "Euler-Maruyama stationary variance ratio 1/(1 - lambda dt/2): bias O(lambda dt), order 1",
+            ),
+            IntegratorKind::BackwardEuler if obs == 0 && membrane => e(
+                Some(1.0),
+                false,
+                "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the membrane's sum over its 2D modes (sum 1/q^4 beyond q ~ dt^(-1/4)) gives about dt^(1/2), so the observed order lies between 1/2 and 1",
             ),
             IntegratorKind::BackwardEuler if obs == 0 => e(
                 Some(1.0),
@@ -349,13 +464,20 @@ pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, node_at_mid: bool)
     }
 }
 
-/// Rebuilds `scene` for one value of the study: sets the element count (or the run's
-/// Δt/τ1), samples modes 1–3 and the profile at x/L = 0.5, and drops the two-time points
-/// (not reported here).
+/// Rebuilds `scene` for one value of the study: sets the element count (a membrane's in
+/// both directions, [`membrane_elements_y`]) or the run's Δt/τ1, samples modes 1–3 and
+/// the profile at x/L = 0.5 (a membrane: x/a = 0.5 on its midline y = b/2, its centre),
+/// and drops the two-time points (not reported here).
 pub fn rebuild(scene: &Scene, run: usize, over: Over, value: f64) -> Scene {
     let mut s = scene.clone();
     match over {
-        Over::Elements => s.mesh.elements = value.round() as usize,
+        Over::Elements => {
+            let nx = value.round() as usize;
+            if s.is_membrane() && s.mesh.elements_y.is_some() {
+                s.mesh.elements_y = Some(membrane_elements_y(scene, nx));
+            }
+            s.mesh.elements = nx;
+        }
         Over::Dt => s.runs[run].dt_tau1 = value,
     }
     s.sampling.modes = N_MODES;
@@ -364,25 +486,67 @@ pub fn rebuild(scene: &Scene, run: usize, over: Over, value: f64) -> Scene {
     s
 }
 
-/// The Δt → 0 limit of this scene's mesh and the run's noise model: ⟨w²(L/2)⟩ and the
-/// variances of modes 1–3 from the semi-discrete stationary covariance.
-fn semi_discrete_limit(scene: &Scene, spec: &RunSpec) -> Result<Vec<f64>> {
-    let p = scene.filament;
-    let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
-    let gm = generalized_modes(&beam)?;
-    let sq = modal_noise_covariance(&gm, &NoiseGenerator::new(spec.noise, &beam)?.covariance());
-    let s = continuous_stationary_covariance(&sq, &gm.rates, p.kt);
-    let a = modal_probe(&beam, &gm.vectors, 0.5 * p.length);
+/// The element count along y of membrane `scene` refined to `nx` elements along x: the
+/// scene's aspect ratio of elements kept, round(nx · ny₀/nx₀) (`nx` if the scene gives no
+/// `mesh.elements_y`).
+pub fn membrane_elements_y(scene: &Scene, nx: usize) -> usize {
+    match scene.mesh.elements_y {
+        Some(ny0) => ((nx * ny0) as f64 / scene.mesh.elements as f64).round() as usize,
+        None => nx,
+    }
+}
+
+/// The mesh of `scene` in words: its element count, a membrane's `nx x ny`.
+fn mesh_text(scene: &Scene) -> String {
+    if scene.is_membrane() {
+        format!(
+            "{} x {}",
+            scene.mesh.elements,
+            scene.mesh.elements_along_y()
+        )
+    } else {
+        scene.mesh.elements.to_string()
+    }
+}
+
+/// The Δt → 0 limit of the mesh of the prepared run `lr` (whichever object it is) with
+/// the noise model of `spec`: the variance at the profile point and those of modes 1–3
+/// from the semi-discrete stationary covariance `S_ij = 2kT Σ_q,ij/(λ_i + λ_j)` of the
+/// object's linear system (its generalized modes, the modal covariance of the noise).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--scene` if the run has no finite-element object;
+/// numerical failures of the modes or of the noise covariance.
+fn semi_discrete_limit(scene: &Scene, lr: &LinearRun, spec: &RunSpec) -> Result<Vec<f64>> {
+    let object = lr
+        .fem_object()
+        .ok_or_else(|| Error::invalid("--scene", &scene.name, "a finite-element scene"))?;
+    let system = object.system();
+    let gm = object.modes()?;
+    let sq = modal_noise_covariance(&gm, &NoiseGenerator::new(spec.noise, system)?.covariance());
+    let s = continuous_stationary_covariance(&sq, &gm.rates, system.kt());
+    let x = lr.reference.profile_x[0];
+    let a = probe_of(system.n_dofs(), &gm.vectors, |e| object.value_at(e, x));
     let mut out = vec![(a.transpose() * &s * &a)[(0, 0)]];
     out.extend((0..N_MODES).map(|i| s[(i, i)]));
     Ok(out)
 }
 
-/// h of a value: L/elements, or Δt/τ1.
+/// h of a value: L/elements (a membrane: a/elements, its element width), or Δt/τ1.
 fn h_of(scene: &Scene, over: Over, value: f64) -> f64 {
+    match (over, scene.membrane) {
+        (Over::Elements, None) => scene.filament.length / value,
+        (Over::Elements, Some(m)) => m.width / value,
+        (Over::Dt, _) => value,
+    }
+}
+
+/// What h is for a study of `scene` over `over`: `L/elements`, `a/elements` (a membrane)
+/// or `dt/tau1`.
+fn h_label(scene: &Scene, over: Over) -> &'static str {
     match over {
-        Over::Elements => scene.filament.length / value,
-        Over::Dt => value,
+        Over::Elements if scene.is_membrane() => "a/elements",
+        _ => over.h_label(),
     }
 }
 
@@ -400,7 +564,8 @@ fn prepare(scene: &Scene, run: usize, over: Over, value: f64) -> Result<(Scene, 
                     value,
                     format!(
                         "< {limit_tau1:.4e} (dt_tau1: the stability limit 2/lambda_max of {} with {} elements)",
-                        spec.integrator, s.mesh.elements
+                        spec.integrator,
+                        mesh_text(&s)
                     ),
                 ),
                 Over::Elements => Error::invalid(
@@ -408,7 +573,9 @@ fn prepare(scene: &Scene, run: usize, over: Over, value: f64) -> Result<(Scene, 
                     value,
                     format!(
                         "an element count whose stability limit of {} exceeds the run's dt_tau1 = {:e} (with {} elements the limit is {limit_tau1:.4e}); use fewer elements or a stable integrator such as crank-nicolson",
-                        spec.integrator, spec.dt_tau1, value
+                        spec.integrator,
+                        spec.dt_tau1,
+                        mesh_text(&s)
                     ),
                 ),
             }
@@ -428,17 +595,19 @@ pub fn exact_study(
     over: Over,
     values: &[f64],
 ) -> Result<Vec<PointReference>> {
-    let limit_dt = match over {
-        Over::Dt => Some(semi_discrete_limit(scene, &scene.runs[run])?),
-        Over::Elements => None,
-    };
-    values
+    let prepared = values
         .iter()
-        .map(|&v| {
-            let (_, lr) = prepare(scene, run, over, v)?;
-            Ok(reference_point(scene, &lr, over, v, limit_dt.as_deref()))
-        })
-        .collect()
+        .map(|&v| prepare(scene, run, over, v))
+        .collect::<Result<Vec<_>>>()?;
+    let limit_dt = match (over, prepared.first()) {
+        (Over::Dt, Some((_, lr))) => Some(semi_discrete_limit(scene, lr, &scene.runs[run])?),
+        _ => None,
+    };
+    Ok(prepared
+        .iter()
+        .zip(values)
+        .map(|((_, lr), &v)| reference_point(scene, lr, over, v, limit_dt.as_deref()))
+        .collect())
 }
 
 fn reference_point(
@@ -451,7 +620,7 @@ fn reference_point(
     let r = &lr.reference;
     let mut discrete = vec![r.profile_discrete[0]];
     discrete.extend(r.modes.iter().take(N_MODES).map(|m| m.variance_discrete));
-    let limit = match limit_dt {
+    let mut limit = match limit_dt {
         Some(l) => l.to_vec(),
         None => {
             let mut c = vec![r.profile_continuum[0]];
@@ -462,6 +631,12 @@ fn reference_point(
     let rate1 = lr.reference.modes[0]
         .rate_discrete
         .unwrap_or(lr.reference.modes[0].rate_continuum);
+    if scene.is_membrane() && over == Over::Elements {
+        // The exact observable: λ_h/λ of mode 1, kT/λ over kT/λ_h.
+        let m = &r.modes[0];
+        discrete.push(m.variance_continuum / m.variance_equipartition);
+        limit.push(1.0);
+    }
     PointReference {
         value,
         h: h_of(scene, over, value),
@@ -477,9 +652,19 @@ fn reference_point(
 /// From the stability-limit computation (euler-maruyama over dt).
 pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>> {
     Ok(match over {
+        Over::Elements if scene.is_membrane() => membrane_default_elements(scene)?,
         Over::Elements => DEFAULT_ELEMENTS.iter().map(|&n| n as f64).collect(),
         // Schemes with a stability limit (the explicit ones): fractions of that limit.
         Over::Dt if scene.runs[run].integrator.stability_limit(1.0).is_some() => {
+            if let Some(m) = scene.membrane {
+                let plate = PlateModel::new(m, scene.mesh.elements, scene.mesh.elements_along_y())?;
+                let limit = scene.runs[run]
+                    .integrator
+                    .stability_limit(plate.max_rate()?)
+                    .unwrap_or(f64::INFINITY)
+                    / scene.tau1();
+                return Ok(DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect());
+            }
             let p = scene.filament;
             let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
             let limit = scene.runs[run]
@@ -491,6 +676,132 @@ pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>>
         }
         Over::Dt => DEFAULT_DT_TAU1.to_vec(),
     })
+}
+
+/// The default element counts along x of a membrane: [`DEFAULT_MEMBRANE_ELEMENTS`] if
+/// its coarsest mesh resolves the study's modes 1–3 ([`membrane_resolves`], the y count at
+/// the scene's aspect ratio of elements, [`membrane_elements_y`]); else s, 2s, 4s (s, 2s,
+/// 3s where 4s exceeds the cap) from the coarsest count s ≥ 4 that resolves them, one
+/// with both counts even (the centre on a node) if there is one. Counts are kept where
+/// both directions are within [`MEMBRANE_ELEMENTS_RANGE`]. A square mesh of a square or
+/// a 2 × 1 rectangle: 4, 8, 16.
+///
+/// # Errors
+/// As [`PlateModel::new`] and [`PlateModes::new`]; [`Error::InvalidParameter`] naming
+/// `--values` if fewer than two counts remain.
+fn membrane_default_elements(scene: &Scene) -> Result<Vec<f64>> {
+    let (_, hi) = MEMBRANE_ELEMENTS_RANGE;
+    let first = DEFAULT_MEMBRANE_ELEMENTS[0];
+    let within = |n: usize| n <= hi && membrane_elements_y(scene, n) <= hi;
+    let counts: Vec<usize> = if membrane_resolves(scene, first)? {
+        DEFAULT_MEMBRANE_ELEMENTS.to_vec()
+    } else {
+        let mut resolving = Vec::new();
+        for n in first..=hi / 2 {
+            if membrane_resolves(scene, n)? {
+                resolving.push(n);
+            }
+        }
+        let even =
+            |n: &&usize| n.is_multiple_of(2) && membrane_elements_y(scene, **n).is_multiple_of(2);
+        match resolving.iter().find(even).or(resolving.first()) {
+            Some(&s) if within(4 * s) => vec![s, 2 * s, 4 * s],
+            Some(&s) => vec![s, 2 * s, 3 * s],
+            None => Vec::new(),
+        }
+    };
+    let values: Vec<f64> = counts
+        .into_iter()
+        .filter(|&n| within(n))
+        .map(|n| n as f64)
+        .collect();
+    if values.len() < 2 {
+        return Err(Error::invalid(
+            "--values",
+            "(not given)",
+            format!(
+                "element counts given explicitly: at the aspect ratio of elements of {} ({} x {}) fewer than two default counts resolve the study's modes with at most {hi} elements a side",
+                scene.path.display(),
+                scene.mesh.elements,
+                scene.mesh.elements_along_y()
+            ),
+        ));
+    }
+    Ok(values)
+}
+
+/// Whether the mesh of membrane `scene` refined to `nx` elements along x (and
+/// [`membrane_elements_y`] along y) resolves the study's modes 1–3: each has an acoustic
+/// plate mode ([`PlateModes::acoustic`]), as the run's references need.
+///
+/// # Errors
+/// As [`PlateModel::new`] and [`PlateModes::new`]; `Ok(false)` for a y count below 1.
+fn membrane_resolves(scene: &Scene, nx: usize) -> Result<bool> {
+    let Some(p) = scene.membrane else {
+        return Ok(true);
+    };
+    let ny = membrane_elements_y(scene, nx);
+    if ny == 0 {
+        return Ok(false);
+    }
+    let modes = PlateModes::new(&PlateModel::new(p, nx, ny)?)?;
+    Ok(Membrane::new(p)?
+        .modes(N_MODES)?
+        .iter()
+        .all(|m| modes.acoustic(*m).is_some()))
+}
+
+/// Validates the element counts of a study of membrane `scene`: integers within
+/// [`MEMBRANE_ELEMENTS_RANGE`] along x, and along y at the scene's aspect ratio of
+/// elements ([`membrane_elements_y`]), whose meshes resolve the study's modes 1–3.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--values`, the value and the allowed range.
+pub fn validate_membrane_elements(scene: &Scene, values: &[f64]) -> Result<()> {
+    let (lo, hi) = MEMBRANE_ELEMENTS_RANGE;
+    let file = scene.path.display();
+    for &v in values {
+        if !(v.fract() == 0.0 && v >= lo as f64 && v <= hi as f64) {
+            return Err(Error::invalid(
+                "--values",
+                v,
+                format!(
+                    "integer element counts in [{lo}, {hi}] for a membrane ({file}: the references decompose the plate's 4(nx+1)(ny+1) unknowns densely)"
+                ),
+            ));
+        }
+        let ny = membrane_elements_y(scene, v as usize);
+        if !(lo..=hi).contains(&ny) {
+            return Err(Error::invalid(
+                "--values",
+                v,
+                format!(
+                    "element counts whose count along y, round({v} x {}/{}) = {ny} at the aspect ratio of elements of {file}, is in [{lo}, {hi}] too",
+                    scene.mesh.elements_along_y(),
+                    scene.mesh.elements
+                ),
+            ));
+        }
+        if !membrane_resolves(scene, v as usize)? {
+            let labels: Vec<String> = match scene.membrane {
+                Some(p) => Membrane::new(p)?
+                    .modes(N_MODES)?
+                    .into_iter()
+                    .map(mode_label)
+                    .collect(),
+                None => Vec::new(),
+            };
+            return Err(Error::invalid(
+                "--values",
+                v,
+                format!(
+                    "element counts whose {v} x {ny} mesh of {file} resolves the study's modes {} (a simply supported mode (m,n) needs m < nx and n < ny; a periodic one 2|m| < nx and 2|n| < ny)",
+                    labels.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Validates the values of a study: at least two, distinct, in range.
@@ -631,7 +942,7 @@ pub fn projected_work(
                 drivers: format!(
                     "{} ({} elements, dt_tau1 = {})",
                     drivers.join(", "),
-                    s.mesh.elements,
+                    mesh_text(&s),
                     Num(s.runs.get(run).map_or(f64::NAN, |r| r.dt_tau1))
                 ),
                 origin: Origin::Flags(flags.clone()),
@@ -785,8 +1096,15 @@ pub struct ObservableSummary {
     /// Values whose exact error is at round-off (the discretization is exact there).
     pub exact_at_rounding: Vec<f64>,
     /// Whether the observed order agrees with the expected one: its confidence interval
-    /// holds the expected order (`None` without an expected order or an interval).
+    /// holds the expected order (`None` without an expected order or an interval). For
+    /// an exact observable ([`ObservableSummary::unsampled`]), the exact-error order's
+    /// interval.
     pub agrees: Option<bool>,
+    /// An exact observable: computed without sampling (every standard error zero), so
+    /// it has no observed order, only its exact-error order (the membrane's λ_h/λ).
+    /// Absent from the JSON when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub unsampled: bool,
     /// Why no observed order was fitted, if none was, or why it differs from the
     /// expected one.
     pub note: String,
@@ -1007,9 +1325,9 @@ pub fn select_run(scene: &Scene, name: Option<&str>) -> Result<usize> {
 /// `<scene>-<run>-<over>.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad input (exit 2) naming the flag, or a membrane scene ([`Scene::refuse_membrane`]);
-/// run failures (exit 3). A value whose run diverges, or whose estimators fail, is
-/// recorded in [`ConvergeSummary::failed`], not fatal.
+/// Bad input (exit 2) naming the flag; run failures (exit 3). A value whose run
+/// diverges, or whose estimators fail, is recorded in [`ConvergeSummary::failed`], not
+/// fatal.
 pub fn run_convergence(opts: &ConvergeOptions) -> Result<ConvergeSummary> {
     let start = Instant::now();
     let setup = setup(opts)?;
@@ -1053,8 +1371,6 @@ pub(crate) struct Setup {
 /// # Errors
 /// Bad input (exit 2) naming the flag.
 fn setup(opts: &ConvergeOptions) -> Result<Setup> {
-    opts.scene
-        .refuse_membrane("the convergence study (converge)")?;
     let run = select_run(&opts.scene, opts.run.as_deref())?;
     let mut scene = opts.scene.clone();
     let mut label = scene.runs[run].name.clone();
@@ -1113,16 +1429,16 @@ fn linear_study(
     let values = linear_values(scene, run, opts)?;
     let work = projected_work(scene, run, opts, ensemble, &values, None);
     opts.limits.check(&work.scaled(source.fraction()))?;
-    let names = observable_names();
-    let limit_dt = match over {
-        Over::Dt => Some(semi_discrete_limit(scene, spec)?),
-        Over::Elements => None,
-    };
+    let names = observable_names(scene, over)?;
     // Prepare everything first, so that bad input fails before any simulation.
     let prepared = values
         .iter()
         .map(|&v| prepare(scene, run, over, v))
         .collect::<Result<Vec<_>>>()?;
+    let limit_dt = match (over, prepared.first()) {
+        (Over::Dt, Some((_, lr))) => Some(semi_discrete_limit(scene, lr, spec)?),
+        _ => None,
+    };
     let mut rows = Vec::new();
     let mut failed = Vec::new();
     let mut largest_slope: Option<(f64, (f64, f64))> = None;
@@ -1145,7 +1461,11 @@ fn linear_study(
             }
         };
         let est = match estimates(lr, &records) {
-            Ok(est) => est,
+            // The exact observables (past the sampled ones) are their exact values.
+            Ok(mut est) => {
+                est.extend(refp.discrete[SAMPLED..].iter().map(|&d| (d, 0.0)));
+                est
+            }
             Err(e) => {
                 failed.push(FailedValue::record(v, e)?);
                 continue;
@@ -1169,14 +1489,31 @@ fn linear_study(
             );
         }
     }
-    let node_at_mid = match over {
-        Over::Elements => values
-            .iter()
-            .all(|v| (v.round() as usize).is_multiple_of(2)),
-        Over::Dt => scene.mesh.elements.is_multiple_of(2),
+    let object = if scene.is_membrane() {
+        StudyObject::Membrane {
+            centre_alike: match over {
+                Over::Elements => {
+                    let parities = |v: &f64| {
+                        let nx = v.round() as usize;
+                        (nx % 2, membrane_elements_y(scene, nx) % 2)
+                    };
+                    values.iter().all(|v| parities(v) == parities(&values[0]))
+                }
+                Over::Dt => true,
+            },
+        }
+    } else {
+        StudyObject::Filament {
+            node_at_mid: match over {
+                Over::Elements => values
+                    .iter()
+                    .all(|v| (v.round() as usize).is_multiple_of(2)),
+                Over::Dt => scene.mesh.elements.is_multiple_of(2),
+            },
+        }
     };
     let expected = (0..names.len())
-        .map(|k| expected_order(over, spec, k, node_at_mid))
+        .map(|k| expected_order(over, spec, k, object))
         .collect();
     let (notes, warnings) = slope_notes(scene, over, largest_slope);
     let (limit_reference, fixed) = linear_texts(scene, spec, over);
@@ -1201,6 +1538,9 @@ fn linear_values(scene: &Scene, run: usize, opts: &ConvergeOptions) -> Result<Ve
         Some(v) => v.clone(),
         None => default_values(scene, run, over)?,
     };
+    if over == Over::Elements && scene.is_membrane() {
+        validate_membrane_elements(scene, &values)?;
+    }
     validate_values(over, &values)?;
     values.sort_by(|a, b| h_of(scene, over, *b).total_cmp(&h_of(scene, over, *a)));
     Ok(values)
@@ -1262,6 +1602,11 @@ fn slope_notes(
 /// What the errors of a linear study are measured against, and its fixed parameter.
 fn linear_texts(scene: &Scene, spec: &RunSpec, over: Over) -> (String, String) {
     match over {
+        Over::Elements if scene.is_membrane() => (
+            "continuum (M1): mode variance kT/lambda_q = kT xi/(kappa q^4 + sigma q^2) (damping-normalized modes), <h^2(a/2, b/2)> the exact sum over the modes (M3); the eigenvalue ratio lambda_h/lambda against 1"
+                .to_string(),
+            format!("dt_tau1 = {:e}", spec.dt_tau1),
+        ),
         Over::Elements => (
             "continuum (eq. 2): mode variance 2kTL^3/(pi^4 n^4 EI), profile kT x^2(L-x)^2/(3 EI L)"
                 .to_string(),
@@ -1270,9 +1615,9 @@ fn linear_texts(scene: &Scene, spec: &RunSpec, over: Over) -> (String, String) {
         Over::Dt => (
             format!(
                 "dt -> 0 limit of this mesh ({} elements) and noise model: S_ij = 2kT Sigma_q,ij/(lambda_i + lambda_j)",
-                scene.mesh.elements
+                mesh_text(scene)
             ),
-            format!("elements = {}", scene.mesh.elements),
+            format!("elements = {}", mesh_text(scene)),
         ),
     }
 }
@@ -1306,7 +1651,7 @@ fn finish(
         integrator: spec.integrator.name().to_string(),
         noise: spec.noise.name().to_string(),
         over,
-        h: over.h_label().to_string(),
+        h: h_label(scene, over).to_string(),
         limit_reference: study.limit_reference,
         budget: opts.budget.name().to_string(),
         trajectories: ensemble.trajectories,
@@ -1334,6 +1679,9 @@ pub fn summarize(names: &[String], rows: &[Row], expected: &[Expected]) -> Vec<O
         .zip(expected)
         .map(|(name, expected)| {
             let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
+            if is_unsampled(&rs) {
+                return unsampled_summary(name, expected, &rs);
+            }
             let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
             let all_exact = !rs.is_empty() && rs.iter().all(|r| r.exact_at_rounding);
             let within = rs.iter().filter(|r| r.sampling_floor).count();
@@ -1420,10 +1768,69 @@ pub fn summarize(names: &[String], rows: &[Row], expected: &[Expected]) -> Vec<O
                     .map(|r| r.value)
                     .collect(),
                 agrees,
+                unsampled: false,
                 note,
             }
         })
         .collect()
+}
+
+/// Whether the rows of an observable are of an exact observable: computed, not sampled
+/// (every standard error zero).
+fn is_unsampled(rs: &[&Row]) -> bool {
+    !rs.is_empty() && rs.iter().all(|r| r.std_error == 0.0)
+}
+
+/// The summary of an exact observable (rows `rs`, no sampling): no observed order; its
+/// exact-error order, with its interval, is compared with the expected one.
+fn unsampled_summary(name: &str, expected: &Expected, rs: &[&Row]) -> ObservableSummary {
+    let exact = exact_order_fit(rs);
+    let agrees = match (expected.order, exact.and_then(|f| f.ci)) {
+        (Some(p), Some((lo, hi))) => Some(lo <= p && p <= hi),
+        _ => None,
+    };
+    let at_rounding: Vec<f64> = rs
+        .iter()
+        .filter(|r| r.exact_at_rounding)
+        .map(|r| r.value)
+        .collect();
+    let order = match (exact, expected.order) {
+        (Some(f), Some(p)) => {
+            let ci =
+                f.ci.map_or("no interval (2 points)".to_string(), |(lo, hi)| {
+                    format!("95 % interval [{lo:.2}, {hi:.2}]")
+                });
+            let verdict = match agrees {
+                Some(true) => format!("agrees with the expected {p}"),
+                Some(false) => format!("differs from the expected {p}: its interval excludes it"),
+                None => format!("no interval to compare with the expected {p}"),
+            };
+            format!(
+                "exact-error order {:.2} ({ci}, {} points) {verdict}",
+                f.order, f.points
+            )
+        }
+        (Some(f), None) => format!("exact-error order {:.2} ({} points)", f.order, f.points),
+        (None, _) => "too few points above round-off for an order".to_string(),
+    };
+    ObservableSummary {
+        observable: name.to_string(),
+        expected: expected.clone(),
+        observed: None,
+        floor_values: Vec::new(),
+        exact,
+        agrees,
+        unsampled: true,
+        note: format!(
+            "an exact observable (no sampling): its error is the exact discrete error, so no observed order is fitted; {order}{}",
+            if at_rounding.is_empty() {
+                String::new()
+            } else {
+                format!("; at round-off at {at_rounding:?}")
+            }
+        ),
+        exact_at_rounding: at_rounding,
+    }
 }
 
 /// The order of the exact error, fitted on the rows whose exact error is known and
@@ -1524,12 +1931,17 @@ fn figure(
     rows: &[Row],
 ) -> Figure {
     let units = AxisUnits::new(scene.physical.is_some());
+    let membrane = scene.is_membrane();
     let x_label = match over {
+        Over::Elements if membrane => format!("element width h = a/N_x {}", units.length()),
         Over::Elements => format!("element length h = L/N {}", units.length()),
         Over::Dt => "time step h = Δt / τ₁".to_string(),
     };
     let y_label = match scene.model {
         ModelKind::Compression => "|error of ⟨F⟩| / F_c0".to_string(),
+        ModelKind::Fem | ModelKind::Spectral if membrane && over == Over::Elements => {
+            format!("|error| {} (λ_h/λ: relative)", units.area())
+        }
         ModelKind::Fem | ModelKind::Spectral => format!("|error| {}", units.area()),
     };
     let mut fig = Figure::new(
@@ -1573,9 +1985,14 @@ fn figure(
 fn observable_series(mut fig: Figure, hue: usize, o: &ObservableSummary, rows: &[Row]) -> Figure {
     let name = &o.observable;
     let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
-    let res: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+    // An exact observable (no sampling) has its exact error and the fit of its order only.
+    let unsampled = is_unsampled(&rs);
+    let res: Vec<&&Row> = rs
+        .iter()
+        .filter(|r| !(r.sampling_floor || unsampled && r.exact_at_rounding))
+        .collect();
     let floor: Vec<&&Row> = rs.iter().filter(|r| r.sampling_floor).collect();
-    if !res.is_empty() {
+    if !res.is_empty() && !unsampled {
         fig = fig.series(
             Series::markers(
                 format!("{name}: simulated"),
@@ -1585,7 +2002,7 @@ fn observable_series(mut fig: Figure, hue: usize, o: &ObservableSummary, rows: &
             .palette(hue),
         );
     }
-    if !floor.is_empty() {
+    if !floor.is_empty() && !unsampled {
         // At the floor the error is not resolved: drawn at 3 standard errors (an
         // upper bound), without error bars.
         fig = fig.series(
@@ -1612,10 +2029,8 @@ fn observable_series(mut fig: Figure, hue: usize, o: &ObservableSummary, rows: &
                 .light(),
         );
     }
-    if let Some(f) = o
-        .observed
-        .filter(|f| f.order.is_finite() && f.prefactor > 0.0)
-    {
+    let fit = if unsampled { o.exact } else { o.observed };
+    if let Some(f) = fit.filter(|f| f.order.is_finite() && f.prefactor > 0.0) {
         let (lo, hi) = res.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
             (lo.min(r.h), hi.max(r.h))
         });
@@ -1624,8 +2039,13 @@ fn observable_series(mut fig: Figure, hue: usize, o: &ObservableSummary, rows: &
                 .iter()
                 .map(|&h| (h, f.prefactor * h.powf(f.order)))
                 .collect();
+            let what = if unsampled {
+                "fit of the exact error"
+            } else {
+                "fit"
+            };
             fig = fig.series(
-                Series::line(format!("{name}: fit, order {:.2}", f.order), line)
+                Series::line(format!("{name}: {what}, order {:.2}", f.order), line)
                     .dashed()
                     .palette(hue),
             );
