@@ -10,6 +10,9 @@
 //!   "(dimensionless)"; every figure listed in `summary.json` has a caption, which is
 //!   also the SVG's `<title>`; the linear runs have their ⟨w²(x)⟩ and two-time figures;
 //!   the files stay small (under 200 kB, at most 1400 px wide);
+//! - a quick `verify` of the membrane fixture writes the height spectrum (log–log against
+//!   |q|), the m, n, q columns of its mode tables and figures worded for the membrane
+//!   ((M5), (M4), c_q/ξ; no filament formula), each with units and a caption;
 //! - the stability map draws each cell as a disc in its status colour — stable green
 //!   `#1A7F37`, biased amber `#E69100`, unstable red `#CF222E` — counted against the
 //!   statuses in `stability-cells.csv` (plus one legend disc per status), and every
@@ -18,9 +21,9 @@
 //!   corner puts it there; a pair of series joined in the legend shares one colour, the
 //!   reference one in a lighter tint.
 //!
-//! The verify run takes a few seconds (quick budget of two scenes), the stability map a
-//! fraction of a second (two meshes, short runs): the statuses it finds do not matter,
-//! only that each is drawn in its colour.
+//! The verify run takes a few seconds (quick budget of two scenes), the membrane fixture's
+//! about one, the stability map a fraction of a second (two meshes, short runs): the
+//! statuses it finds do not matter, only that each is drawn in its colour.
 
 mod common;
 
@@ -170,6 +173,126 @@ fn verify_figures_have_units_and_captions() {
     // Every SVG written is listed with its caption (fig2.svg under the compression
     // scene).
     assert_eq!(listed, files.len(), "{files:?}");
+}
+
+/// A quick `verify` of the membrane fixture (issue #27; about a second): its run has the
+/// height spectrum `<run>-height-spectrum.svg` — log–log, |q| with its unit, the simulated
+/// markers with error bars, the continuum law (M3) and the discrete discs — listed with its
+/// caption in `summary.json` and in `index.html`; its mode tables carry `m`, `n` and `q`
+/// after `mode` (known to the column dictionary, with the slowest mode (1, 1) at
+/// |q| = π√2); its profile, two-time and rates figures are worded for the membrane
+/// ((M5), (M4), c_q/ξ) and not for the filament (EI, eq. (4), n⁴). Every figure has axis
+/// units and a caption that says what to see, as the filament's.
+#[test]
+fn membrane_report_has_its_spectrum_mode_labels_and_profile() {
+    let tmp = TempDir::new("figures_membrane");
+    let out = tmp.join_str("out");
+    let scene = common::fixture("tests/scenes/good/membrane-hinged.toml");
+    let scene = scene.to_string_lossy();
+    let args = ["verify", "--scene", &scene, "--out", &out];
+    let o = run(&args);
+    assert_no_panic(&args, &o);
+    // Exit 1 (a check failed) is a legitimate outcome of a tiny ensemble; the outputs are
+    // written either way.
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        describe(&args, &o)
+    );
+    let out = Path::new(&out);
+    let dir = out.join("membrane-hinged");
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).expect(f);
+
+    // The height spectrum: log–log, |q| with its unit, markers, curve and discs.
+    let svg = read("crank-nicolson-height-spectrum.svg");
+    let (x, y) = axis_labels(&svg);
+    assert!(x.contains("|q|") && has_unit(&x), "{x}");
+    assert!(y.contains("⟨a²⟩") && has_unit(&y), "{y}");
+    let texts = svg_texts(&svg);
+    for legend in [
+        "continuum (M3): 4kT/(A c_q)",
+        "simulated (±1 s.e.)",
+        "exact, discretized",
+    ] {
+        assert!(
+            texts.iter().any(|t| t.starts_with(legend)),
+            "{legend} not in {texts:?}"
+        );
+    }
+    // Decade ticks of both log axes (10⁻², 10⁻³ on the variances).
+    assert!(texts.iter().any(|t| t.contains("10⁻")), "{texts:?}");
+
+    // The mode tables: m, n, q after mode, every column in the dictionary.
+    let manifest = json(&out.join("manifest.json"));
+    for (table, rest) in [
+        ("crank-nicolson-modes.csv", "predicted_ratio"),
+        ("crank-nicolson-mode-statistics.csv", "variance"),
+    ] {
+        let text = read(table);
+        let mut lines = text.lines();
+        let header = lines.next().expect("header");
+        assert!(
+            header.starts_with(&format!("mode,m,n,q,{rest},")),
+            "{header}"
+        );
+        let first: Vec<f64> = lines
+            .next()
+            .expect("row")
+            .split(',')
+            .map(|v| v.parse().expect("number"))
+            .collect();
+        assert_eq!(first[..3], [1.0, 1.0, 1.0], "{table}");
+        let q = std::f64::consts::PI * 2f64.sqrt();
+        assert!((first[3] / q - 1.0).abs() < 1e-12, "{table}: {first:?}");
+        let columns = &manifest["columns"][format!("membrane-hinged/{table}")]["columns"];
+        let columns = columns.as_array().expect("columns");
+        assert!(columns.iter().all(|c| !c["unit"].is_null()), "{columns:?}");
+        assert_eq!(columns[3]["unit"], "1/[L]");
+    }
+
+    // Every figure listed with a caption that says what to see; the membrane's words.
+    let summary = json(&out.join("summary.json"));
+    let scene = &summary["scenes"][0];
+    let figures = strings(&scene["figures"]);
+    let captions = strings(&scene["captions"]);
+    assert_eq!(figures.len(), captions.len());
+    assert_eq!(figures.len(), svg_files(out).len(), "{figures:?}");
+    let caption = |name: &str| -> &str {
+        let k = figures
+            .iter()
+            .position(|f| f.ends_with(name))
+            .unwrap_or_else(|| panic!("{name} not listed in {figures:?}"));
+        &captions[k]
+    };
+    for (fig, caption) in figures.iter().zip(&captions) {
+        assert!(caption.contains("should"), "{fig}: {caption}");
+        let svg = std::fs::read_to_string(out.join(fig)).expect("listed figure exists");
+        let (x, y) = axis_labels(&svg);
+        assert!(has_unit(&x) && has_unit(&y), "{fig}: {x} / {y}");
+        assert!(!svg.contains("filament") && !svg.contains("EI"), "{fig}");
+    }
+    let spectrum = caption("crank-nicolson-height-spectrum.svg");
+    assert!(
+        spectrum.contains("q⁻⁴") && spectrum.contains("(1, 1)"),
+        "{spectrum}"
+    );
+    let profile = caption("crank-nicolson-profile.svg");
+    assert!(
+        profile.contains("membrane") && profile.contains("(M5)") && profile.contains("b/2"),
+        "{profile}"
+    );
+    let two_time = caption("crank-nicolson-two-time.svg");
+    assert!(
+        two_time.contains("(M4)") && !two_time.contains("eq. (4)"),
+        "{two_time}"
+    );
+    let rates = read("crank-nicolson-rates.svg");
+    assert!(!rates.contains("n⁴") && rates.contains("c_q/ξ"));
+
+    // The index shows the height spectrum with its caption.
+    let index = std::fs::read_to_string(out.join("index.html")).expect("index");
+    assert!(index.contains("membrane-hinged/crank-nicolson-height-spectrum.svg"));
+    assert!(index.contains("Height fluctuation spectrum"));
 }
 
 /// The stability map: every cell a disc in its status colour, the count of each colour

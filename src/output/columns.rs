@@ -16,6 +16,7 @@
 //! | unit | meaning |
 //! |---|---|
 //! | `[L]`, `[L]^2` | scene length (the unit of `filament.length`), its square |
+//! | `1/[L]` | an inverse length (a wavenumber) |
 //! | `[T]`, `1/[T]` | scene time (the unit that ξ, L and EI imply; τ₁ is given in it): physical time, *not* a multiple of τ₁ |
 //! | `[L]^2*[T]` | a power spectral density of a length (one-sided, per unit of frequency) |
 //! | `tau1` | a multiple of τ₁ = ξL⁴/(π⁴EI) |
@@ -59,6 +60,14 @@ const fn col(name: &'static str, unit: &'static str, meaning: &'static str) -> C
     }
 }
 
+/// A membrane's mode in the per-mode tables of `verify` (after `mode`): its lattice
+/// indices m, n and wavenumber |q| (a filament's tables have no such columns).
+const MODE_M: Column = col("m", "1", "membrane only: lattice index of the mode along x");
+/// See [`MODE_M`].
+const MODE_N: Column = col("n", "1", "membrane only: lattice index of the mode along y");
+/// See [`MODE_M`].
+const MODE_Q: Column = col("q", "1/[L]", "membrane only: wavenumber |q| of the mode");
+
 /// Every kind of CSV table `verify`, `converge`, `stability`, `work-precision` and
 /// `calibrate` write.
 pub const TABLES: &[TableKind] = &[
@@ -67,6 +76,9 @@ pub const TABLES: &[TableKind] = &[
         meaning: "verify, linear scene, per run: stationary variance and relaxation rate of each checked mode (modal amplitude a_n, w = sum a_n phi_n(x), phi_n -> sin(n pi x/L))",
         columns: &[
             col("mode", "1", "mode number n"),
+            MODE_M,
+            MODE_N,
+            MODE_Q,
             col("variance", "[L]^2", "simulated stationary variance of a_n"),
             col("variance_std_error", "[L]^2", "its standard error"),
             col(
@@ -102,6 +114,9 @@ pub const TABLES: &[TableKind] = &[
         meaning: "verify, linear scene, per run: modal variance relative to equipartition kT/lambda_i of the discrete modes",
         columns: &[
             col("mode", "1", "mode number n"),
+            MODE_M,
+            MODE_N,
+            MODE_Q,
             col(
                 "predicted_ratio",
                 "1",
@@ -517,6 +532,7 @@ mod tests {
         let units = [
             "[L]",
             "[L]^2",
+            "1/[L]",
             "[T]",
             "1/[T]",
             "[L]^2*[T]",

@@ -671,7 +671,7 @@ fn pooled_variance_check(ctx: &mut LinearContext<'_>) -> Result<()> {
     let total: f64 = weights.iter().sum();
     let per_mode: Vec<Vec<f64>> = (0..nm).map(|i| normalized_variances(ctx, i)).collect();
     let n_series = per_mode.first().map_or(0, Vec::len);
-    if n_series < MIN_SERIES_FOR_T || !(total > 0.0) {
+    if n_series < MIN_SERIES_FOR_T || total.is_nan() || total <= 0.0 {
         ctx.est.skipped.push(SkippedCheck {
             name,
             reason: format!(

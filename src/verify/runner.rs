@@ -24,7 +24,15 @@
 //! - a linear scene, per run `<run>`: `<run>-modes.csv` and `.svg` (modal variance against
 //!   equipartition, when estimated), `<run>-mode-statistics.csv`, `<run>-rates.svg` (when
 //!   rates were estimated), `<run>-profile.csv` and `.svg`, `<run>-two-time.csv` and
-//!   `.svg`, `<run>-spectrum.csv` and `.svg` (when the checks produced them);
+//!   `.svg`, `<run>-spectrum.csv` and `.svg` (Welch spectra per mode; when the checks
+//!   produced them);
+//! - a membrane scene, in addition: `<run>-height-spectrum.svg` (each mode's variance
+//!   against its wavenumber |q| on log–log axes, with the continuum law (M3), when the
+//!   variances were estimated), and the columns `m`, `n` (lattice indices) and `q` (|q|)
+//!   after `mode` in `<run>-modes.csv` and `<run>-mode-statistics.csv`; its profile and
+//!   two-time outputs are on the midline y = b/2, against (M5) and (M4). The words and
+//!   continuum curves of every figure are the object's (`subject.rs`); a filament's
+//!   outputs are the same as before membranes ran here;
 //! - a `fem` scene with an element-uniform run: the element-count study of that noise
 //!   (theory only, [`element_uniform_variance_ratios`]), `element-uniform-vs-elements.csv`
 //!   and `.svg` and a note, written right after the outputs of the first such run;
@@ -53,7 +61,6 @@ use crate::scene::compression::{
 use crate::scene::linear::{LinearRun, TrajectoryRecord, small_slope_warning};
 use crate::scene::{Budget, CheckKind, Ensemble, ModelKind, PrecisionTarget, Scene};
 use crate::shard::{Shard, ShardSet};
-use crate::spectral::HingedBeam;
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
@@ -62,6 +69,9 @@ use crate::verify::summary::{CheckResult, SceneSummary, SkippedCheck, Summary};
 use crate::work::{WorkLimits, WorkProjection};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use subject::Subject;
+
+mod subject;
 
 /// Options of a verification run.
 #[derive(Debug, Clone)]
@@ -1373,7 +1383,8 @@ fn linear_run_note(scene: &Scene, run: &LinearRun, e: &Ensemble) -> String {
     )
 }
 
-/// The tables and figures of one linear run (see the [module docs](self)), in this order.
+/// The tables and figures of one linear run (see the [module docs](self)), in this order,
+/// worded and drawn for the scene's object ([`Subject`], built here: it is cheap).
 fn write_run_outputs(
     scene: &Scene,
     dir: &Path,
@@ -1382,115 +1393,175 @@ fn write_run_outputs(
     outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let units = AxisUnits::new(scene.physical.is_some());
+    let subject = Subject::of(scene)?;
     if est.modes.iter().any(|m| m.variance.1 > 0.0) {
-        write_mode_variances(dir, run, est, outputs)?;
+        write_mode_variances(&subject, dir, run, est, outputs)?;
+        if subject.is_membrane() {
+            write_height_spectrum(&subject, units, dir, run, est, outputs)?;
+        }
     }
-    write_mode_statistics(dir, run, est, outputs)?;
+    write_mode_statistics(&subject, dir, run, est, outputs)?;
     if !est.profile.is_empty() {
-        write_profile(scene, units, dir, run, est, outputs)?;
+        write_profile(&subject, units, dir, run, est, outputs)?;
     }
     if !est.two_time.is_empty() {
-        write_two_time(scene, units, dir, run, est, outputs)?;
+        write_two_time(scene, &subject, units, dir, run, est, outputs)?;
     }
-    write_spectra(units, dir, run, est, outputs)
+    write_spectra(&subject, units, dir, run, est, outputs)
 }
-
-/// Label of a mode-number axis.
-const MODE_LABEL: &str = "mode n (dimensionless)";
 
 /// `<run>-modes.csv` and `.svg`: the modal variances relative to equipartition,
 /// simulated against the exact discrete and the continuum values.
 fn write_mode_variances(
+    subject: &Subject,
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
     outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let name = &run.spec.name;
-    let modes: Vec<_> = run.reference.modes.iter().zip(&est.modes).collect();
+    let refs = &run.reference.modes;
+    let modes: Vec<_> = refs.iter().zip(&est.modes).collect();
     let path = dir.join(format!("{name}-modes.csv"));
-    let rows: Vec<Vec<f64>> = modes
+    // (mode, predicted ratio, simulated ratio, its standard error, continuum ratio).
+    let ratios: Vec<[f64; 5]> = modes
         .iter()
         .map(|(mr, me)| {
             let eq = mr.variance_equipartition;
-            vec![
+            [
                 mr.n as f64,
                 mr.variance_discrete / eq,
                 me.variance.0 / eq,
                 me.variance.1 / eq,
+                mr.variance_continuum / eq,
             ]
+        })
+        .collect();
+    let rows: Vec<Vec<f64>> = modes
+        .iter()
+        .zip(&ratios)
+        .map(|((mr, _), r)| {
+            let mut row = subject.mode_columns(mr);
+            row.extend(&r[1..4]);
+            row
         })
         .collect();
     outputs.write_table(
         path,
-        &["mode", "predicted_ratio", "simulated_ratio", "std_error"],
+        &subject.mode_header(&["predicted_ratio", "simulated_ratio", "std_error"]),
         &rows,
     )?;
-    let continuum = modes
-        .iter()
-        .map(|(mr, _)| {
-            (
-                mr.n as f64,
-                mr.variance_continuum / mr.variance_equipartition,
+    let words = subject.variance_words(name, refs);
+    let fig = Figure::new(words.title, words.x_label, words.y_label)
+        .series(
+            Series::line(
+                words.discrete,
+                ratios.iter().map(|r| (r[0], r[1])).collect(),
             )
-        })
-        .collect();
-    let fig = Figure::new(
-        format!("{name}: stationary variance of each mode"),
-        MODE_LABEL,
-        "⟨aₙ²⟩ / (kT/λᵢ) (dimensionless)",
-    )
-    .series(
-        Series::line(
-            "exact, discretized system and integrator",
-            rows.iter().map(|r| (r[0], r[1])).collect(),
+            .palette(1),
         )
-        .palette(1),
-    )
-    .series(
-        Series::line("continuum kT/λₙ", continuum)
+        .series(
+            Series::line(
+                words.continuum,
+                ratios.iter().map(|r| (r[0], r[4])).collect(),
+            )
             .dashed()
             .palette(2),
-    )
-    .series(
-        Series::markers(
-            "simulated (±1 s.e.)",
-            rows.iter().map(|r| (r[0], r[2])).collect(),
         )
-        .with_errors(rows.iter().map(|r| r[3]).collect())
-        .palette(0),
-    )
-    .hline(1.0, "equipartition kT/λᵢ")
-    .caption(
-        "Stationary variance of each mode aₙ relative to equipartition kT/λᵢ of the \
-         discrete mode, simulated (markers, ±1 s.e.) against the exact variance of the \
-         discretized system and integrator (solid line) and the continuum value \
-         (dashed line). The markers should scatter about the solid line within their \
-         error bars; a systematic offset is an integrator or noise bias. The solid line's \
-         distance from 1 is the time step's exact bias.",
-    );
+        .series(
+            Series::markers(
+                "simulated (±1 s.e.)",
+                ratios.iter().map(|r| (r[0], r[2])).collect(),
+            )
+            .with_errors(ratios.iter().map(|r| r[3]).collect())
+            .palette(0),
+        )
+        .hline(1.0, "equipartition kT/λᵢ")
+        .caption(words.caption);
     outputs.write_figure(&fig, dir.join(format!("{name}-modes.svg")))?;
     Ok(())
+}
+
+/// `<run>-height-spectrum.svg` of a membrane: the stationary variance of each checked
+/// mode against its wavenumber |q| on log–log axes, simulated (±1 s.e.), exact discrete
+/// and the continuum law (M3), all in the normalization of (M3) (finite-element
+/// amplitudes scaled by [`Subject::Membrane::to_sine`]).
+fn write_height_spectrum(
+    subject: &Subject,
+    units: AxisUnits,
+    dir: &Path,
+    run: &LinearRun,
+    est: &LinearEstimates,
+    outputs: &mut SceneOutputs<'_>,
+) -> Result<()> {
+    let Subject::Membrane { to_sine, .. } = *subject else {
+        return Ok(());
+    };
+    let name = &run.spec.name;
+    let refs = &run.reference.modes;
+    // (|q|, simulated, its standard error, exact discrete), in (M3)'s normalization.
+    let points: Vec<[f64; 4]> = refs
+        .iter()
+        .zip(&est.modes)
+        .map(|(mr, me)| {
+            [
+                subject.wavenumber(mr),
+                to_sine * me.variance.0,
+                to_sine * me.variance.1,
+                to_sine * mr.variance_discrete,
+            ]
+        })
+        .collect();
+    let qs: Vec<f64> = points.iter().map(|p| p[0]).collect();
+    let words = subject.spectrum_words(name, units, refs);
+    let fig = Figure::new(words.title, words.x_label, words.y_label)
+        .log_x()
+        .log_y()
+        .series(
+            Series::line(words.continuum, subject.spectrum_curve(&qs))
+                .dashed()
+                .palette(2),
+        )
+        .series(
+            Series::markers(
+                words.discrete,
+                points.iter().map(|p| (p[0], p[3])).collect(),
+            )
+            .palette(1)
+            .light()
+            .marker_radius(8),
+        )
+        .series(
+            Series::markers(
+                "simulated (±1 s.e.)",
+                points.iter().map(|p| (p[0], p[1])).collect(),
+            )
+            .with_errors(points.iter().map(|p| p[2]).collect())
+            .palette(0),
+        )
+        .caption(words.caption);
+    outputs.write_figure(&fig, dir.join(format!("{name}-height-spectrum.svg")))
 }
 
 /// `<run>-mode-statistics.csv` (variance and rate per mode, simulated, exact discrete and
 /// continuum) and, when rates were estimated, `<run>-rates.svg`.
 fn write_mode_statistics(
+    subject: &Subject,
     dir: &Path,
     run: &LinearRun,
     est: &LinearEstimates,
     outputs: &mut SceneOutputs<'_>,
 ) -> Result<()> {
     let name = &run.spec.name;
+    let refs = &run.reference.modes;
     let stats_path = dir.join(format!("{name}-mode-statistics.csv"));
-    let rows: Vec<Vec<f64>> = run
-        .reference
-        .modes
+    let label_columns = subject.mode_header(&[]).len();
+    let rows: Vec<Vec<f64>> = refs
         .iter()
         .zip(&est.modes)
         .map(|(mr, me)| {
-            vec![
-                mr.n as f64,
+            let mut row = subject.mode_columns(mr);
+            row.extend([
                 me.variance.0,
                 me.variance.1,
                 mr.variance_discrete,
@@ -1499,13 +1570,13 @@ fn write_mode_statistics(
                 me.rate.1,
                 mr.rate_discrete.unwrap_or(f64::NAN),
                 mr.rate_continuum,
-            ]
+            ]);
+            row
         })
         .collect();
     outputs.write_table(
         stats_path,
-        &[
-            "mode",
+        &subject.mode_header(&[
             "variance",
             "variance_std_error",
             "variance_discrete",
@@ -1514,51 +1585,42 @@ fn write_mode_statistics(
             "rate_std_error",
             "rate_discrete",
             "rate_continuum",
-        ],
+        ]),
         &rows,
     )?;
     if est.modes.iter().any(|m| m.rate.0.is_finite()) {
-        let fig = Figure::new(
-            format!("{name}: relaxation rate of each mode"),
-            MODE_LABEL,
-            "rate / λₙ (dimensionless)",
-        )
-        .series(
-            Series::line(
-                "exact, discrete update: −ln(m)/Δt",
-                rows.iter().map(|r| (r[0], r[7] / r[8])).collect(),
+        // Each row's mode number, then its columns after the labels: variance (4), rate,
+        // its error, discrete rate and continuum rate.
+        let at = |r: &Vec<f64>, k: usize| r[label_columns + k - 1];
+        let words = subject.rate_words(name, refs);
+        let fig = Figure::new(words.title, words.x_label, words.y_label)
+            .series(
+                Series::line(
+                    words.discrete,
+                    rows.iter().map(|r| (r[0], at(r, 7) / at(r, 8))).collect(),
+                )
+                .palette(1),
             )
-            .palette(1),
-        )
-        .series(
-            Series::markers(
-                "simulated (±1 s.e.)",
-                rows.iter().map(|r| (r[0], r[5] / r[8])).collect(),
+            .series(
+                Series::markers(
+                    "simulated (±1 s.e.)",
+                    rows.iter().map(|r| (r[0], at(r, 5) / at(r, 8))).collect(),
+                )
+                .with_errors(rows.iter().map(|r| at(r, 6) / at(r, 8)).collect())
+                .palette(0),
             )
-            .with_errors(rows.iter().map(|r| r[6] / r[8]).collect())
-            .palette(0),
-        )
-        .hline(1.0, "continuum λₙ = n⁴/τ₁")
-        .caption(
-            "Decay rate of each mode's autocorrelation relative to the continuum rate \
-             λₙ = n⁴/τ₁, simulated (markers, ±1 s.e.) against the exact rate −ln(m)/Δt of \
-             the discrete update, m its one-step multiplier (solid line); the dashed line \
-             at 1 is the continuum. The markers should scatter about the solid line; its \
-             distance from 1 is the discretization's (mesh and time step) effect on the \
-             dynamics.",
-        );
+            .hline(1.0, words.continuum)
+            .caption(words.caption);
         outputs.write_figure(&fig, dir.join(format!("{name}-rates.svg")))?;
     }
     Ok(())
 }
 
-/// Points on each continuum curve drawn in the profile and two-time figures.
-const CURVE_POINTS: usize = 81;
-
 /// `<run>-profile.csv`: ⟨w²(x)⟩ simulated, exact discrete and continuum; and
-/// `<run>-profile.svg`, the same with the continuum curve over the whole filament.
+/// `<run>-profile.svg`, the same with the continuum curve over the whole filament (or
+/// ⟨h²(x, b/2)⟩ along the whole midline of a membrane).
 fn write_profile(
-    scene: &Scene,
+    subject: &Subject,
     units: AxisUnits,
     dir: &Path,
     run: &LinearRun,
@@ -1583,58 +1645,38 @@ fn write_profile(
         &["x", "variance", "std_error", "discrete", "continuum"],
         &rows,
     )?;
-    let length = scene.filament.length;
-    let curve: Vec<(f64, f64)> = match HingedBeam::new(scene.filament) {
-        Ok(beam) => (0..CURVE_POINTS)
-            .map(|k| {
-                let x = length * k as f64 / (CURVE_POINTS - 1) as f64;
-                (x, beam.profile_variance(x))
-            })
-            .collect(),
-        Err(_) => Vec::new(),
-    };
-    let fig = Figure::new(
-        format!("{}: equilibrium profile ⟨w²(x)⟩", run.spec.name),
-        format!("position x {}", units.length()),
-        format!("⟨w²(x)⟩ {}", units.area()),
-    )
-    .series(
-        Series::line("continuum kT x²(L−x)²/(3EI·L)", curve)
-            .dashed()
-            .palette(2),
-    )
-    .series(
-        Series::markers(
-            "exact, discretized filament",
-            rows.iter().map(|r| (r[0], r[3])).collect(),
+    let words = subject.profile_words(&run.spec.name, units);
+    let fig = Figure::new(words.title, words.x_label, words.y_label)
+        .series(
+            Series::line(words.continuum, subject.profile_curve())
+                .dashed()
+                .palette(2),
         )
-        .palette(1)
-        .light()
-        .marker_radius(8),
-    )
-    .series(
-        Series::markers(
-            "simulated (±1 s.e.)",
-            rows.iter().map(|r| (r[0], r[1])).collect(),
+        .series(
+            Series::markers(words.discrete, rows.iter().map(|r| (r[0], r[3])).collect())
+                .palette(1)
+                .light()
+                .marker_radius(8),
         )
-        .with_errors(rows.iter().map(|r| r[2]).collect())
-        .palette(0),
-    )
-    .caption(
-        "Equilibrium variance of the deflection ⟨w²(x)⟩ at the scene's profile points, \
-         simulated (markers, ±1 s.e.) against the exact value of the discretized \
-         filament (light discs) and the continuum kT x²(L−x)²/(3EI·L) (dashed curve). \
-         Each marker should sit on its disc within its error bar; the discs lie on the \
-         curve up to the discretization error.",
-    );
+        .series(
+            Series::markers(
+                "simulated (±1 s.e.)",
+                rows.iter().map(|r| (r[0], r[1])).collect(),
+            )
+            .with_errors(rows.iter().map(|r| r[2]).collect())
+            .palette(0),
+        )
+        .caption(words.caption);
     outputs.write_figure(&fig, dir.join(format!("{}-profile.svg", run.spec.name)))
 }
 
-/// `<run>-two-time.csv`: the two-time correlation eq. (4) simulated, exact discrete and
-/// continuum; and `<run>-two-time.svg`: per point, the simulated value and the exact
-/// discrete one at η, on eq. (4) as a function of η at the point's x, y and t.
+/// `<run>-two-time.csv`: the two-time correlation eq. (4) (a membrane's (M4) on its
+/// midline) simulated, exact discrete and continuum; and `<run>-two-time.svg`: per point,
+/// the simulated value and the exact discrete one at η, on the continuum as a function
+/// of η at the point's x, y and t.
 fn write_two_time(
     scene: &Scene,
+    subject: &Subject,
     units: AxisUnits,
     dir: &Path,
     run: &LinearRun,
@@ -1663,46 +1705,30 @@ fn write_two_time(
         ],
         &rows,
     )?;
-    let fig = two_time_figure(scene, units, &run.spec.name, &rows);
+    let fig = two_time_figure(scene.tau1(), subject, units, &run.spec.name, &rows);
     outputs.write_figure(&fig, dir.join(format!("{}-two-time.svg", run.spec.name)))
 }
 
 /// The two-time figure of [`write_two_time`] from the rows of `<run>-two-time.csv`.
-fn two_time_figure(scene: &Scene, units: AxisUnits, name: &str, rows: &[Vec<f64>]) -> Figure {
-    let tau1 = scene.tau1();
-    let length = scene.filament.length;
-    let beam = HingedBeam::new(scene.filament).ok();
+fn two_time_figure(
+    tau1: f64,
+    subject: &Subject,
+    units: AxisUnits,
+    name: &str,
+    rows: &[Vec<f64>],
+) -> Figure {
+    let (length, unit, equation) = subject.two_time_legend();
     let eta_max = 1.25 * rows.iter().map(|r| r[3]).fold(0.0, f64::max);
-    let mut fig = Figure::new(
-        format!("{name}: two-time correlation from rest (eq. 4)"),
-        "later time η / τ₁",
-        format!("⟨w(x,t) w(y,η)⟩ {}", units.area()),
-    )
-    .caption(
-        "Two-time correlation ⟨w(x,t) w(y,η)⟩ of the filament started from rest, at the \
-         scene's points (x, y, t, η), one colour per point: simulated (markers, ±1 s.e.) \
-         against eq. (4) of the continuum as a function of the later time η at the point's \
-         x, y and t (light curve) and the exact value of the discretized filament (light \
-         disc). Each marker should sit on its disc within its error bar, and the discs on \
-         their curves up to the discretization error.",
-    );
+    let words = subject.two_time_words(name, units);
+    let mut fig = Figure::new(words.title, words.x_label, words.y_label).caption(words.caption);
     for (k, r) in rows.iter().enumerate() {
         let (x, y, t, eta) = (r[0], r[1], r[2], r[3]);
-        let curve: Vec<(f64, f64)> = beam
-            .iter()
-            .flat_map(|b| {
-                (0..CURVE_POINTS).filter_map(move |j| {
-                    let e = t + (eta_max - t).max(0.0) * j as f64 / (CURVE_POINTS - 1) as f64;
-                    let c = b.correlation(x, y, t, e, 1e-9).ok()?;
-                    Some((e / tau1, c.value))
-                })
-            })
-            .collect();
+        let curve = subject.two_time_curve((x, y, t), eta_max, tau1);
         fig = fig
             .series(
                 Series::markers(
                     format!(
-                        "x = {} L, y = {} L, t = {} τ₁: simulated / eq. (4)",
+                        "x = {} {unit}, y = {} {unit}, t = {} τ₁: simulated / {equation}",
                         short(x / length),
                         short(y / length),
                         short(t / tau1)
@@ -1722,7 +1748,7 @@ fn two_time_figure(scene: &Scene, units: AxisUnits, name: &str, rows: &[Vec<f64>
             );
     }
     fig.series(
-        Series::markers("exact, discretized filament (disc)", Vec::new())
+        Series::markers(words.discrete, Vec::new())
             .rgb(127, 127, 127)
             .light()
             .marker_radius(8),
@@ -1740,9 +1766,13 @@ fn short(v: f64) -> String {
     }
 }
 
+/// The modes whose Welch spectra `<run>-spectrum.svg` draws.
+const SPECTRUM_MODES: [usize; 3] = [1, 3, 6];
+
 /// `<run>-spectrum.csv` and `.svg` (modes 1, 3, 6): the pooled Welch spectra against
 /// their exact expectation, when the spectrum check computed any.
 fn write_spectra(
+    subject: &Subject,
     units: AxisUnits,
     dir: &Path,
     run: &LinearRun,
@@ -1766,24 +1796,20 @@ fn write_spectra(
     )
     .log_x()
     .log_y()
-    .caption(
-        "One-sided power spectral density of the modal amplitudes aₙ of modes 1, 3 and 6, \
-         one colour per mode: the Welch estimate pooled over trajectories (markers) \
-         against its exact expectation for the sampled discrete process, window included \
-         (light line). The markers should follow the line of their mode at every \
-         frequency; a systematic departure at high frequency is a time-step error, at low \
-         frequency a run too short to resolve the mode's relaxation.",
-    );
+    .caption(subject.welch_caption(&SPECTRUM_MODES, &run.reference.modes));
     let mut hue = 0;
     for (n, (f, p, e)) in &spectra {
         for k in 1..f.len() {
             rows.push(vec![*n as f64, f[k], p[k], e[k]]);
         }
-        if [1, 3, 6].contains(n) {
+        if SPECTRUM_MODES.contains(n) {
             fig = fig
                 .series(
                     Series::markers(
-                        format!("mode {n}: simulated / exact"),
+                        format!(
+                            "{}: simulated / exact",
+                            subject.mode_name(*n, &run.reference.modes)
+                        ),
                         f.iter().zip(p).skip(1).map(|(a, b)| (*a, *b)).collect(),
                     )
                     .palette(hue)
