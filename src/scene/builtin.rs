@@ -333,6 +333,10 @@ mod tests {
                 "compression-3d",
                 "hinged-linear-2d",
                 "hinged-linear-3d",
+                "membrane-bilayer",
+                "membrane-hinged",
+                "membrane-periodic",
+                "membrane-spectral",
                 "spectral-reference"
             ]
         );

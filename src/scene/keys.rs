@@ -976,7 +976,12 @@ mod tests {
         let pool: Vec<(&'static str, &'static str)> = if membrane_key(pattern) {
             MEMBRANES.to_vec()
         } else {
-            BUILTIN.iter().map(|b| (b.name, b.text)).collect()
+            // The filament's bounds; the membranes' own are probed on MEMBRANES.
+            BUILTIN
+                .iter()
+                .filter(|b| !b.text.lines().any(|l| l.trim() == "[membrane]"))
+                .map(|b| (b.name, b.text))
+                .collect()
         };
         let with = |pattern: &str| -> Vec<(&'static str, Value, Vec<String>)> {
             pool.iter()
