@@ -745,7 +745,7 @@ fn membrane_study_runs_and_writes_its_outputs() {
             "--values",
             "4,6,8",
             "--trajectories",
-            "2",
+            "8",
             "--duration-tau1",
             "20",
         ],

@@ -62,7 +62,7 @@ fn membrane_scene_runs_through_the_linear_pipeline() {
     assert!(r.profile_discrete.iter().all(|v| *v > 0.0));
     let steps = run.sampled_steps(80.0 * scene.tau1());
     let records = run
-        .simulate_ensemble(scene.seed, 0, 4, steps, |_| {})
+        .simulate_ensemble(scene.seed, 0, 16, steps, |_| {})
         .expect("membrane ensemble");
     let nm = r.modes.len();
     let z_of = |i: usize, reference: f64| variance_z(&records, i, reference);
