@@ -50,8 +50,8 @@ verify: build
 # (seed k = 1 + k, each exactly `verify --scene S --seed <seed>`): the false-alarm rate
 # per scene with its exact binomial interval against alpha, and the uniformity of the
 # checks' p-values per check kind (KS, Holm), in $(OUT)/calibration/. Exit 1 if a scene's
-# rate is above alpha or a kind's p-values are not uniform. About 15 s per seed at the
-# quick budget on 2 cores (25 min for 100 seeds).
+# rate is above alpha or a kind's p-values are not uniform. About 21 s per seed at the
+# quick budget on 2 cores (35 min for 100 seeds).
 SEEDS ?= 100
 CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference
 calibrate: build
