@@ -88,6 +88,10 @@ pub const BUILTIN: &[BuiltinScene] = &[
     builtin!(extreme "hinged-1000-2d"),
     builtin!(extreme "hinged-floppy-2d"),
     builtin!(extreme "hinged-stiff-2d"),
+    builtin!(extreme "membrane-fine"),
+    builtin!(extreme "membrane-near-buckling"),
+    builtin!(extreme "membrane-stiff"),
+    builtin!(extreme "membrane-tension-dominated"),
 ];
 
 /// The built-in scene called `name`, if any.
@@ -357,7 +361,10 @@ mod tests {
             m.starts_with("--scene must be one of: actin-10um, compression-2d, "),
             "{m}"
         );
-        assert!(m.contains("hinged-stiff-2d (the built-in scenes)"), "{m}");
+        assert!(
+            m.contains("membrane-tension-dominated (the built-in scenes)"),
+            "{m}"
+        );
         assert!(m.ends_with("got no-such-scene"), "{m}");
         let e = resolve("no/such/file.toml", None).unwrap_err();
         assert_eq!(e.exit_code(), 2);
