@@ -17,12 +17,16 @@ use std::process::Output;
 
 const LINEAR: &str = "tests/scenes/good/tiny-linear.toml";
 const COMPRESSION: &str = "tests/scenes/good/tiny-compression.toml";
+/// A membrane (issue #27: plate elements on their modal path).
+const MEMBRANE: &str = "tests/scenes/good/membrane-hinged.toml";
 
-/// `verify -q` of both fixtures with `extra` flags, as arguments.
+/// `verify -q` of the fixtures (filament, compression, membrane) with `extra` flags, as
+/// arguments.
 fn verify_args(extra: &[&str]) -> Vec<String> {
-    let (lin, comp) = (fixture(LINEAR), fixture(COMPRESSION));
+    let (lin, comp, memb) = (fixture(LINEAR), fixture(COMPRESSION), fixture(MEMBRANE));
     let mut args = strings(&["verify", "-q", "-s", lin.to_str().unwrap()]);
     args.extend(strings(&["-s", comp.to_str().unwrap()]));
+    args.extend(strings(&["-s", memb.to_str().unwrap()]));
     args.extend(strings(extra));
     args
 }
@@ -77,8 +81,9 @@ fn three_shards_merge_to_the_whole_run_byte_for_byte() {
     let files = assert_same_outputs(&whole, &merged, volatile);
     assert!(
         files.iter().any(|f| f.ends_with("force-strain.csv"))
-            && files.iter().any(|f| f.ends_with("-two-time.csv")),
-        "the fixtures wrote no force-strain or two-time table: {files:?}"
+            && files.iter().any(|f| f.ends_with("-two-time.csv"))
+            && files.iter().any(|f| f.ends_with("-height-spectrum.svg")),
+        "the fixtures wrote no force-strain or two-time table or membrane spectrum: {files:?}"
     );
 }
 
