@@ -485,6 +485,15 @@ impl<S: Observables + ?Sized> Observer<S> for Recorder<'_> {
     }
 }
 
+/// `rates` × `factor` (the rates themselves, bit for bit, at factor 1).
+fn scaled(rates: &[f64], factor: f64) -> Vec<f64> {
+    if factor == 1.0 {
+        rates.to_vec()
+    } else {
+        rates.iter().map(|r| r * factor).collect()
+    }
+}
+
 /// Greatest common divisor (the cadence at which every series' own cadence is met).
 fn gcd(a: u64, b: u64) -> u64 {
     if b == 0 { a } else { gcd(b, a % b) }
@@ -758,28 +767,8 @@ impl Setup<'_> {
     /// ([`DiscreteLaw`]: the same law whichever object assembled the system).
     fn fem(&self) -> Result<Prepared> {
         let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
-        let object = match &self.continuum {
-            Continuum::Filament(_) => {
-                let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
-                #[cfg(any(test, feature = "faults"))]
-                let beam = crate::fault::shared_model(self.scene.fault, beam)?;
-                FemObject::Beam(Box::new(beam))
-            }
-            Continuum::Membrane { membrane, modes } => FemObject::plate(
-                #[cfg(any(test, feature = "faults"))]
-                &Membrane::new(crate::fault::shared_membrane(
-                    self.scene.fault,
-                    membrane.params,
-                ))?,
-                #[cfg(not(any(test, feature = "faults")))]
-                membrane,
-                self.scene.mesh.elements,
-                self.scene.mesh.elements_along_y(),
-                modes.clone(),
-            )?,
-        };
+        let object = self.fem_object()?;
         let system = object.system();
-        let kt = system.kt();
         // An explicit step above its limit fails at once (λ_max by an O(n)
         // inertia bisection), before the O(n³) eigen-decomposition.
         if spec.integrator.stability_limit(1.0).is_some() {
@@ -797,20 +786,7 @@ impl Setup<'_> {
         // Fails early with the stability limit if the step is too large.
         build_integrator(spec.integrator, system, spec.noise, dt, max_rate, Some(&gm))?;
         let law = DiscreteLaw::new(system, &gm, spec.integrator, spec.noise, dt)?;
-        let mut refs = Vec::new();
-        for i in 0..self.scene.sampling.modes {
-            let n = i + 1;
-            refs.push(ModeReference {
-                n,
-                variance_discrete: law.mode_variance(i),
-                variance_equipartition: law.equipartition(i),
-                variance_continuum: kt / self.continuum.mode_rate(n),
-                multiplier: law.multipliers[i],
-                rate_discrete: law.decay_rate(i),
-                rate_continuum: self.continuum.mode_rate(n),
-                label: self.continuum.mode_label(n),
-            });
-        }
+        let refs = self.fem_mode_references(&law, system.kt());
         // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
         let probe = |x: f64| probe_of(system.n_dofs(), &gm.vectors, |e| object.value_at(e, x));
         let profile_discrete = self
@@ -822,20 +798,7 @@ impl Setup<'_> {
             })
             .collect();
         let two_time = self.fem_two_time(&law, &probe)?;
-        // The plate's modes are separable: with consistent noise its runs step in modal
-        // coordinates, O(n) per step (the banded nodal path stays the general one and,
-        // for the element-uniform load, the path).
-        let modal = (matches!(object, FemObject::Plate { .. })
-            && spec.noise == NoiseModel::Consistent)
-            .then(|| {
-                let mut xs = self.profile_x.clone();
-                xs.extend(two_time.iter().flat_map(|q| [q.x, q.y]));
-                xs.dedup();
-                ModalPath {
-                    rates: gm.rates.iter().copied().collect(),
-                    probes: xs.into_iter().map(|x| (x, probe(x))).collect(),
-                }
-            });
+        let modal = self.modal_path(&object, &gm, &two_time, &probe);
         let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
         // The trajectory data format's sine-basis amplitudes are the filament's; a
@@ -866,6 +829,78 @@ impl Setup<'_> {
             profile_discrete,
             two_time,
             max_rate,
+        })
+    }
+
+    /// The finite-element model of the continuum: the beam, or the plate of a membrane
+    /// (under an injected shared-model fault, the faulty one).
+    ///
+    /// # Errors
+    /// Assembly failures; a checked mode the plate's mesh does not resolve.
+    fn fem_object(&self) -> Result<FemObject> {
+        let p = self.scene.filament;
+        Ok(match &self.continuum {
+            Continuum::Filament(_) => {
+                let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
+                #[cfg(any(test, feature = "faults"))]
+                let beam = crate::fault::shared_model(self.scene.fault, beam)?;
+                FemObject::Beam(Box::new(beam))
+            }
+            Continuum::Membrane { membrane, modes } => FemObject::plate(
+                #[cfg(any(test, feature = "faults"))]
+                &Membrane::new(crate::fault::shared_membrane(
+                    self.scene.fault,
+                    membrane.params,
+                ))?,
+                #[cfg(not(any(test, feature = "faults")))]
+                membrane,
+                self.scene.mesh.elements,
+                self.scene.mesh.elements_along_y(),
+                modes.clone(),
+            )?,
+        })
+    }
+
+    /// The references of every checked mode under the discrete law `law`, with the
+    /// continuum's beside them (thermal energy `kt`).
+    fn fem_mode_references(&self, law: &DiscreteLaw, kt: f64) -> Vec<ModeReference> {
+        (0..self.scene.sampling.modes)
+            .map(|i| {
+                let n = i + 1;
+                ModeReference {
+                    n,
+                    variance_discrete: law.mode_variance(i),
+                    variance_equipartition: law.equipartition(i),
+                    variance_continuum: kt / self.continuum.mode_rate(n),
+                    multiplier: law.multipliers[i],
+                    rate_discrete: law.decay_rate(i),
+                    rate_continuum: self.continuum.mode_rate(n),
+                    label: self.continuum.mode_label(n),
+                }
+            })
+            .collect()
+    }
+
+    /// The O(n) modal path of a plate with consistent noise ([`ModalPath`]): its modes
+    /// are separable, so its runs step in modal coordinates, with the modal probes at
+    /// every position an observer reads (profile and two-time points); `None` for the
+    /// beam and for the element-uniform load (the banded nodal path, the general one).
+    fn modal_path(
+        &self,
+        object: &FemObject,
+        gm: &GeneralizedModes,
+        two_time: &[TwoTimeReference],
+        probe: &dyn Fn(f64) -> DVector<f64>,
+    ) -> Option<ModalPath> {
+        let plate = matches!(object, FemObject::Plate { .. });
+        (plate && self.spec.noise == NoiseModel::Consistent).then(|| {
+            let mut xs = self.profile_x.clone();
+            xs.extend(two_time.iter().flat_map(|q| [q.x, q.y]));
+            xs.dedup();
+            ModalPath {
+                rates: gm.rates.iter().copied().collect(),
+                probes: xs.into_iter().map(|x| (x, probe(x))).collect(),
+            }
         })
     }
 
@@ -1127,13 +1162,12 @@ impl LinearRun {
             },
         ) = (self.modal_path(), &self.model)
         {
-            let rates: Vec<f64> = if rate == 1.0 {
-                path.rates.clone()
-            } else {
-                path.rates.iter().map(|r| r * rate).collect()
-            };
-            let stepper =
-                ModalStep::new(*integrator, &rates, self.reference.dt, object.system().kt())?;
+            let stepper = ModalStep::new(
+                *integrator,
+                &scaled(&path.rates, rate),
+                self.reference.dt,
+                object.system().kt(),
+            )?;
             #[cfg(any(test, feature = "faults"))]
             let stepper = if gain == 1.0 {
                 stepper
@@ -1186,21 +1220,7 @@ impl LinearRun {
                 })
             }
             Model::SpectralMembrane { simulator, checked } => {
-                #[cfg(any(test, feature = "faults"))]
-                let faulty = crate::fault::spectral_membrane(self.fault, *simulator.membrane())?;
-                #[cfg(any(test, feature = "faults"))]
-                let mut sim = if faulty == *simulator.membrane() {
-                    (**simulator).clone()
-                } else {
-                    MembraneSimulator::new(faulty, simulator.modes().to_vec(), self.reference.dt)?
-                };
-                #[cfg(not(any(test, feature = "faults")))]
-                let mut sim = (**simulator).clone();
-                sim.set_rest();
-                Box::new(MembraneSampler {
-                    sim,
-                    checked: checked.clone(),
-                })
+                Box::new(self.membrane_sampler(simulator, checked)?)
             }
             Model::Spectral { beam, n_modes } => {
                 #[cfg(any(test, feature = "faults"))]
@@ -1223,6 +1243,33 @@ impl LinearRun {
                     "a run with a model to simulate (this one checks another program's data)",
                 ));
             }
+        })
+    }
+
+    /// The membrane's exact modal simulator at rest as a sampler of the modes `checked`
+    /// (under an injected fault, a simulator of the faulty membrane).
+    ///
+    /// # Errors
+    /// Invalid faulty parameters.
+    fn membrane_sampler(
+        &self,
+        simulator: &MembraneSimulator,
+        checked: &[usize],
+    ) -> Result<MembraneSampler> {
+        #[cfg(any(test, feature = "faults"))]
+        let faulty = crate::fault::spectral_membrane(self.fault, *simulator.membrane())?;
+        #[cfg(any(test, feature = "faults"))]
+        let mut sim = if faulty == *simulator.membrane() {
+            simulator.clone()
+        } else {
+            MembraneSimulator::new(faulty, simulator.modes().to_vec(), self.reference.dt)?
+        };
+        #[cfg(not(any(test, feature = "faults")))]
+        let mut sim = simulator.clone();
+        sim.set_rest();
+        Ok(MembraneSampler {
+            sim,
+            checked: checked.to_vec(),
         })
     }
 

@@ -330,137 +330,150 @@ pub struct Expected {
 /// `object` (a filament, with whether x = L/2 is a mesh node for every value studied, or
 /// a membrane).
 pub fn expected_order(over: Over, spec: &RunSpec, obs: usize, object: StudyObject) -> Expected {
+    match over {
+        Over::Elements => expected_over_elements(spec, obs, object),
+        Over::Dt => expected_over_dt(spec, obs, matches!(object, StudyObject::Membrane { .. })),
+    }
+}
+
+/// An expected order with its reason.
+fn expected(order: Option<f64>, exact: bool, why: &str) -> Expected {
+    Expected {
+        order,
+        exact,
+        why: why.to_string(),
+    }
+}
+
+/// [`expected_order`] over the element count.
+fn expected_over_elements(spec: &RunSpec, obs: usize, object: StudyObject) -> Expected {
     let exact_stationary = matches!(
         spec.integrator,
         IntegratorKind::CrankNicolson | IntegratorKind::ExactModal
     );
-    let e = |order: Option<f64>, exact: bool, why: &str| Expected {
-        order,
-        exact,
-        why: why.to_string(),
-    };
-    let membrane = matches!(object, StudyObject::Membrane { .. });
-    match over {
-        Over::Elements => {
-            if obs >= SAMPLED {
-                return e(
-                    Some(4.0),
-                    false,
-                    "the plate's eigenvalue of the mode: Bogner-Fox-Schmit (bicubic Hermite) elements are a conforming Rayleigh-Ritz discretization, so lambda_h >= lambda, and the error lambda_h/lambda - 1 > 0 is O(h^4) (2(k+1-m), k = 3, m = 2); exact (no sampling), whatever the integrator, noise and dt",
-                );
-            }
-            if !exact_stationary {
-                return e(
-                    None,
-                    false,
-                    "the integrator's stationary bias at fixed dt (O(lambda dt) per mode) does not vanish as h -> 0, and grows with lambda_max for sums over modes: no order in h",
-                );
-            }
-            match (spec.noise, obs, object) {
-                (NoiseModel::Consistent, 0, StudyObject::Filament { node_at_mid: true }) => e(
-                    None,
-                    true,
-                    "consistent noise with an exact-stationary integrator gives the covariance kT K^-1, whose nodal values are exact for Hermite cubics (the beam's Green's function is piecewise cubic): zero error, no order",
-                ),
-                (NoiseModel::Consistent, 0, StudyObject::Filament { .. }) => e(
-                    None,
-                    false,
-                    "kT K^-1 is exact at nodes (zero error there); where x = L/2 lies inside an element (odd element counts) the interpolated variance falls below the continuum by the energy-norm error of the point-load response, about h^3: no single order over these meshes",
-                ),
-                (NoiseModel::Consistent, 0, StudyObject::Membrane { centre_alike: true }) => e(
-                    Some(2.0),
-                    false,
-                    "consistent noise with an exact-stationary integrator gives the covariance kT K^-1: the centre variance is the plate's energy of its response to a point load there, below the continuum by the energy-norm error of that response (Galerkin); the biharmonic point-load response (r^2 ln r) makes this O(h^2), as does the modal tail sum 4kT/(ab kappa q^4) over the 2D modes beyond q ~ pi/h. Unlike the beam's, the plate's nodal values are not exact. Measured from the exact references (simply supported square, kappa = kT = 1): error/h^2 -> 0.0021 with the centre on a node, 0.0058 inside an element",
-                ),
-                (NoiseModel::Consistent, 0, StudyObject::Membrane { .. }) => e(
-                    None,
-                    false,
-                    "the centre variance converges as h^2 from below (the energy-norm error of the point-load response), but with a different constant where (a/2, b/2) is a node (even counts; simply supported square: about 0.0021 h^2 kT/kappa) and where it lies inside an element (odd counts: about 0.0058 h^2 kT/kappa): no single power law over meshes of both kinds",
-                ),
-                (NoiseModel::Consistent, _, StudyObject::Filament { .. }) => e(
-                    Some(4.0),
-                    false,
-                    "the variance is kT/lambda_i^h; Hermite-cubic generalized eigenvalues converge as h^4 (2(k+1-m), k = 3, m = 2)",
-                ),
-                (NoiseModel::Consistent, _, StudyObject::Membrane { .. }) => e(
-                    Some(4.0),
-                    false,
-                    "the variance is kT/lambda_h of the plate's mode; Bogner-Fox-Schmit (bicubic Hermite) eigenvalues converge as h^4 from above (2(k+1-m), k = 3, m = 2), so the variance converges as h^4 from below",
-                ),
-                (NoiseModel::ElementUniform, 0, StudyObject::Filament { .. }) => e(
-                    Some(2.0),
-                    false,
-                    "the element-uniform noise (eq. 5) under-excites every mode by about (i pi h/L)^2/12; the profile sums these h^2 deficits (plus the h^4 eigenvalue error)",
-                ),
-                (NoiseModel::ElementUniform, 0, StudyObject::Membrane { .. }) => e(
-                    None,
-                    false,
-                    "element-uniform noise under-excites every mode by about (q_x^2 h_x^2 + q_y^2 h_y^2)/12; summed over the 2D modes at the centre (sum 1/q^2 up to q ~ pi/h) these deficits give about h^2 ln(1/h)/(24 pi) kT/kappa (simply supported square; measured from the exact references: 0.0134 h^2 ln(1/h)): no pure power law, the fitted order over 4-24 elements is about 1.6-1.75, tending to 2 only logarithmically",
-                ),
-                (NoiseModel::ElementUniform, _, StudyObject::Filament { .. }) => e(
-                    Some(2.0),
-                    false,
-                    "element-uniform noise (eq. 5): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (i pi h/L)^2/12, order h^2 (dominates the h^4 eigenvalue error)",
-                ),
-                (NoiseModel::ElementUniform, _, StudyObject::Membrane { .. }) => e(
-                    Some(2.0),
-                    false,
-                    "element-uniform noise (a uniform load per element area): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (q_x^2 h_x^2 + q_y^2 h_y^2)/12, order h^2 (dominates the h^4 eigenvalue error)",
-                ),
-            }
-        }
-        Over::Dt => match spec.integrator {
-            IntegratorKind::CrankNicolson => e(
-                None,
-                true,
-                "Crank-Nicolson: m = (1-a/2)/(1+a/2), g^2 = 2kT dt/(1+a/2)^2 give S_ij = 2kT Sigma_q,ij/(lambda_i+lambda_j) exactly for any dt, any noise model: zero error, no order",
-            ),
-            IntegratorKind::ExactModal if spec.noise == NoiseModel::Consistent || obs > 0 => e(
-                None,
-                true,
-                "exact OU update per mode: the stationary variance of every mode is kT Sigma_q,ii/lambda_i at any dt: zero error, no order",
-            ),
-            IntegratorKind::ExactModal => e(
-                None,
-                false,
-                "exact OU update with element-uniform noise: the modal variances are exact, but the cross-covariances of modes (correlated by eq. 5 noise) are not, by O((lambda dt)^2) for resolved modes: no single order",
-            ),
-            IntegratorKind::EulerMaruyama if obs == 0 && membrane => e(
-                Some(1.0),
-                false,
-                "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the error at the profile point is dt kT/2 sum_i phi_i(a/2, b/2)^2 + O(dt^2): order 1",
-            ),
-            IntegratorKind::EulerMaruyama if obs == 0 => e(
-                Some(1.0),
-                false,
-                "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the profile error is dt kT/2 sum_i phi_i(L/2)^2 + O(dt^2): order 1",
-            ),
-            IntegratorKind::EulerMaruyama => e(
-                Some(1.0),
-                false,
-                "Euler-Maruyama stationary variance ratio 1/(1 - lambda dt/2): bias O(lambda dt), order 1",
-            ),
-            IntegratorKind::BackwardEuler if obs == 0 && membrane => e(
-                Some(1.0),
-                false,
-                "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the membrane's sum over its 2D modes (sum 1/q^4 beyond q ~ dt^(-1/4)) gives about dt^(1/2), so the observed order lies between 1/2 and 1",
-            ),
-            IntegratorKind::BackwardEuler if obs == 0 => e(
-                Some(1.0),
-                false,
-                "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the continuum-like sum gives about dt^(3/4), so the observed order lies between 3/4 and 1",
-            ),
-            IntegratorKind::BackwardEuler => e(
-                Some(1.0),
-                false,
-                "backward Euler stationary variance ratio 1/(1 + lambda dt/2): bias O(lambda dt), order 1",
-            ),
-            IntegratorKind::MetropolisCrankNicolson => e(
-                None,
-                true,
-                "on the linear problem every Crank-Nicolson proposal is accepted: exact",
-            ),
-        },
+    let e = expected;
+    if obs >= SAMPLED {
+        return e(
+            Some(4.0),
+            false,
+            "the plate's eigenvalue of the mode: Bogner-Fox-Schmit (bicubic Hermite) elements are a conforming Rayleigh-Ritz discretization, so lambda_h >= lambda, and the error lambda_h/lambda - 1 > 0 is O(h^4) (2(k+1-m), k = 3, m = 2); exact (no sampling), whatever the integrator, noise and dt",
+        );
+    }
+    if !exact_stationary {
+        return e(
+            None,
+            false,
+            "the integrator's stationary bias at fixed dt (O(lambda dt) per mode) does not vanish as h -> 0, and grows with lambda_max for sums over modes: no order in h",
+        );
+    }
+    match (spec.noise, obs, object) {
+        (NoiseModel::Consistent, 0, StudyObject::Filament { node_at_mid: true }) => e(
+            None,
+            true,
+            "consistent noise with an exact-stationary integrator gives the covariance kT K^-1, whose nodal values are exact for Hermite cubics (the beam's Green's function is piecewise cubic): zero error, no order",
+        ),
+        (NoiseModel::Consistent, 0, StudyObject::Filament { .. }) => e(
+            None,
+            false,
+            "kT K^-1 is exact at nodes (zero error there); where x = L/2 lies inside an element (odd element counts) the interpolated variance falls below the continuum by the energy-norm error of the point-load response, about h^3: no single order over these meshes",
+        ),
+        (NoiseModel::Consistent, 0, StudyObject::Membrane { centre_alike: true }) => e(
+            Some(2.0),
+            false,
+            "consistent noise with an exact-stationary integrator gives the covariance kT K^-1: the centre variance is the plate's energy of its response to a point load there, below the continuum by the energy-norm error of that response (Galerkin); the biharmonic point-load response (r^2 ln r) makes this O(h^2), as does the modal tail sum 4kT/(ab kappa q^4) over the 2D modes beyond q ~ pi/h. Unlike the beam's, the plate's nodal values are not exact. Measured from the exact references (simply supported square, kappa = kT = 1): error/h^2 -> 0.0021 with the centre on a node, 0.0058 inside an element",
+        ),
+        (NoiseModel::Consistent, 0, StudyObject::Membrane { .. }) => e(
+            None,
+            false,
+            "the centre variance converges as h^2 from below (the energy-norm error of the point-load response), but with a different constant where (a/2, b/2) is a node (even counts; simply supported square: about 0.0021 h^2 kT/kappa) and where it lies inside an element (odd counts: about 0.0058 h^2 kT/kappa): no single power law over meshes of both kinds",
+        ),
+        (NoiseModel::Consistent, _, StudyObject::Filament { .. }) => e(
+            Some(4.0),
+            false,
+            "the variance is kT/lambda_i^h; Hermite-cubic generalized eigenvalues converge as h^4 (2(k+1-m), k = 3, m = 2)",
+        ),
+        (NoiseModel::Consistent, _, StudyObject::Membrane { .. }) => e(
+            Some(4.0),
+            false,
+            "the variance is kT/lambda_h of the plate's mode; Bogner-Fox-Schmit (bicubic Hermite) eigenvalues converge as h^4 from above (2(k+1-m), k = 3, m = 2), so the variance converges as h^4 from below",
+        ),
+        (NoiseModel::ElementUniform, 0, StudyObject::Filament { .. }) => e(
+            Some(2.0),
+            false,
+            "the element-uniform noise (eq. 5) under-excites every mode by about (i pi h/L)^2/12; the profile sums these h^2 deficits (plus the h^4 eigenvalue error)",
+        ),
+        (NoiseModel::ElementUniform, 0, StudyObject::Membrane { .. }) => e(
+            None,
+            false,
+            "element-uniform noise under-excites every mode by about (q_x^2 h_x^2 + q_y^2 h_y^2)/12; summed over the 2D modes at the centre (sum 1/q^2 up to q ~ pi/h) these deficits give about h^2 ln(1/h)/(24 pi) kT/kappa (simply supported square; measured from the exact references: 0.0134 h^2 ln(1/h)): no pure power law, the fitted order over 4-24 elements is about 1.6-1.75, tending to 2 only logarithmically",
+        ),
+        (NoiseModel::ElementUniform, _, StudyObject::Filament { .. }) => e(
+            Some(2.0),
+            false,
+            "element-uniform noise (eq. 5): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (i pi h/L)^2/12, order h^2 (dominates the h^4 eigenvalue error)",
+        ),
+        (NoiseModel::ElementUniform, _, StudyObject::Membrane { .. }) => e(
+            Some(2.0),
+            false,
+            "element-uniform noise (a uniform load per element area): stationary variance (Phi^T Sigma Phi)_ii kT/lambda_i, deficit about (q_x^2 h_x^2 + q_y^2 h_y^2)/12, order h^2 (dominates the h^4 eigenvalue error)",
+        ),
+    }
+}
+
+/// [`expected_order`] over Δt, for a membrane's study if `membrane`.
+fn expected_over_dt(spec: &RunSpec, obs: usize, membrane: bool) -> Expected {
+    let e = expected;
+    match spec.integrator {
+        IntegratorKind::CrankNicolson => e(
+            None,
+            true,
+            "Crank-Nicolson: m = (1-a/2)/(1+a/2), g^2 = 2kT dt/(1+a/2)^2 give S_ij = 2kT Sigma_q,ij/(lambda_i+lambda_j) exactly for any dt, any noise model: zero error, no order",
+        ),
+        IntegratorKind::ExactModal if spec.noise == NoiseModel::Consistent || obs > 0 => e(
+            None,
+            true,
+            "exact OU update per mode: the stationary variance of every mode is kT Sigma_q,ii/lambda_i at any dt: zero error, no order",
+        ),
+        IntegratorKind::ExactModal => e(
+            None,
+            false,
+            "exact OU update with element-uniform noise: the modal variances are exact, but the cross-covariances of modes (correlated by eq. 5 noise) are not, by O((lambda dt)^2) for resolved modes: no single order",
+        ),
+        IntegratorKind::EulerMaruyama if obs == 0 && membrane => e(
+            Some(1.0),
+            false,
+            "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the error at the profile point is dt kT/2 sum_i phi_i(a/2, b/2)^2 + O(dt^2): order 1",
+        ),
+        IntegratorKind::EulerMaruyama if obs == 0 => e(
+            Some(1.0),
+            false,
+            "Euler-Maruyama: every mode's variance is multiplied by 1/(1 - lambda dt/2); at a fixed mesh the profile error is dt kT/2 sum_i phi_i(L/2)^2 + O(dt^2): order 1",
+        ),
+        IntegratorKind::EulerMaruyama => e(
+            Some(1.0),
+            false,
+            "Euler-Maruyama stationary variance ratio 1/(1 - lambda dt/2): bias O(lambda dt), order 1",
+        ),
+        IntegratorKind::BackwardEuler if obs == 0 && membrane => e(
+            Some(1.0),
+            false,
+            "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the membrane's sum over its 2D modes (sum 1/q^4 beyond q ~ dt^(-1/4)) gives about dt^(1/2), so the observed order lies between 1/2 and 1",
+        ),
+        IntegratorKind::BackwardEuler if obs == 0 => e(
+            Some(1.0),
+            false,
+            "backward Euler: each mode's variance is multiplied by 1/(1 + lambda dt/2): order 1 once lambda_max dt << 1; while lambda_max dt >> 1 the modes above lambda dt ~ 1 are frozen and the continuum-like sum gives about dt^(3/4), so the observed order lies between 3/4 and 1",
+        ),
+        IntegratorKind::BackwardEuler => e(
+            Some(1.0),
+            false,
+            "backward Euler stationary variance ratio 1/(1 + lambda dt/2): bias O(lambda dt), order 1",
+        ),
+        IntegratorKind::MetropolisCrankNicolson => e(
+            None,
+            true,
+            "on the linear problem every Crank-Nicolson proposal is accepted: exact",
+        ),
     }
 }
 
