@@ -651,16 +651,9 @@ fn corpus() -> Vec<Case> {
 }
 
 /// A membrane scene (issue #27): its parameters, its mesh, its sampling positions, the
-/// keys of the filament it cannot have, and every command that cannot simulate or check
-/// it yet (refused naming the scene and "not yet supported for membranes"; `converge`
-/// runs it, and refuses element counts above its cap).
+/// keys of the filament it cannot have, and the element caps of the studies that refine
+/// its plate (`converge`, `stability`).
 fn membrane_cases() -> Vec<Case> {
-    const REFUSED: &[&str] = &["key `membrane`", "not yet supported for membranes"];
-    let refused = |name: &'static str, a: &'static [&'static str]| Case {
-        name,
-        input: Input::Args(a, Some((Base::Membrane, &[]))),
-        expect: REFUSED,
-    };
     vec![
         memb(
             "membrane-kappa-nan",
@@ -878,7 +871,6 @@ fn membrane_cases() -> Vec<Case> {
             &[("[[0.5, 0.25, 0.5, 1.0]]", "[[0.5, 0.0, 0.5, 1.0]]")],
             &["key `sampling.two_time[0][1] (x'/a)`", "got 0", "in (0, 1)"],
         ),
-        refused("membrane-refused-run", &["run", "--scene", "SCENE"]),
         // converge runs a membrane's plate (issue #27) within its element cap.
         Case {
             name: "membrane-converge-values-above-cap",
@@ -890,14 +882,24 @@ fn membrane_cases() -> Vec<Case> {
             ),
             expect: &["--values", "got 30", "integer element counts in [2, 24]"],
         },
-        refused(
-            "membrane-refused-stability",
-            &["stability", "--scene", "SCENE"],
-        ),
-        refused(
-            "membrane-refused-work-precision",
-            &["work-precision", "--scene", "SCENE"],
-        ),
+        // stability maps a membrane's plate within the same cap, along x and along y at
+        // the scene's aspect ratio of elements (8 x 4 here).
+        Case {
+            name: "membrane-stability-elements-above-cap",
+            input: Input::Args(
+                &["stability", "--scene", "SCENE", "--elements", "4,30"],
+                Some((Base::Membrane, &[])),
+            ),
+            expect: &["--elements", "got 30", "integers in [2, 24] for a membrane"],
+        },
+        Case {
+            name: "membrane-stability-elements-y-below-cap",
+            input: Input::Args(
+                &["stability", "--scene", "SCENE", "--elements", "2"],
+                Some((Base::Membrane, &[])),
+            ),
+            expect: &["--elements", "got 2", "(got 2 x 1)", "(8 x 4)"],
+        },
     ]
 }
 

@@ -98,17 +98,11 @@ fn own_output_round_trips_in_both_formats() {
     }
 }
 
-/// Modal amplitudes scaled by 1.1 (variances +21 %): `check` exits 1 naming the mode
-/// variance checks of the well-resolved modes; the deflections untouched, the profile
-/// checks still pass.
-#[test]
-fn an_injected_bias_fails_naming_the_checks() {
-    let dir = TempDir::new("run-check-bias");
-    let data = dir.join_str("data");
-    simulate(&data, "csv");
-    let side = json(&Path::new(&data).join("data.json"));
+/// Multiplies, in every CSV file of the first run of the data in `data` (sidecar
+/// `side`), the columns whose header `chosen` picks by `factor`.
+fn scale_columns(data: &str, side: &serde_json::Value, chosen: impl Fn(&str) -> bool, factor: f64) {
     for f in side["runs"][0]["files"].as_array().unwrap() {
-        let path = Path::new(&data).join(f.as_str().unwrap());
+        let path = Path::new(data).join(f.as_str().unwrap());
         let text = std::fs::read_to_string(&path).unwrap();
         let mut lines = text.lines();
         let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -118,8 +112,8 @@ fn an_injected_bias_fails_naming_the_checks() {
                 .split(',')
                 .zip(&header)
                 .map(|(v, h)| {
-                    if h.starts_with("aw_") {
-                        (v.parse::<f64>().unwrap() * 1.1).to_string()
+                    if chosen(h) {
+                        (v.parse::<f64>().unwrap() * factor).to_string()
                     } else {
                         v.to_string()
                     }
@@ -129,6 +123,18 @@ fn an_injected_bias_fails_naming_the_checks() {
         }
         std::fs::write(&path, out).unwrap();
     }
+}
+
+/// Modal amplitudes scaled by 1.1 (variances +21 %): `check` exits 1 naming the mode
+/// variance checks of the well-resolved modes; the deflections untouched, the profile
+/// checks still pass.
+#[test]
+fn an_injected_bias_fails_naming_the_checks() {
+    let dir = TempDir::new("run-check-bias");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let side = json(&Path::new(&data).join("data.json"));
+    scale_columns(&data, &side, |h| h.starts_with("aw_"), 1.1);
     let report = dir.join("report");
     let (o, args) = check(&data, report.to_str().unwrap());
     assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
@@ -383,5 +389,104 @@ fn compression_data_round_trip() {
         report
             .join("compression-2d/metropolis-force-strain.csv")
             .is_file()
+    );
+}
+
+/// `run` of membrane-periodic's Crank–Nicolson run (16 trajectories, CSV) into `out`.
+fn simulate_membrane(out: &str) {
+    let args = [
+        "run",
+        "--scene",
+        "membrane-periodic",
+        "--run",
+        "crank-nicolson",
+        "--trajectories",
+        "16",
+        "--format",
+        "csv",
+        "--out",
+        out,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+}
+
+/// `check` of data `data` against `scene`, the report in `out`.
+fn check_scene(scene: &str, data: &str, out: &str) -> (std::process::Output, Vec<String>) {
+    let args: Vec<String> = ["check", "--scene", scene, "--data", data, "--out", out]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    (run(&refs), args)
+}
+
+/// A membrane's trajectories (issue #27): heights on the midline and the modal
+/// amplitudes named by their modes; its own output passes every check kind of the
+/// scene against its discretization's exact references; amplitudes scaled by 1.1 fail
+/// the mode variances of the slowest modes; a filament scene refuses the data naming
+/// the sidecar key `membrane`.
+#[test]
+fn membrane_output_round_trips_and_a_bias_fails() {
+    let dir = TempDir::new("run-check-membrane");
+    let data = dir.join_str("data");
+    simulate_membrane(&data);
+    let side = json(&Path::new(&data).join("data.json"));
+    assert_eq!(side["membrane"]["boundary"], "periodic");
+    assert!(side.get("filament").is_none());
+    assert_eq!(side["dims"], 3);
+    let first = Path::new(&data).join(side["runs"][0]["files"][0].as_str().unwrap());
+    let header = std::fs::read_to_string(&first).unwrap();
+    let header = header.lines().next().unwrap();
+    assert!(
+        header.starts_with("t,h_0,h_1,") && header.contains(",ac_0_1,as_0_1,ac_1_0,as_1_0"),
+        "{header}"
+    );
+    let report = dir.join("report");
+    let (o, args) = check_scene("membrane-periodic", &data, report.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr_of(&o));
+    let names: Vec<String> = checks(&report).into_iter().map(|c| c.0).collect();
+    for kind in [
+        "profile",
+        "mode-variance",
+        "decay-rate",
+        "two-time",
+        "pooled-variance",
+    ] {
+        assert!(
+            names.iter().any(|n| n.contains(&format!("/{kind}"))),
+            "{kind} missing: {names:?}"
+        );
+    }
+    // The amplitudes scaled by 1.1.
+    scale_columns(&data, &side, |h| h.starts_with('a'), 1.1);
+    let biased = dir.join("biased");
+    let (o, args) = check_scene("membrane-periodic", &data, biased.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr_of(&o));
+    let failed: Vec<String> = checks(&biased)
+        .into_iter()
+        .filter(|c| !c.1)
+        .map(|c| c.0)
+        .collect();
+    assert!(
+        failed.iter().any(|f| f == "crank-nicolson/pooled-variance"),
+        "{failed:?}"
+    );
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.starts_with("crank-nicolson/mode-variance/")),
+        "{failed:?}"
+    );
+    let (o, _) = check_scene(
+        "hinged-linear-2d",
+        &data,
+        dir.join("other").to_str().unwrap(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr_of(&o);
+    assert!(
+        err.contains("data.json: key `membrane`") && err.contains("the data are of a membrane"),
+        "{err}"
     );
 }

@@ -15,8 +15,8 @@ pub use merge::merge;
 use super::{Verbosity, usize_in};
 use clap::Args;
 use langevin_fem::data::{
-    COMPRESSION_COLUMNS, DataFilament, DataRun, DataSidecar, Discretization, FORMAT, SIDECAR,
-    Start, TrajectoryFile, VERSION, trajectory_columns,
+    COMPRESSION_COLUMNS, DataFilament, DataMembrane, DataRun, DataSidecar, Discretization, FORMAT,
+    SIDECAR, Start, TrajectoryFile, VERSION, trajectory_columns,
 };
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::banded::LANES;
@@ -57,8 +57,9 @@ Progress goes to stderr, the closing line (what was written, where) to stdout.";
 pub struct RunArgs {
     /// Scene: a name from the scene directory or a path to a .toml file, linear
     /// (hinged-linear-2d, hinged-linear-3d, spectral-reference: the deflection and modal
-    /// amplitudes) or compression (compression-2d, compression-3d: F and the stored length
-    /// per strain; a budget by target precision needs --duration-tau1).
+    /// amplitudes), a membrane (membrane-hinged, membrane-periodic, ...: the height on the
+    /// midline and modal amplitudes) or compression (compression-2d, compression-3d: F and
+    /// the stored length per strain; a budget by target precision needs --duration-tau1).
     #[arg(short, long, value_name = "NAME|PATH")]
     scene: String,
     /// Run of the scene to simulate (repeatable; default: every run).
@@ -376,24 +377,25 @@ impl Job {
             version: VERSION,
             producer: format!("langevin-fem {}", env!("CARGO_PKG_VERSION")),
             dims: scene.dims,
-            filament: DataFilament {
+            filament: scene.membrane.is_none().then_some(DataFilament {
                 length: f.length,
                 bending_rigidity: f.bending_rigidity,
                 drag: f.drag,
                 kt: f.kt,
                 stretch_rigidity,
-            },
+            }),
+            membrane: scene.membrane.as_ref().map(DataMembrane::of),
             runs,
             provenance: Some(serde_json::json!({
                 "run_id": report.run_id(),
                 "budget": self.budget().name(),
                 "seed": scene.seed,
                 "seed_note": self.seed_note,
-                "tau1": f.tau1(),
+                "tau1": scene.tau1(),
                 "journal": "manifest.json",
                 "record": provenance,
             })),
-            columns: Some(trajectory_columns()),
+            columns: Some(trajectory_columns(scene.is_membrane())),
         }
     }
 
@@ -407,6 +409,10 @@ impl Job {
             }
             .to_string(),
             elements: Some(self.scene.mesh.elements),
+            elements_y: self
+                .scene
+                .is_membrane()
+                .then(|| self.scene.mesh.elements_along_y()),
             integrator: Some(spec.integrator.to_string()),
             noise: Some(spec.noise.name().to_string()),
             dt: Some(dt),
@@ -417,7 +423,6 @@ impl Job {
 /// Runs the command (progress on stderr unless quiet); exit code 0.
 pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
     let mut scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
-    scene.refuse_membrane("writing trajectories (run)")?;
     args.sim.start()?;
     let seed_note = args.sim.apply(&mut scene);
     let runs = if args.runs.is_empty() {

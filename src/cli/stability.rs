@@ -7,8 +7,8 @@ use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::scene::load_scene;
 use langevin_fem::studies::stability::{
-    DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, ELEMENTS_RANGE, StabilityOptions,
-    Status, run_stability,
+    DEFAULT_DT_LAMBDA_MAX, DEFAULT_ELEMENTS, DEFAULT_INTEGRATORS, DEFAULT_MEMBRANE_ELEMENTS,
+    ELEMENTS_RANGE, StabilityOptions, Status, run_stability,
 };
 use std::path::PathBuf;
 
@@ -18,6 +18,7 @@ Examples:
   langevin-fem stability                                   the default map (4 integrators x 4 meshes x 7 steps)
   langevin-fem stability --elements 10 --dt-lambda-max 0.1,1.9,2.1,1e3 --steps 20000
   langevin-fem stability --integrators euler-maruyama,crank-nicolson -o out -j 2
+  langevin-fem stability -s membrane-hinged --elements 4 -o out   a membrane's plate, 4 x 4
 
 The map goes to stdout, progress to stderr; the exit code is 1 if an exact formula was
 rejected or a stability prediction failed.";
@@ -26,8 +27,8 @@ rejected or a stability prediction failed.";
 #[derive(Debug, Args)]
 #[command(after_help = EXAMPLES)]
 pub struct StabilityArgs {
-    /// Linear finite-element scene supplying the filament and the seed: a built-in
-    /// scene's name, a name in --scene-dir, or a path to a .toml file.
+    /// Linear finite-element scene supplying the filament (or membrane) and the seed: a
+    /// built-in scene's name, a name in --scene-dir, or a path to a .toml file.
     #[arg(
         short,
         long,
@@ -39,7 +40,8 @@ pub struct StabilityArgs {
     /// crank-nicolson, exact-modal).
     #[arg(long, value_name = "I1,I2,...")]
     integrators: Option<String>,
-    /// Comma-separated element counts (default 5,10,20,40).
+    /// Comma-separated element counts (default 5,10,20,40; a membrane's along x, default
+    /// 4,8, along y at the scene's aspect ratio of elements).
     #[arg(long, value_name = "N1,N2,...", allow_hyphen_values = true)]
     elements: Option<String>,
     /// Comma-separated normalized steps dt*lambda_max (default 0.1,1,1.9,2.1,10,1e3,1e5;
@@ -93,10 +95,16 @@ pub fn run(args: StabilityArgs, verbosity: Verbosity) -> Result<i32> {
             })
             .collect::<Result<_>>()?,
     };
+    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
+    args.sim.apply(&mut scene);
     let elements = parse_list_or(
         "--elements",
         args.elements.as_deref(),
-        &DEFAULT_ELEMENTS,
+        if scene.is_membrane() {
+            &DEFAULT_MEMBRANE_ELEMENTS
+        } else {
+            &DEFAULT_ELEMENTS
+        },
         &format!(
             "comma-separated integers in [{}, {}]",
             ELEMENTS_RANGE.0, ELEMENTS_RANGE.1
@@ -108,8 +116,6 @@ pub fn run(args: StabilityArgs, verbosity: Verbosity) -> Result<i32> {
         &DEFAULT_DT_LAMBDA_MAX,
         "comma-separated numbers in (0, 1e12]",
     )?;
-    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
-    args.sim.apply(&mut scene);
     let s = run_stability(&StabilityOptions {
         scene,
         integrators,

@@ -28,7 +28,7 @@ The cost table goes to stdout, progress to stderr.";
 #[command(after_help = EXAMPLES)]
 pub struct WorkPrecisionArgs {
     /// Linear finite-element scene (a built-in scene's name, a name in --scene-dir, or a
-    /// .toml path): filament, mesh, seed, burn-in.
+    /// .toml path): filament or membrane, mesh, seed, burn-in.
     #[arg(
         short,
         long,
@@ -143,10 +143,11 @@ pub fn run(args: WorkPrecisionArgs, verbosity: Verbosity) -> Result<i32> {
         limits: args.limits.limits(),
     })?;
     println!(
-        "{} ({} elements, seed {}): <w2(L/2)> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",
+        "{} ({} elements, seed {}): <{}> continuum {:.6e}; {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {:.2e}",
         s.scene,
         s.elements,
         s.seed,
+        s.observable,
         s.continuum,
         s.trajectories,
         s.duration_tau1,

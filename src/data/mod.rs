@@ -20,6 +20,13 @@
 //! - `filament`: length L, bending rigidity EI, transverse drag per length ξ and thermal
 //!   energy kT in one consistent unit system; every time (`dt_sample`, `burn_in`, the
 //!   column `t`) is in the time unit it implies (τ₁ = ξL⁴/(π⁴EI) sets the scale).
+//! - Or `membrane` ([`DataMembrane`], `dims` = 3): `width` a, `height` b,
+//!   `bending_rigidity` κ, `tension` σ, `drag` ξ per area, `kt` and `boundary`, every key
+//!   required; τ₁ = ξ/c_q of the slowest mode. Positions are x on the midline y = b/2;
+//!   the columns are `t`, `h_j` (the height there; periodic: from the spatial mean) and
+//!   the amplitudes of the `modes` slowest real modes named by their mode
+//!   ([`membrane_columns`]: `a_m_n`, or `ac_m_n` and `as_m_n`), in the conventions of
+//!   [`crate::spectral::membrane`].
 //! - A run's trajectories are sampled every `dt_sample` (between 1e-12 and 1e6 τ₁):
 //!   row `r` of a file is at time `t₀ + r·dt_sample`. `start = "rest"`: each trajectory starts from w = 0 at t = 0
 //!   (the first row), so the two-time correlation from rest, eq. (4), can be checked at
@@ -76,6 +83,9 @@ use crate::fem::noise::NoiseModel;
 use crate::input::{MAX_METADATA_BYTES, read_text};
 use crate::params::FilamentParams;
 use crate::scene::validate::MAX_ELEMENTS;
+use crate::spectral::membrane::{
+    Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
+};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -103,10 +113,16 @@ pub struct DataSidecar {
     /// Free text naming the program that wrote the data.
     #[serde(default)]
     pub producer: String,
-    /// 2 (one transverse deflection w) or 3 (w and v).
+    /// 2 (one transverse deflection w) or 3 (w and v; a membrane, whose height h is its
+    /// one component).
     pub dims: usize,
-    /// Physical parameters, in one consistent unit system.
-    pub filament: DataFilament,
+    /// The filament's physical parameters, in one consistent unit system (filament data:
+    /// exactly one of `filament` and `membrane` is given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filament: Option<DataFilament>,
+    /// The membrane's physical parameters and boundary (membrane data).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub membrane: Option<DataMembrane>,
     /// The runs.
     pub runs: Vec<DataRun>,
     /// Where the data came from when this tool wrote it (version, commit, seed, scene):
@@ -120,9 +136,20 @@ pub struct DataSidecar {
 }
 
 /// The units and meanings of the trajectory files' columns (`#` stands for the index
-/// `j` of `positions` or the mode number `n`), in the base dimensions of the filament's
-/// unit system ([`crate::output::columns`]: `[L]` its length unit, `[T]` its time unit).
-pub fn trajectory_columns() -> serde_json::Value {
+/// `j` of `positions` or the mode number `n`), in the base dimensions of the object's
+/// unit system ([`crate::output::columns`]: `[L]` its length unit, `[T]` its time unit):
+/// a filament's, or (`membrane`) a membrane's.
+pub fn trajectory_columns(membrane: bool) -> serde_json::Value {
+    if membrane {
+        return serde_json::json!([
+            { "name": "t", "unit": "[T]", "meaning": "time since the start (physical time, not a multiple of tau1)" },
+            { "name": "h_#", "unit": "[L]", "meaning": "height h at (positions[#], b/2) on the midline; periodic: measured from the spatial mean" },
+            { "name": "a_m_n", "unit": "[L]", "meaning": "simply supported: amplitude of sin(m pi x/a) sin(n pi y/b)" },
+            { "name": "ac_m_n, as_m_n", "unit": "[L]", "meaning": "periodic: amplitudes of cos(q.r) and sin(q.r), q = 2 pi (m/a, n/b)" },
+            { "name": "positions (sidecar)", "unit": "[L]", "meaning": "x of the height columns on the midline y = b/2" },
+            { "name": "dt_sample, burn_in, discretization.dt (sidecar)", "unit": "[T]", "meaning": "time between rows, burn-in, integration step" }
+        ]);
+    }
     serde_json::json!([
         { "name": "t", "unit": "[T]", "meaning": "time since the start (physical time, not a multiple of tau1)" },
         { "name": "w_#", "unit": "[L]", "meaning": "transverse deflection w at positions[#]" },
@@ -165,6 +192,125 @@ impl DataFilament {
             stretch_rigidity: self.stretch_rigidity.unwrap_or(default.stretch_rigidity),
         }
     }
+}
+
+/// The membrane of a data directory: the parameters of (M1) ([`MembraneParams`]), every
+/// key required.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataMembrane {
+    /// Side a along x (the sampling line y = b/2 runs along it).
+    pub width: f64,
+    /// Side b along y.
+    pub height: f64,
+    /// Bending rigidity κ (energy).
+    pub bending_rigidity: f64,
+    /// Tension σ (energy per area), above the buckling tension −κ q_min².
+    pub tension: f64,
+    /// Friction ξ per unit area.
+    pub drag: f64,
+    /// Thermal energy kT.
+    pub kt: f64,
+    /// `simply-supported` or `periodic`.
+    pub boundary: MembraneBoundary,
+}
+
+impl DataMembrane {
+    /// The membrane's parameters.
+    pub fn params(&self) -> MembraneParams {
+        MembraneParams {
+            bending_rigidity: self.bending_rigidity,
+            tension: self.tension,
+            drag: self.drag,
+            kt: self.kt,
+            width: self.width,
+            height: self.height,
+            boundary: self.boundary,
+        }
+    }
+
+    /// The membrane of `params`, as a sidecar records it.
+    pub fn of(params: &MembraneParams) -> Self {
+        DataMembrane {
+            width: params.width,
+            height: params.height,
+            bending_rigidity: params.bending_rigidity,
+            tension: params.tension,
+            drag: params.drag,
+            kt: params.kt,
+            boundary: params.boundary,
+        }
+    }
+}
+
+/// What the trajectories of a (validated) data directory are of.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DataObject {
+    /// A filament.
+    Filament(DataFilament),
+    /// A membrane, sampled on its midline y = b/2.
+    Membrane(DataMembrane),
+}
+
+impl DataObject {
+    /// The time unit τ₁ (the slowest relaxation time) of the object: ξL⁴/(π⁴EI) for a
+    /// filament ([`FilamentParams::tau1`]), ξ/c_q of the slowest mode for a membrane
+    /// ([`MembraneParams::tau1`]); NaN for parameters [`DataSidecar::validate`] refuses.
+    pub fn tau1(&self) -> f64 {
+        match self {
+            DataObject::Filament(f) => f.params().tau1(),
+            DataObject::Membrane(m) => m.params().tau1(),
+        }
+    }
+
+    /// The length of the sampling line on which `positions` lie: L, or the width a.
+    pub fn line_length(&self) -> f64 {
+        match self {
+            DataObject::Filament(f) => f.length,
+            DataObject::Membrane(m) => m.width,
+        }
+    }
+
+    /// The column names of a linear run with `positions` deflection columns and `modes`
+    /// modal amplitudes per component ([`columns`], [`membrane_columns`]).
+    ///
+    /// # Errors
+    /// A membrane whose modes cannot be listed ([`Membrane::modes`]).
+    pub fn columns(&self, dims: usize, positions: usize, modes: usize) -> Result<Vec<String>> {
+        match self {
+            DataObject::Filament(_) => Ok(columns(dims, positions, modes)),
+            DataObject::Membrane(m) => {
+                let labels = if modes == 0 {
+                    Vec::new()
+                } else {
+                    Membrane::new(m.params())?.modes(modes)?
+                };
+                Ok(membrane_columns(positions, &labels))
+            }
+        }
+    }
+}
+
+/// The name of the modal-amplitude column of membrane mode `mode`: `a_m_n` for
+/// sin(mπx/a) sin(nπy/b), `ac_m_n` and `as_m_n` for cos(q·r) and sin(q·r), q = 2π(m/a,
+/// n/b) (the real amplitudes of [`crate::spectral::membrane`]).
+pub fn membrane_mode_column(mode: MembraneMode) -> String {
+    let prefix = match mode.shape {
+        ModeShape::SineSine => "a",
+        ModeShape::Cosine => "ac",
+        ModeShape::Sine => "as",
+    };
+    format!("{prefix}_{}_{}", mode.m, mode.n)
+}
+
+/// The columns of a membrane run's files: `t`, the heights `h_j` at `positions` on the
+/// midline, then the modal amplitudes of `modes`, in their order
+/// ([`membrane_mode_column`]).
+pub fn membrane_columns(positions: usize, modes: &[MembraneMode]) -> Vec<String> {
+    let mut c = vec!["t".to_string()];
+    c.extend((0..positions).map(|j| format!("h_{j}")));
+    c.extend(modes.iter().map(|&m| membrane_mode_column(m)));
+    c
 }
 
 /// How the trajectories of a run start.
@@ -228,9 +374,13 @@ pub struct Discretization {
     /// `fem` (this tool's Hermite-cubic elements), `spectral` (exact modal), or any other
     /// name (then only reported).
     pub model: String,
-    /// Elements (`fem`) or modes carried (`spectral`).
+    /// Elements (`fem`) or modes carried (`spectral`); of a membrane, along x.
     #[serde(default)]
     pub elements: Option<usize>,
+    /// Membrane data: elements (`fem`) or mode indices (`spectral`) along y (left out:
+    /// as `elements`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements_y: Option<usize>,
     /// Integrator name as in scene files.
     #[serde(default)]
     pub integrator: Option<String>,
@@ -290,16 +440,18 @@ impl Discretization {
         if !self.is_modelled() {
             return Ok(());
         }
-        if let Some(e) = self.elements
-            && !(1..=MAX_ELEMENTS).contains(&e)
-        {
-            return Err((
-                key("elements"),
-                format!(
-                    "must be in [1, {MAX_ELEMENTS}] (as mesh.elements in scene files) for model {:?}, got {e}",
-                    self.model
-                ),
-            ));
+        for (name, count) in [("elements", self.elements), ("elements_y", self.elements_y)] {
+            if let Some(e) = count
+                && !(1..=MAX_ELEMENTS).contains(&e)
+            {
+                return Err((
+                    key(name),
+                    format!(
+                        "must be in [1, {MAX_ELEMENTS}] (as mesh.{name} in scene files) for model {:?}, got {e}",
+                        self.model
+                    ),
+                ));
+            }
         }
         if self.integrator_kind().is_none() {
             return Err((
@@ -408,26 +560,12 @@ impl DataSidecar {
                 format!("must be 2 or 3, got {}", self.dims),
             ));
         }
-        let f = &self.filament;
-        for (key, v) in [
-            ("stretch_rigidity", f.stretch_rigidity.unwrap_or(1.0)),
-            ("length", f.length),
-            ("bending_rigidity", f.bending_rigidity),
-            ("drag", f.drag),
-            ("kt", f.kt),
-        ] {
-            if !(v.is_finite() && v > 0.0 && (1e-30..=1e30).contains(&v)) {
-                return Err(bad(
-                    format!("filament.{key}"),
-                    format!("must be a finite number in [1e-30, 1e30], got {v}"),
-                ));
-            }
-        }
+        let object = self.validate_object(path)?;
         if self.runs.is_empty() {
             return Err(bad("runs".into(), "must list at least one run".into()));
         }
         for (k, run) in self.runs.iter().enumerate() {
-            run.validate(k, f, self.runs.iter().take(k))
+            run.validate(k, &object, self.runs.iter().take(k))
                 .map_err(|(key, message)| bad(key, message))?;
         }
         // Each file is one trajectory: listed twice, it would be counted twice.
@@ -448,13 +586,110 @@ impl DataSidecar {
     }
 }
 
+impl DataSidecar {
+    /// The object of the data: the filament or the membrane (`None` unless exactly one
+    /// is given; [`DataSidecar::load`] refuses that).
+    pub fn object(&self) -> Option<DataObject> {
+        match (self.filament, self.membrane) {
+            (Some(f), None) => Some(DataObject::Filament(f)),
+            (None, Some(m)) => Some(DataObject::Membrane(m)),
+            _ => None,
+        }
+    }
+
+    /// Checks the object's parameters (sidecar `path`): exactly one of `filament` and
+    /// `membrane`, every parameter finite, positive where it must be and within
+    /// [1e-30, 1e30] in magnitude; a membrane's tension above its buckling tension and
+    /// `dims` = 3 (a surface in space).
+    fn validate_object(&self, path: &Path) -> Result<DataObject> {
+        let bad = |key: String, message: String| Error::Scene {
+            file: path.to_path_buf(),
+            key,
+            message,
+        };
+        let Some(object) = self.object() else {
+            let key = if self.filament.is_some() {
+                "membrane"
+            } else {
+                "filament"
+            };
+            return Err(bad(
+                key.into(),
+                "exactly one of filament (a filament's length, bending_rigidity, drag, kt) and membrane (width, height, bending_rigidity, tension, drag, kt, boundary) must be given".into(),
+            ));
+        };
+        let (table, values): (&str, Vec<(&str, f64)>) = match &object {
+            DataObject::Filament(f) => (
+                "filament",
+                vec![
+                    ("stretch_rigidity", f.stretch_rigidity.unwrap_or(1.0)),
+                    ("length", f.length),
+                    ("bending_rigidity", f.bending_rigidity),
+                    ("drag", f.drag),
+                    ("kt", f.kt),
+                ],
+            ),
+            DataObject::Membrane(m) => (
+                "membrane",
+                vec![
+                    ("width", m.width),
+                    ("height", m.height),
+                    ("bending_rigidity", m.bending_rigidity),
+                    ("drag", m.drag),
+                    ("kt", m.kt),
+                ],
+            ),
+        };
+        for (key, v) in values {
+            if !(v.is_finite() && v > 0.0 && (1e-30..=1e30).contains(&v)) {
+                return Err(bad(
+                    format!("{table}.{key}"),
+                    format!("must be a finite number in [1e-30, 1e30], got {v}"),
+                ));
+            }
+        }
+        if let DataObject::Membrane(m) = &object {
+            if !(m.tension.is_finite() && m.tension.abs() <= 1e30) {
+                return Err(bad(
+                    "membrane.tension".into(),
+                    format!(
+                        "must be a finite number in [-1e30, 1e30], got {}",
+                        m.tension
+                    ),
+                ));
+            }
+            m.params().validate().map_err(|e| match e {
+                Error::InvalidParameter {
+                    name,
+                    value,
+                    allowed,
+                } => bad(
+                    format!("membrane.{name}"),
+                    format!("must be {allowed}, got {value}"),
+                ),
+                other => other,
+            })?;
+            if self.dims != 3 {
+                return Err(bad(
+                    "dims".into(),
+                    format!(
+                        "must be 3 for membrane data (a surface in space, one height h per position), got {}",
+                        self.dims
+                    ),
+                ));
+            }
+        }
+        Ok(object)
+    }
+}
+
 impl DataRun {
-    /// Checks run `k` of a sidecar (`earlier`: the runs before it), for filament
-    /// `filament`; on failure (key, message).
+    /// Checks run `k` of a sidecar (`earlier`: the runs before it), of `object`; on
+    /// failure (key, message).
     fn validate<'a>(
         &self,
         k: usize,
-        filament: &DataFilament,
+        object: &DataObject,
         mut earlier: impl Iterator<Item = &'a DataRun>,
     ) -> std::result::Result<(), (String, String)> {
         let key = |s: &str| format!("runs[{k}].{s}");
@@ -486,13 +721,17 @@ impl DataRun {
                 format!("must be a finite ratio in [-1e6, 1e6], got {r}"),
             ));
         }
-        let tau1 = filament.params().tau1();
+        let tau1 = object.tau1();
         let (lo, hi) = (MIN_SAMPLE_TAU1 * tau1, MAX_SAMPLE_TAU1 * tau1);
         if !(self.dt_sample.is_finite() && (lo..=hi).contains(&self.dt_sample)) {
             return Err((
                 key("dt_sample"),
                 format!(
-                    "must be a time between rows in [{MIN_SAMPLE_TAU1:e}, {MAX_SAMPLE_TAU1:e}] tau1 = [{lo:e}, {hi:e}] (tau1 = xi L^4/(pi^4 EI) = {tau1:e} from the filament), got {:e}",
+                    "must be a time between rows in [{MIN_SAMPLE_TAU1:e}, {MAX_SAMPLE_TAU1:e}] tau1 = [{lo:e}, {hi:e}] (tau1 = {} = {tau1:e}), got {:e}",
+                    match object {
+                        DataObject::Filament(_) => "xi L^4/(pi^4 EI) from the filament",
+                        DataObject::Membrane(_) => "xi/c_q of the membrane's slowest mode",
+                    },
                     self.dt_sample
                 ),
             ));
@@ -503,9 +742,9 @@ impl DataRun {
                 format!("must be a finite time >= 0, got {}", self.burn_in),
             ));
         }
-        self.validate_layout(k, filament.length)?;
+        self.validate_layout(k, object.line_length())?;
         match &self.discretization {
-            Some(d) => d.validate(k, self.dt_sample, filament.params().tau1()),
+            Some(d) => d.validate(k, self.dt_sample, tau1),
             None => Ok(()),
         }
     }
@@ -528,7 +767,9 @@ impl DataRun {
             if !(x.is_finite() && (0.0..=length).contains(&x)) {
                 return Err((
                     format!("runs[{k}].positions[{j}]"),
-                    format!("must be in [0, L] = [0, {length}], got {x}"),
+                    format!(
+                        "must be in [0, {length}] (the filament's [0, L], or a membrane's midline x in [0, a]), got {x}"
+                    ),
                 ));
             }
         }
@@ -688,6 +929,71 @@ mod tests {
             .replace("\"fem\"", "\"finite-differences\"")
             .replace("\"elements\": 4", "\"elements\": 100000");
         assert!(load("other", &other).is_ok());
+    }
+
+    /// A valid membrane sidecar: a simply supported unit square, rows of heights on
+    /// its midline.
+    const MEMBRANE: &str = r#"{ "format": "langevin-fem-trajectories", "version": 1, "dims": 3,
+  "membrane": { "width": 1.0, "height": 1.0, "bending_rigidity": 1.0, "tension": 0.0,
+                "drag": 1.0, "kt": 1.0, "boundary": "simply-supported" },
+  "runs": [ { "name": "cn", "dt_sample": 1.0e-4, "start": "rest", "burn_in": 0.0,
+              "positions": [0.5], "modes": 3, "files": ["cn/t0.csv"] } ] }"#;
+
+    /// Membrane data load with their own time unit and columns (heights `h_j`, then
+    /// the modal amplitudes named by their modes, slowest first); every key is
+    /// required, the tension must lie above buckling, dims must be 3, and exactly one
+    /// of filament and membrane may be given.
+    #[test]
+    fn membrane_sidecars_load_and_their_errors_name_the_key() {
+        let side = load("membrane", MEMBRANE).unwrap();
+        let object = side.object().unwrap();
+        // τ₁ = ξ/c_q of mode (1, 1): q² = 2π², c_q = κq⁴.
+        let q2 = 2.0 * std::f64::consts::PI.powi(2);
+        assert!((object.tau1() * q2 * q2 - 1.0).abs() < 1e-14);
+        assert_eq!(
+            object.columns(3, 1, 3).unwrap(),
+            ["t", "h_0", "a_1_1", "a_1_2", "a_2_1"]
+        );
+        let periodic = MEMBRANE.replace("\"simply-supported\"", "\"periodic\"");
+        let p = load("periodic", &periodic).unwrap().object().unwrap();
+        assert_eq!(
+            p.columns(3, 0, 4).unwrap(),
+            ["t", "ac_0_1", "as_0_1", "ac_1_0", "as_1_0"]
+        );
+        let bad = |from: &str, to: &str, named: &[&str]| {
+            assert!(MEMBRANE.contains(from), "{from}");
+            let e = load("bad-membrane", &MEMBRANE.replacen(from, to, 1)).unwrap_err();
+            assert_eq!(e.exit_code(), 2, "{e}");
+            for n in named {
+                assert!(e.to_string().contains(n), "{n:?} not in {e}");
+            }
+        };
+        bad(
+            "\"tension\": 0.0",
+            "\"tension\": -20.0",
+            &["`membrane.tension`", "buckling tension", "got -20"],
+        );
+        bad("\"kt\": 1.0,", "", &["`membrane.kt`", "missing field `kt`"]);
+        bad(
+            "\"width\": 1.0",
+            "\"width\": 0.0",
+            &["`membrane.width`", "[1e-30, 1e30]", "got 0"],
+        );
+        bad(
+            "\"dims\": 3",
+            "\"dims\": 2",
+            &["`dims`", "must be 3", "got 2"],
+        );
+        bad(
+            "\"membrane\": {",
+            "\"filament\": { \"length\": 1.0, \"bending_rigidity\": 1.0, \"drag\": 1.0, \"kt\": 1.0 }, \"membrane\": {",
+            &["`membrane`", "exactly one of filament"],
+        );
+        bad(
+            "\"positions\": [0.5]",
+            "\"positions\": [1.5]",
+            &["`runs[0].positions[0]`", "[0, 1]", "got 1.5"],
+        );
     }
 
     /// A FIFO named data.json is refused at once.

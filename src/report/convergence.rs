@@ -174,8 +174,13 @@ fn convergence_section(h: &mut String, dir: &Path, journal: &str, v: &ConvergeSu
 fn work_precision_section(h: &mut String, dir: &Path, journal: &str, v: &WorkPrecisionSummary) {
     let _ = writeln!(
         h,
-        "<h2>Work–precision ({})</h2>\n<p class=\"meta\">Error in &lt;w²(L/2)&gt; against the continuum, {} elements, {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {}. Projected wall time to reach a relative error of {} with 95 % confidence (bias + 2 s.e.), from the measured cost and standard error (s.e. ∝ T<sup>-1/2</sup>); {} points disagree with their exact discrete value by more than 3 s.e.</p>",
+        "<h2>Work–precision ({})</h2>\n<p class=\"meta\">Error in &lt;{}&gt; against the continuum, {} elements, {} trajectories x {} tau1 per point (euler-maruyama {} tau1), {} threads; sampling floor (median relative s.e.) {}. Projected wall time to reach a relative error of {} with 95 % confidence (bias + 2 s.e.), from the measured cost and standard error (s.e. ∝ T<sup>-1/2</sup>); {} points disagree with their exact discrete value by more than 3 s.e.</p>",
         esc(&v.scene),
+        match v.observable.as_str() {
+            "w2(L/2)" => "w²(L/2)".to_string(),
+            "h2(a/2,b/2)" => "h²(a/2, b/2)".to_string(),
+            other => esc(other),
+        },
         v.elements,
         v.trajectories,
         json(&v.duration_tau1),

@@ -32,7 +32,8 @@ use std::cell::RefCell;
 mod object;
 mod stream;
 
-use object::{Continuum, FemObject};
+pub(crate) use object::Continuum;
+pub(crate) use object::FemObject;
 
 pub use stream::RowPlan;
 
@@ -883,8 +884,9 @@ impl Setup<'_> {
 
     /// The O(n) modal path of a plate with consistent noise ([`ModalPath`]): its modes
     /// are separable, so its runs step in modal coordinates, with the modal probes at
-    /// every position an observer reads (profile and two-time points); `None` for the
-    /// beam and for the element-uniform load (the banded nodal path, the general one).
+    /// every position an observer reads (profile and two-time points, and the mesh
+    /// nodes on the sampling line that `run` writes); `None` for the beam and for the
+    /// element-uniform load (the banded nodal path, the general one).
     fn modal_path(
         &self,
         object: &FemObject,
@@ -896,6 +898,8 @@ impl Setup<'_> {
         (plate && self.spec.noise == NoiseModel::Consistent).then(|| {
             let mut xs = self.profile_x.clone();
             xs.extend(two_time.iter().flat_map(|q| [q.x, q.y]));
+            xs.extend(object.line_nodes());
+            xs.sort_by(f64::total_cmp);
             xs.dedup();
             ModalPath {
                 rates: gm.rates.iter().copied().collect(),
@@ -943,10 +947,7 @@ impl LinearRun {
     /// [`Error::UnstableTimeStep`] for an explicit integrator above its limit; numerical
     /// failures of the reference computations.
     pub fn prepare(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
-        let continuum = match scene.membrane {
-            Some(m) => Continuum::membrane(Membrane::new(m)?, scene.sampling.modes)?,
-            None => Continuum::Filament(HingedBeam::new(scene.filament)?),
-        };
+        let continuum = Continuum::of(scene)?;
         let tau1 = scene.tau1();
         let dt = spec.dt_tau1 * tau1;
         let length = continuum.line_length();

@@ -68,9 +68,8 @@
 //! two_time = [[0.5, 0.5, 0.5, 1.0]]  # (x/a, x'/a, t/τ1, η/τ1) on y = b/2
 //! ```
 //!
-//! (`[[runs]]` as for the filament.) `verify` (with `--shard` and `merge`), `calibrate`
-//! and `converge` (finite-element membranes) run membrane scenes; `run`, `check`,
-//! `stability` and `work-precision` refuse them yet ([`Scene::refuse_membrane`]).
+//! (`[[runs]]` as for the filament.) Every command of the linear filament takes membrane
+//! scenes; the compression model refuses them ([`Scene::refuse_membrane`]).
 //!
 //! An ensemble's keys (every budget: `quick`, `standard`, `full`):
 //!
@@ -132,7 +131,7 @@ use crate::fem::noise::NoiseModel;
 use crate::output::provenance::{DescribeScene, SceneProvenance};
 use crate::params::FilamentParams;
 use crate::params::physical::{self, FilamentInput, PhysicalFilament};
-use crate::spectral::membrane::{Membrane, MembraneParams};
+use crate::spectral::membrane::MembraneParams;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -595,9 +594,17 @@ impl Scene {
     pub fn tau1(&self) -> f64 {
         match &self.membrane {
             None => self.filament.tau1(),
-            Some(p) => Membrane::new(*p)
-                .and_then(|m| Ok((m, m.modes(1)?)))
-                .map_or(f64::NAN, |(m, slowest)| p.drag / m.stiffness(slowest[0])),
+            Some(p) => p.tau1(),
+        }
+    }
+
+    /// The length of the line the scene's positions lie on (profile and two-time points
+    /// are fractions of it): the filament's length L, or the membrane's width a (its
+    /// midline y = b/2).
+    pub fn line_length(&self) -> f64 {
+        match &self.membrane {
+            None => self.filament.length,
+            Some(p) => p.width,
         }
     }
 
@@ -611,9 +618,9 @@ impl Scene {
         }
     }
 
-    /// Refuses a membrane scene where only filament scenes can go yet (issue #27:
-    /// membranes are verified, calibrated, sharded and converged like filaments, but trajectory
-    /// files, the stability map and the work-precision study are the filament's):
+    /// Refuses a membrane scene where only filament scenes can go (issue #27: every
+    /// command of the linear filament takes membranes; the compression model of Fig. 2 is
+    /// the filament's):
     /// `what` names the command or path, e.g. `run`.
     ///
     /// # Errors
@@ -628,8 +635,8 @@ impl Scene {
             key: "membrane".to_string(),
             message: format!(
                 "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
-                 (membranes run through verify, verify --shard, merge, calibrate and converge); use a \
-                 filament scene here",
+                 (membranes run through every command of the linear filament); use a filament scene \
+                 here",
                 self.name
             ),
         })

@@ -2,8 +2,9 @@
 //! (`langevin-fem stability`).
 //!
 //! For each integrator, element count and normalized step a = Δt·λ_max (λ_max the fastest
-//! generalized rate of (K, C) on that mesh) the linear filament is simulated from rest
-//! with consistent noise, and the cell is classified:
+//! generalized rate of (K, C) on that mesh) the linear filament (or the membrane's plate,
+//! [`uniform_object`]) is simulated from rest with consistent noise, and the cell is
+//! classified:
 //!
 //! - **unstable**: the amplification factor of some mode has |m| ≥ 1. The tool refuses
 //!   such a run before simulating ([`build_integrator`] returns
@@ -40,14 +41,16 @@ use crate::dynamics::{
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
-use crate::fem::modal::generalized_modes;
 use crate::fem::noise::NoiseModel;
 use crate::output::io::CsvWriter;
 use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::{derive_seed, trajectory_rng};
+use crate::scene::linear::FemObject;
 use crate::scene::{ModelKind, Scene};
+use crate::spectral::membrane::Membrane;
 use crate::stats;
 use crate::studies::converge::nan_if_null;
+use crate::studies::converge::{MEMBRANE_ELEMENTS_RANGE, membrane_elements_y};
 use crate::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -56,6 +59,8 @@ use std::time::Instant;
 
 /// Default element counts of the map.
 pub const DEFAULT_ELEMENTS: [usize; 4] = [5, 10, 20, 40];
+/// Default element counts (along x) of the map of a membrane.
+pub const DEFAULT_MEMBRANE_ELEMENTS: [usize; 2] = [4, 8];
 /// Default normalized steps a = Δt·λ_max: well inside, at and beyond the explicit limit
 /// (a = 2), and far beyond it.
 pub const DEFAULT_DT_LAMBDA_MAX: [f64; 7] = [0.1, 1.0, 1.9, 2.1, 10.0, 1.0e3, 1.0e5];
@@ -98,8 +103,20 @@ pub struct StabilityOptions {
     pub limits: WorkLimits,
 }
 
+/// The unknowns of `scene`'s object on a uniform mesh of `elements` elements (an upper
+/// bound): 2·elements for a beam, 4(nx + 1)(ny + 1) for a plate.
+fn unknowns(scene: &Scene, elements: usize) -> f64 {
+    if scene.is_membrane() {
+        let ny = membrane_elements_y(scene, elements);
+        4.0 * (elements as f64 + 1.0) * (ny as f64 + 1.0)
+    } else {
+        2.0 * elements as f64
+    }
+}
+
 /// The projected work of the map (an upper bound, see [`crate::work`]): every cell runs
-/// `trajectories × (burn_in_steps + sampled_steps)` steps of `2·elements` unknowns
+/// `trajectories × (burn_in_steps + sampled_steps)` steps of its unknowns ([`unknowns`]:
+/// `2·elements` for a filament)
 /// (`(2·elements)²` for exact-modal; a refused cell runs one forced trajectory instead)
 /// and holds the series of at most [`MAX_CHECKED_MODES`] modes at every sampled step;
 /// the cells run in parallel, as many at once as there are threads.
@@ -111,7 +128,7 @@ pub fn projected_work(opts: &StabilityOptions) -> WorkProjection {
     let mut per_cell_samples: f64 = 0.0;
     for &k in &opts.integrators {
         for &e in &opts.elements {
-            let n = 2.0 * e as f64;
+            let n = unknowns(&opts.scene, e);
             let cost = if k == IntegratorKind::ExactModal {
                 n * n
             } else {
@@ -301,8 +318,6 @@ pub struct StabilitySummary {
 
 /// Validates the options (exit code 2 on bad input, naming the flag).
 fn validate(opts: &StabilityOptions) -> Result<()> {
-    opts.scene
-        .refuse_membrane("the stability study (stability)")?;
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
             "--scene",
@@ -310,15 +325,7 @@ fn validate(opts: &StabilityOptions) -> Result<()> {
             "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d)",
         ));
     }
-    for &e in &opts.elements {
-        if !(ELEMENTS_RANGE.0..=ELEMENTS_RANGE.1).contains(&e) {
-            return Err(Error::invalid(
-                "--elements",
-                e,
-                format!("integers in [{}, {}]", ELEMENTS_RANGE.0, ELEMENTS_RANGE.1),
-            ));
-        }
-    }
+    validate_elements(&opts.scene, &opts.elements, "--elements")?;
     for &a in &opts.dt_lambda_max {
         if !(a.is_finite() && a > 0.0 && a <= 1e12) {
             return Err(Error::invalid("--dt-lambda-max", a, "numbers in (0, 1e12]"));
@@ -368,6 +375,42 @@ fn validate(opts: &StabilityOptions) -> Result<()> {
     Ok(())
 }
 
+/// Checks the element counts `elements` of a study of `scene` (flag `flag`): integers in
+/// [`ELEMENTS_RANGE`] for a filament; for a membrane in [`MEMBRANE_ELEMENTS_RANGE`] along
+/// x and, at the scene's aspect ratio of elements, along y (a periodic membrane needs 2
+/// a side).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `flag`, the value and the allowed range.
+pub(crate) fn validate_elements(scene: &Scene, elements: &[usize], flag: &str) -> Result<()> {
+    let (lo, hi) = if scene.is_membrane() {
+        MEMBRANE_ELEMENTS_RANGE
+    } else {
+        ELEMENTS_RANGE
+    };
+    for &e in elements {
+        let ny = if scene.is_membrane() {
+            membrane_elements_y(scene, e)
+        } else {
+            e
+        };
+        if !(lo..=hi).contains(&e) || !(lo..=hi).contains(&ny) {
+            let what = if scene.is_membrane() {
+                format!(
+                    "integers in [{lo}, {hi}] for a membrane, whose count along y at the aspect ratio of elements of {} ({} x {}) is in [{lo}, {hi}] too (got {e} x {ny})",
+                    scene.path.display(),
+                    scene.mesh.elements,
+                    scene.mesh.elements_along_y()
+                )
+            } else {
+                format!("integers in [{lo}, {hi}]")
+            };
+            return Err(Error::invalid(flag, e, what));
+        }
+    }
+    Ok(())
+}
+
 /// Decay per step of a mode with multiplier `m` (infinite for m = 0).
 fn decay(m: f64) -> f64 {
     -m.abs().ln()
@@ -404,9 +447,32 @@ fn checked_modes(rates: &[f64], mult: &[f64], burn_in: u64, sampled: u64) -> Vec
     out
 }
 
-/// The model of one cell: the beam, its generalized modes, the step and the multipliers.
+/// The finite-element object of `scene` on a uniform mesh of `elements` elements: the
+/// filament's beam, or the membrane's plate with `elements` along x and, along y, the
+/// scene's aspect ratio of elements ([`membrane_elements_y`]).
+///
+/// # Errors
+/// As [`BeamModel::new`] and [`FemObject::plate`].
+pub(crate) fn uniform_object(scene: &Scene, elements: usize) -> Result<FemObject> {
+    match scene.membrane {
+        None => {
+            let p = scene.filament;
+            let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
+            Ok(FemObject::Beam(Box::new(beam)))
+        }
+        Some(m) => FemObject::plate(
+            &Membrane::new(m)?,
+            elements,
+            membrane_elements_y(scene, elements),
+            Vec::new(),
+        ),
+    }
+}
+
+/// The model of one cell: the object, its generalized modes, the step and the
+/// multipliers.
 struct CellModel {
-    beam: BeamModel,
+    object: FemObject,
     gm: crate::fem::modal::GeneralizedModes,
     rates: Vec<f64>,
     dt: f64,
@@ -423,14 +489,13 @@ impl CellModel {
         a: f64,
     ) -> Result<(CellModel, Cell)> {
         let scene = &opts.scene;
-        let p = scene.filament;
-        let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
-        let gm = generalized_modes(&beam)?;
+        let object = uniform_object(scene, elements)?;
+        let gm = object.modes()?;
         let rates: Vec<f64> = gm.rates.iter().copied().collect();
         let n = rates.len();
         let lmax = rates[n - 1];
         let dt = a / lmax;
-        let kt = p.kt;
+        let kt = object.system().kt();
         let mult: Vec<f64> = rates
             .iter()
             .map(|&r| kind.modal_form(r, dt, kt).0)
@@ -443,7 +508,7 @@ impl CellModel {
             integrator: kind.name().to_string(),
             elements,
             dt_lambda_max: a,
-            dt_tau1: dt / p.tau1(),
+            dt_tau1: dt / scene.tau1(),
             max_multiplier: mult[n - 1],
             status: Status::Stable,
             detail: String::new(),
@@ -454,7 +519,7 @@ impl CellModel {
             modes: Vec::new(),
         };
         let model = CellModel {
-            beam,
+            object,
             gm,
             rates,
             dt,
@@ -473,7 +538,7 @@ impl CellModel {
     fn integrator(&self, kind: IntegratorKind) -> Result<Box<dyn Integrator>> {
         build_integrator(
             kind,
-            &self.beam,
+            self.object.system(),
             NoiseModel::Consistent,
             self.dt,
             self.max_rate(),
@@ -493,8 +558,9 @@ impl CellModel {
                 });
             }
         };
-        let forced = ThetaScheme::new(&self.beam, NoiseModel::Consistent, theta, self.dt)?;
-        let mut system = Components::at_rest(forced, 1, self.rates.len());
+        let system = self.object.system();
+        let forced = ThetaScheme::new(system, NoiseModel::Consistent, theta, self.dt)?;
+        let mut system = Components::at_rest(forced, 1, system.n_dofs());
         let driver = Driver::new(self.dt, opts.burn_in_steps, opts.sampled_steps, 1);
         let mut rng = trajectory_rng(self.seed, 0);
         match driver.run(0, &mut system, &mut rng, &mut (), |_| String::new()) {
@@ -516,7 +582,8 @@ impl CellModel {
         let driver = Driver::new(self.dt, opts.burn_in_steps, opts.sampled_steps, 1);
         (0..opts.trajectories)
             .map(|j| -> Result<Vec<Vec<f64>>> {
-                let mut system = Components::at_rest(self.integrator(kind)?, 1, self.rates.len());
+                let n_dofs = self.object.system().n_dofs();
+                let mut system = Components::at_rest(self.integrator(kind)?, 1, n_dofs);
                 let mut rng = trajectory_rng(self.seed, j as u64);
                 let mut obs = ModeSeries {
                     rows,
@@ -627,7 +694,7 @@ fn run_cell(
         })
         .count();
     cell.unresolved_modes = n - n_resolvable;
-    let projector = model.gm.projector(&model.beam, n);
+    let projector = model.gm.projector(model.object.system(), n);
     let rows: Vec<Vec<f64>> = modes
         .iter()
         .map(|&i| projector.row(i).iter().copied().collect())
@@ -644,7 +711,7 @@ fn run_cell(
             Err(e) => return Err(e),
         }
     }
-    let kt = opts.scene.filament.kt;
+    let kt = model.object.system().kt();
     for (k, &i) in modes.iter().enumerate() {
         let m = model.mode_bias(kind, kt, &per_traj, (k, i))?;
         cell.predicted_max_bias = cell.predicted_max_bias.max((m.formula_ratio - 1.0).abs());
@@ -712,9 +779,8 @@ fn classify(cell: &mut Cell, biased: bool) {
 /// ([`super::output`]); a rerun removes the maps of integrators it left out.
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag), a membrane scene (exit 2,
-/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`;
-/// numerical or I/O failures.
+/// Bad options (exit 2, naming the flag), a projected work or memory above
+/// `opts.limits`; numerical or I/O failures.
 pub fn run_stability(opts: &StabilityOptions) -> Result<StabilitySummary> {
     let start = Instant::now();
     let provenance = Provenance::begin(&[&opts.scene]);

@@ -1,5 +1,6 @@
-//! Work–precision study (`langevin-fem work-precision`): the error in ⟨w²(L/2)⟩ against
-//! wall time for every integrator and noise model on the same scene.
+//! Work–precision study (`langevin-fem work-precision`): the error in ⟨w²(L/2)⟩ (a
+//! membrane's ⟨h²⟩ at the middle of its midline, the centre) against wall time for every
+//! integrator and noise model on the same scene.
 //!
 //! Each method (integrator × noise model) is run at several time steps, each point with
 //! the same ensemble (trajectories × sampled duration; euler-maruyama, whose step is
@@ -8,7 +9,7 @@
 //! (cost per step). For each point:
 //!
 //! - the measured relative error |estimate − continuum|/continuum (the continuum profile
-//!   variance kT x²(L − x)²/(3EIL) of eq. 2), with its standard error
+//!   variance kT x²(L − x)²/(3EIL) of eq. 2, or the membrane's (M5)), with its standard error
 //!   (autocorrelation-aware, trajectories in quadrature, as in the verification checks);
 //! - the exact relative bias b = |discrete − continuum|/continuum of this mesh, noise
 //!   model, integrator and Δt (no sampling): the error the method keeps with unlimited
@@ -30,7 +31,7 @@ use crate::fem::noise::NoiseModel;
 use crate::output::io::CsvWriter;
 use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
-use crate::scene::linear::LinearRun;
+use crate::scene::linear::{FemObject, LinearRun};
 use crate::scene::validate::Num;
 use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
@@ -149,7 +150,7 @@ pub struct WpPoint {
     /// Measured wall time of the ensemble (s).
     #[serde(deserialize_with = "nan_if_null")]
     pub wall_seconds: f64,
-    /// Estimate of ⟨w²(L/2)⟩.
+    /// Estimate of ⟨w²(L/2)⟩ (a membrane's ⟨h²⟩ at the centre).
     #[serde(deserialize_with = "nan_if_null")]
     pub estimate: f64,
     /// Its standard error.
@@ -217,7 +218,7 @@ pub struct WorkPrecisionSummary {
     pub seed: u64,
     /// Elements of the mesh.
     pub elements: usize,
-    /// The observable.
+    /// The observable: `w2(L/2)`, or a membrane's `h2(a/2,b/2)` (the centre).
     pub observable: String,
     /// Its continuum value.
     #[serde(deserialize_with = "nan_if_null")]
@@ -254,8 +255,6 @@ pub struct WorkPrecisionSummary {
 }
 
 fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
-    opts.scene
-        .refuse_membrane("the work-precision study (work-precision)")?;
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
             "--scene",
@@ -370,9 +369,8 @@ type PreparedPoint = ((IntegratorKind, NoiseModel), f64, Scene, LinearRun);
 /// `work-precision.manifest.json`, after every simulation ([`super::output`]).
 ///
 /// # Errors
-/// Bad options (exit 2, naming the flag), a membrane scene (exit 2,
-/// [`Scene::refuse_membrane`]), a projected work or memory above `opts.limits`; run
-/// failures.
+/// Bad options (exit 2, naming the flag), a projected work or memory above
+/// `opts.limits`; run failures.
 pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSummary> {
     let start = Instant::now();
     let provenance = Provenance::begin(&[&opts.scene]);
@@ -404,7 +402,12 @@ pub fn run_work_precision(opts: &WorkPrecisionOptions) -> Result<WorkPrecisionSu
         scene: opts.scene.name.clone(),
         seed: opts.scene.seed,
         elements: opts.scene.mesh.elements,
-        observable: "w2(L/2)".to_string(),
+        observable: if opts.scene.is_membrane() {
+            "h2(a/2,b/2)"
+        } else {
+            "w2(L/2)"
+        }
+        .to_string(),
         continuum: points.first().map_or(f64::NAN, |p| p.continuum),
         tolerance: opts.tolerance,
         trajectories: opts.trajectories,
@@ -444,8 +447,15 @@ fn method_dts(
 ) -> Result<Vec<f64>> {
     Ok(if method.0 == IntegratorKind::EulerMaruyama {
         let s = point_scene(opts, method, 1.0);
-        let beam = crate::fem::beam::BeamModel::new(s.filament, s.mesh.build(s.filament.length)?)?;
-        let limit = beam.explicit_euler_dt_limit()? / s.tau1();
+        let object = match s.membrane {
+            None => FemObject::Beam(Box::new(crate::fem::beam::BeamModel::new(
+                s.filament,
+                s.mesh.build(s.filament.length)?,
+            )?)),
+            Some(_) => super::stability::uniform_object(&s, s.mesh.elements)?,
+        };
+        // The explicit limit Δt < 2/λ_max (BeamModel::explicit_euler_dt_limit).
+        let limit = 2.0 / object.max_rate()? / s.tau1();
         opts.em_fractions.iter().map(|f| f * limit).collect()
     } else {
         opts.dt_tau1.clone()

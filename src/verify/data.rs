@@ -18,17 +18,16 @@
 //! simulates, and judged by the same checks ([`crate::verify::checks::linear_checks`]),
 //! family-wise correction and report.
 
-use crate::data::{DataRun, DataSidecar, MAX_STEPS_PER_ROW, Start, Table, columns, read_table};
+use crate::data::{DataObject, DataRun, DataSidecar, MAX_STEPS_PER_ROW, Start, Table, read_table};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::input::{human_bytes, open_regular, refused};
 use crate::params::FilamentParams;
 use crate::scene::compression::{CompressionRun, CompressionTheoryTable, ForceRecord};
 use crate::scene::linear::{
-    LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
+    Continuum, LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
 };
 use crate::scene::{CompressionSpec, ModelKind, RunSpec, Scene};
-use crate::spectral::HingedBeam;
 use crate::stats::moments::MIN_SERIES_LEN;
 use std::path::Path;
 
@@ -67,16 +66,26 @@ pub fn prepare_data_check(
 ) -> Result<DataCheck> {
     check_linear_data(scene, sidecar, dir, k)?;
     let data = &sidecar.runs[k];
-    let filament = sidecar.filament.params();
-    let continuum = HingedBeam::new(filament)?;
+    let object = data_object(sidecar, dir)?;
+    let mut data_scene = scene.clone();
+    match object {
+        DataObject::Filament(f) => {
+            data_scene.filament = FilamentParams {
+                stretch_rigidity: scene.filament.stretch_rigidity,
+                ..f.params()
+            }
+        }
+        DataObject::Membrane(m) => data_scene.membrane = Some(m.params()),
+    }
+    let continuum = Continuum::of(&data_scene)?;
     let mut notes = Vec::new();
-    let discrete = discrete_run(scene, filament, (dir, k), data, &mut notes)?;
+    let discrete = discrete_run(&data_scene, object.tau1(), (dir, k), data, &mut notes)?;
     let spec = data_spec(scene, data);
     let (modes, scale, discrete) = mode_references(scene, data, &continuum, discrete, &mut notes);
     let d = discrete.as_ref();
-    let profile = profile_references(scene, data, filament.length, &continuum, d, &mut notes);
+    let profile = profile_references(scene, data, &continuum, d, &mut notes)?;
     let (two_time, tt_cols) =
-        two_time_references(scene, data, filament, &continuum, d, &mut notes)?;
+        two_time_references(scene, data, object.tau1(), &continuum, d, &mut notes)?;
     let dts = data.dt_sample;
     let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
     let mode_every: Vec<u64> = modes
@@ -110,12 +119,24 @@ pub fn prepare_data_check(
         profile_cols: profile.3,
         tt_cols,
     };
-    let (records, products) = read_records(&run, sidecar, dir, k, &layout, max_bytes)?;
+    let columns = object.columns(sidecar.dims, data.positions.len(), data.modes)?;
+    let (records, products) = read_records(&run, (data, &columns), dir, k, &layout, max_bytes)?;
     Ok(DataCheck {
         run,
         records,
         two_time: products,
         notes,
+    })
+}
+
+/// The object of a loaded sidecar (in `dir`).
+fn data_object(sidecar: &DataSidecar, dir: &Path) -> Result<DataObject> {
+    sidecar.object().ok_or_else(|| {
+        refused(
+            &dir.join(crate::data::SIDECAR),
+            "filament",
+            "exactly one of filament and membrane must be given",
+        )
     })
 }
 
@@ -165,9 +186,44 @@ pub fn check_data_kind(scene: &Scene, sidecar: &DataSidecar, dir: &Path) -> Resu
                 scene.path.display()
             ),
         ),
-        _ => return Ok(()),
+        _ => return object_kind(scene, sidecar, dir),
     };
     Err(refused(&dir.join(crate::data::SIDECAR), &key, message))
+}
+
+/// Refuses data of the other object than `scene`'s: a membrane's data against a filament
+/// scene, or a filament's against a membrane scene.
+fn object_kind(scene: &Scene, sidecar: &DataSidecar, dir: &Path) -> Result<()> {
+    let (given, needed) = match (scene.is_membrane(), sidecar.membrane.is_some()) {
+        (true, false) => ("filament", "membrane"),
+        (false, true) => ("membrane", "filament"),
+        _ => return Ok(()),
+    };
+    Err(refused(
+        &dir.join(crate::data::SIDECAR),
+        given,
+        format!(
+            "the data are of a {given} but scene {} ({}) is a {needed} scene: check them with a {given} scene (e.g. {}), or give the {needed}'s data",
+            scene.name,
+            scene.path.display(),
+            if given == "membrane" {
+                "membrane-hinged"
+            } else {
+                "hinged-linear-2d"
+            }
+        ),
+    ))
+}
+
+/// The filament of compression data (`check_data_kind` has refused a membrane's).
+fn data_filament(sidecar: &DataSidecar, dir: &Path) -> Result<crate::data::DataFilament> {
+    sidecar.filament.ok_or_else(|| {
+        refused(
+            &dir.join(crate::data::SIDECAR),
+            "filament",
+            "must be given for compression data",
+        )
+    })
 }
 
 /// Refuses the trajectory files of `sidecar` (in `dir`) unless each is a regular file
@@ -247,7 +303,7 @@ fn check_linear_data(scene: &Scene, sidecar: &DataSidecar, dir: &Path, k: usize)
 fn mode_references(
     scene: &Scene,
     data: &DataRun,
-    continuum: &HingedBeam,
+    continuum: &Continuum,
     discrete: Option<LinearRun>,
     notes: &mut Vec<String>,
 ) -> (Vec<ModeReference>, Vec<f64>, Option<LinearRun>) {
@@ -289,7 +345,7 @@ fn mode_references(
                     multiplier: (-rate_c * dts).exp(),
                     rate_discrete: Some(rate_c),
                     rate_continuum: rate_c,
-                    label: None,
+                    label: continuum.mode_label(n),
                 });
                 scale.push(1.0);
             }
@@ -333,11 +389,11 @@ fn column_of(data: &DataRun, length: f64, x: f64) -> Option<usize> {
 fn profile_references(
     scene: &Scene,
     data: &DataRun,
-    length: f64,
-    continuum: &HingedBeam,
+    continuum: &Continuum,
     discrete: Option<&LinearRun>,
     notes: &mut Vec<String>,
-) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<usize>) {
+) -> Result<ProfileRefs> {
+    let length = continuum.line_length();
     // Profile points present in the data.
     let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (j, f) in scene.sampling.profile_points.iter().enumerate() {
@@ -345,11 +401,12 @@ fn profile_references(
         match column_of(data, length, x) {
             Some(col) => {
                 profile.0.push(x);
+                let exact = continuum.profile_variance(x)?;
                 profile.1.push(match discrete {
                     Some(d) => d.reference.profile_discrete[j],
-                    None => continuum.profile_variance(x),
+                    None => exact,
                 });
-                profile.2.push(continuum.profile_variance(x));
+                profile.2.push(exact);
                 profile.3.push(col);
             }
             None => notes.push(format!(
@@ -358,8 +415,11 @@ fn profile_references(
             )),
         }
     }
-    profile
+    Ok(profile)
 }
+
+/// Profile points: x, discrete and continuum references, and their columns.
+type ProfileRefs = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<usize>);
 
 /// The scene's two-time points on the data's rows and positions, from rest only: the
 /// references (with row indices as steps) and the columns of x and y; the others are
@@ -367,12 +427,12 @@ fn profile_references(
 fn two_time_references(
     scene: &Scene,
     data: &DataRun,
-    filament: FilamentParams,
-    continuum: &HingedBeam,
+    tau1: f64,
+    continuum: &Continuum,
     discrete: Option<&LinearRun>,
     notes: &mut Vec<String>,
 ) -> Result<TwoTimeRefs> {
-    let (length, tau1, dts) = (filament.length, filament.tau1(), data.dt_sample);
+    let (length, dts) = (continuum.line_length(), data.dt_sample);
     // Two-time points on the rows, from rest only.
     let mut two_time = Vec::new();
     let mut tt_cols = Vec::new();
@@ -405,9 +465,9 @@ fn two_time_references(
                         eta_step: re,
                         discrete: match discrete {
                             Some(d) => d.reference.two_time[j].discrete,
-                            None => continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                            None => continuum.correlation(x, y, t, eta)?,
                         },
-                        continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
+                        continuum: continuum.correlation(x, y, t, eta)?,
                     });
                     tt_cols.push((cx, cy));
                 }
@@ -519,20 +579,18 @@ fn require_magnitude(
 /// checked series.
 fn read_records(
     run: &LinearRun,
-    sidecar: &DataSidecar,
+    (data, cols): (&DataRun, &[String]),
     dir: &Path,
     k: usize,
     layout: &Layout,
     max_bytes: u64,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
-    let data = &sidecar.runs[k];
     let dts = data.dt_sample;
-    let cols = columns(sidecar.dims, data.positions.len(), data.modes);
     let mut records = Vec::new();
     let mut products = Vec::new();
     for (j, path) in data.paths(dir).iter().enumerate() {
         let key = format!("runs[{k}].files[{j}]");
-        let table = read_trajectory(data, path, &key, &cols, max_bytes)?;
+        let table = read_trajectory(data, path, &key, cols, max_bytes)?;
         let (rec, tt) = read_record(run, data, (path, &key), &table, layout)?;
         records.push(rec);
         products.push(tt);
@@ -675,15 +733,16 @@ fn data_spec(scene: &Scene, data: &DataRun) -> RunSpec {
 
 /// The producer's discretization as a run of this tool, when it is one it models
 /// (`fem` with elements, integrator, noise and dt; `spectral` with modes and dt): the
-/// run prepared on the data's filament, whose exact discrete references serve as the
-/// data's. `None` (with a note) otherwise.
+/// run prepared on `scene` (the scene with the data's filament or membrane, of time
+/// unit `tau1`), whose exact discrete references serve as the data's. `None` (with a
+/// note) otherwise.
 ///
 /// # Errors
 /// [`Error::Scene`] naming the sidecar key of a known model given with an unknown
 /// integrator or noise name; the preparation's errors.
 fn discrete_run(
     scene: &Scene,
-    filament: FilamentParams,
+    tau1: f64,
     (dir, k): (&Path, usize),
     data: &DataRun,
     notes: &mut Vec<String>,
@@ -727,15 +786,11 @@ fn discrete_run(
     let noise = d
         .noise_model()
         .ok_or_else(|| unknown("discretization.noise"))?;
-    let tau1 = filament.tau1();
     fits(scene, data, (model, elements, dt / tau1)).map_err(|(key, m)| key_err(key, m))?;
     let mut scene = scene.clone();
-    scene.filament = FilamentParams {
-        stretch_rigidity: scene.filament.stretch_rigidity,
-        ..filament
-    };
     scene.model = model;
     scene.mesh.elements = elements;
+    scene.mesh.elements_y = d.elements_y.filter(|_| scene.is_membrane());
     scene.mesh.grading = 1.0;
     let spec = RunSpec {
         integrator,
@@ -767,7 +822,8 @@ fn fits(
     } else {
         elements
     };
-    if carried < scene.sampling.modes {
+    // A membrane's plate refuses, when prepared, a checked mode its mesh does not resolve.
+    if carried < scene.sampling.modes && !scene.is_membrane() {
         return Err((
             "discretization.elements",
             format!(
@@ -856,7 +912,7 @@ pub fn prepare_compression_checks(
             ),
         ));
     }
-    if sidecar.filament.stretch_rigidity.is_none() {
+    if data_filament(sidecar, dir)?.stretch_rigidity.is_none() {
         return Err(bad(
             "filament.stretch_rigidity".into(),
             "must be given for compression data (EA: the force-strain law depends on it)".into(),
@@ -925,7 +981,7 @@ fn compression_data_check(
     }
     let first = by_strain[0].1;
     let mut scene = scene.clone();
-    scene.filament = sidecar.filament.params();
+    scene.filament = data_filament(sidecar, dir)?.params();
     let fem = first
         .discretization
         .as_ref()
@@ -1106,13 +1162,14 @@ mod tests {
             version: VERSION,
             producer: "test".into(),
             dims: 2,
-            filament: DataFilament {
+            filament: Some(DataFilament {
                 length: 1.0,
                 bending_rigidity: 1.0,
                 drag: 1.0,
                 kt: 1.0,
                 stretch_rigidity: None,
-            },
+            }),
+            membrane: None,
             runs,
             provenance: None,
             columns: None,
@@ -1125,25 +1182,26 @@ mod tests {
 
     /// Valid data are read; too few rows after the burn-in are still refused naming
     /// `runs[k].files`; a two-time point beyond the rows names the file.
-    /// A membrane scene is refused against any data before the data are read: its
-    /// message names the scene file, the key `membrane`, the scene and "not yet supported
-    /// for membranes" (the data directory here does not even exist).
+    /// Data of the other object are refused before their files are read, naming the
+    /// sidecar key of the object the data are of and the scene: a filament's data
+    /// against a membrane scene (and, in `tests/run_check.rs`, a membrane's against a
+    /// filament scene).
     #[test]
-    fn membrane_scene_against_data_is_refused() {
+    fn data_of_the_other_object_are_refused() {
         let dir = temp("membrane");
-        let missing = dir.join("no-data");
+        let side = write(&dir, &linear(vec![run("cn", tau1() / 100.0, None)]), 600);
         for name in ["membrane-hinged", "membrane-pbc"] {
-            let r = crate::verify::check_data(&scene(name), &missing, &dir.join("out"), 0.01, CAP);
+            let r = prepare_data_check(&scene(name), &side, &dir, 0, CAP);
             refusal(
                 r,
                 &[
-                    &format!("tests/scenes/good/{name}.toml: key `membrane`"),
-                    "checking trajectory data (check) is not yet supported for membranes",
-                    &format!("scene \"{name}\""),
+                    "data.json: key `filament`",
+                    "the data are of a filament",
+                    &format!("scene {name}"),
+                    "is a membrane scene",
                 ],
             );
         }
-        assert!(!dir.join("out").exists(), "nothing written");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
@@ -1296,7 +1354,7 @@ mod tests {
         refusal(check_data_kind(&comp, &side, &dir), &named);
         refusal(prepare_compression_checks(&comp, &side, &dir, CAP), &named);
         let mut c = linear(vec![run("m", 0.01, Some(0.0))]);
-        c.filament.stretch_rigidity = Some(1e6);
+        c.filament.as_mut().unwrap().stretch_rigidity = Some(1e6);
         let side = write(&dir, &c, 10);
         let named = [
             "`runs[0].strain_ratio`",
@@ -1348,6 +1406,7 @@ mod tests {
             r.discretization = Some(Discretization {
                 model: model.into(),
                 elements: Some(elements),
+                elements_y: None,
                 integrator: Some(integrator.into()),
                 noise: None,
                 dt: Some(dt),
@@ -1398,8 +1457,8 @@ mod tests {
             })
             .collect();
         let mut side = linear(runs);
-        side.filament.bending_rigidity = 100.0;
-        side.filament.stretch_rigidity = Some(1e6);
+        side.filament.as_mut().unwrap().bending_rigidity = 100.0;
+        side.filament.as_mut().unwrap().stretch_rigidity = Some(1e6);
         side
     }
 

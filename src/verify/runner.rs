@@ -1137,9 +1137,8 @@ fn apply_linear_checks(
 /// `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is read.
 ///
 /// # Errors
-/// Input (exit 2): a membrane scene (not yet supported: [`Scene::refuse_membrane`]), a
-/// bad sidecar or trajectory file, data of the other kind than the
-/// scene's or that cannot serve it, files larger than `max_bytes` together; run failures
+/// Input (exit 2): a bad sidecar or trajectory file, data of the other kind or object
+/// than the scene's or that cannot serve it, files larger than `max_bytes` together; run failures
 /// (exit 3): an estimator that finds no answer in the data.
 pub fn check_data(
     scene: &Scene,
@@ -1148,7 +1147,6 @@ pub fn check_data(
     alpha: f64,
     max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
-    scene.refuse_membrane("checking trajectory data (check)")?;
     let sidecar = crate::data::DataSidecar::load(data_dir)?;
     crate::verify::data::check_data_kind(scene, &sidecar, data_dir)?;
     crate::verify::data::require_data_size(&sidecar, data_dir, max_bytes)?;
@@ -1174,7 +1172,7 @@ pub fn check_data(
         outputs.skipped.extend(est.skipped.iter().cloned());
         outputs.notes.extend(dc.notes.iter().cloned());
         outputs.notes.push(format!(
-            "run {}: {} trajectories {}, rows every {:e} (time units of the filament), burn-in {:e}",
+            "run {}: {} trajectories {}, rows every {:e} (time units of the data), burn-in {:e}",
             data.name,
             dc.records.len(),
             if data.start == crate::data::Start::Rest {

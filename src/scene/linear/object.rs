@@ -47,6 +47,26 @@ impl Continuum {
         Ok(Continuum::Membrane { membrane, modes })
     }
 
+    /// The continuum of `scene`'s object: its filament, or its membrane with
+    /// `sampling.modes` modes checked.
+    ///
+    /// # Errors
+    /// Parameters the references refuse.
+    pub(crate) fn of(scene: &crate::scene::Scene) -> Result<Self> {
+        match scene.membrane {
+            Some(m) => Continuum::membrane(Membrane::new(m)?, scene.sampling.modes),
+            None => Ok(Continuum::Filament(HingedBeam::new(scene.filament)?)),
+        }
+    }
+
+    /// The continuum variance of checked mode `n` (1-based): eq. (3), or (M3).
+    pub(crate) fn mode_variance(&self, n: usize) -> f64 {
+        match self {
+            Continuum::Filament(b) => b.mode_variance(n),
+            Continuum::Membrane { membrane, modes } => membrane.mode_variance(modes[n - 1]),
+        }
+    }
+
     /// Length of the sampling line: L, or the membrane's width a.
     pub(crate) fn line_length(&self) -> f64 {
         match self {

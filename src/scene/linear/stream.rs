@@ -40,7 +40,7 @@ impl LinearRun {
         sampled_steps: u64,
         every: Option<u64>,
     ) -> Result<RowPlan> {
-        let length = scene.filament.length;
+        let length = scene.line_length();
         let mut positions: Vec<f64> = match &self.model {
             Model::Fem { object, .. } => object.line_nodes(),
             Model::Spectral { .. } | Model::SpectralMembrane { .. } | Model::Data => {
@@ -71,7 +71,12 @@ impl LinearRun {
         };
         let total = self.schedule(sampled_steps).total();
         Ok(RowPlan {
-            columns: crate::data::columns(self.components + 1, positions.len(), r.modes.len()),
+            columns: if scene.is_membrane() {
+                let labels: Vec<_> = r.modes.iter().filter_map(|m| m.label).collect();
+                crate::data::membrane_columns(positions.len(), &labels)
+            } else {
+                crate::data::columns(self.components + 1, positions.len(), r.modes.len())
+            },
             positions,
             every,
             sampled_steps,

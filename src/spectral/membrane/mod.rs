@@ -240,6 +240,15 @@ impl MembraneParams {
         }
     }
 
+    /// The slowest relaxation time 1/λ = ξ/c_q of the slowest mode ([`Membrane::modes`],
+    /// c_q = κq⁴ + σq², (M2)): the membrane's time unit τ₁. NaN for parameters
+    /// [`MembraneParams::validate`] refuses.
+    pub fn tau1(&self) -> f64 {
+        Membrane::new(*self)
+            .and_then(|m| Ok((m, m.modes(1)?)))
+            .map_or(f64::NAN, |(m, slowest)| self.drag / m.stiffness(slowest[0]))
+    }
+
     /// The buckling tension −κ q_min²: the tension must be strictly above it.
     pub fn buckling_tension(&self) -> f64 {
         -self.bending_rigidity * self.min_wavenumber_sq()
