@@ -802,8 +802,11 @@ impl Setup<'_> {
         let modal = self.modal_path(&object, &gm, &two_time, &probe);
         let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
-        // The trajectory data format's sine-basis amplitudes are the filament's; a
-        // membrane's modal amplitudes stay C-normalized (its data format is to come).
+        // The trajectory data format's amplitudes: the C-normalized modal coordinate q of
+        // a mode whose field is close to c·φ (φ the continuum mode, ξ∫(cφ)² = 1) is the
+        // amplitude a = c·q of φ, c = 1/√(ξ‖φ‖²): √(2/(ξL)) for the filament's sines
+        // (signed as the sine at L/(2n)), 1/√(ξ‖φ‖²) for a membrane's real modes
+        // (‖φ‖² = A/4 or A/2, (M3); signs free).
         let amplitude_scale = match &object {
             FemObject::Beam(_) => {
                 let scale = (2.0 / (p.drag * p.length)).sqrt();
@@ -814,7 +817,11 @@ impl Setup<'_> {
                     })
                     .collect()
             }
-            FemObject::Plate { .. } => vec![1.0; self.scene.sampling.modes],
+            FemObject::Plate { plate, .. } => {
+                let membrane = Membrane::new(*plate.params())?;
+                let scale = 1.0 / (membrane.params.drag * membrane.mode_norm_sq()).sqrt();
+                vec![scale; self.scene.sampling.modes]
+            }
         };
         Ok(Prepared {
             amplitude_scale,
