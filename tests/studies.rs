@@ -8,7 +8,9 @@ use common::{TempDir, scene};
 use langevin_fem::dynamics::IntegratorKind;
 use langevin_fem::fem::noise::NoiseModel;
 use langevin_fem::studies::stability::{StabilityOptions, StabilitySummary, Status, run_stability};
-use langevin_fem::studies::work_precision::{WorkPrecisionOptions, run_work_precision};
+use langevin_fem::studies::work_precision::{
+    WorkPrecisionOptions, WorkPrecisionSummary, run_work_precision,
+};
 use langevin_fem::work::WorkLimits;
 
 /// The map of every linear integrator on `scene` at `elements` elements and a = 1 and
@@ -75,6 +77,29 @@ fn stability_map_classifies_and_matches_the_exact_formulas() {
     }
 }
 
+/// The work–precision study of Crank–Nicolson with both noise models on `scene` at
+/// Δt/τ1 = 1e-2 and 3e-3, 4 trajectories × 40 τ1 per point, at `tolerance`, written to
+/// `dir`.
+fn small_study(scene_file: &str, tolerance: f64, dir: &TempDir) -> WorkPrecisionSummary {
+    run_work_precision(&WorkPrecisionOptions {
+        scene: scene(scene_file),
+        methods: vec![
+            (IntegratorKind::CrankNicolson, NoiseModel::Consistent),
+            (IntegratorKind::CrankNicolson, NoiseModel::ElementUniform),
+        ],
+        dt_tau1: vec![1e-2, 3e-3],
+        em_fractions: vec![0.9],
+        trajectories: 4,
+        duration_tau1: 40.0,
+        em_duration_tau1: 16.0,
+        tolerance,
+        out: dir.path().to_path_buf(),
+        progress: false,
+        limits: WorkLimits::default(),
+    })
+    .expect("study runs")
+}
+
 /// Crank–Nicolson with consistent noise has zero exact bias in ⟨w²(L/2)⟩ (nodal
 /// covariance kT K⁻¹ is exact for Hermite cubics, the scheme's stationary law exact);
 /// the paper's element-uniform noise keeps its spatial deficit at any Δt. Every estimate
@@ -85,23 +110,7 @@ fn stability_map_classifies_and_matches_the_exact_formulas() {
 #[test]
 fn work_precision_separates_bias_from_sampling() {
     let dir = TempDir::new("work-precision");
-    let s = run_work_precision(&WorkPrecisionOptions {
-        scene: scene("verification/hinged-linear-2d.toml"),
-        methods: vec![
-            (IntegratorKind::CrankNicolson, NoiseModel::Consistent),
-            (IntegratorKind::CrankNicolson, NoiseModel::ElementUniform),
-        ],
-        dt_tau1: vec![1e-2, 3e-3],
-        em_fractions: vec![0.9],
-        trajectories: 4,
-        duration_tau1: 40.0,
-        em_duration_tau1: 1.0,
-        tolerance: 0.005,
-        out: dir.path().to_path_buf(),
-        progress: false,
-        limits: WorkLimits::default(),
-    })
-    .expect("study runs");
+    let s = small_study("verification/hinged-linear-2d.toml", 0.005, &dir);
     assert_eq!(s.points.len(), 4);
     assert_eq!(s.inconsistent_points, 0, "{:#?}", s.points);
     for p in &s.points {
@@ -154,23 +163,7 @@ fn the_membrane_maps_and_studies_like_the_filament() {
     );
 
     let wp = TempDir::new("work-precision-membrane");
-    let w = run_work_precision(&WorkPrecisionOptions {
-        scene: scene("verification/membrane-hinged.toml"),
-        methods: vec![
-            (IntegratorKind::CrankNicolson, NoiseModel::Consistent),
-            (IntegratorKind::CrankNicolson, NoiseModel::ElementUniform),
-        ],
-        dt_tau1: vec![1e-2, 3e-3],
-        em_fractions: vec![0.9],
-        trajectories: 4,
-        duration_tau1: 40.0,
-        em_duration_tau1: 16.0,
-        tolerance: 0.01,
-        out: wp.path().to_path_buf(),
-        progress: false,
-        limits: WorkLimits::default(),
-    })
-    .expect("study runs");
+    let w = small_study("verification/membrane-hinged.toml", 0.01, &wp);
     assert_eq!(w.observable, "h2(a/2,b/2)");
     assert_eq!(w.points.len(), 4);
     assert_eq!(w.inconsistent_points, 0, "{:#?}", w.points);

@@ -1502,7 +1502,30 @@ fn linear_study(
             );
         }
     }
-    let object = if scene.is_membrane() {
+    let object = study_object(scene, over, &values);
+    let expected = (0..names.len())
+        .map(|k| expected_order(over, spec, k, object))
+        .collect();
+    let (notes, warnings) = slope_notes(scene, over, largest_slope);
+    let (limit_reference, fixed) = linear_texts(scene, spec, over);
+    Ok(Study {
+        values,
+        names,
+        expected,
+        rows,
+        limit_reference,
+        fixed,
+        failed,
+        notes,
+        warnings,
+    })
+}
+
+/// What the expected orders of a linear study of `scene` over `over` at `values` depend
+/// on: a membrane's meshes alike in where their centre falls (the parities of nx and ny),
+/// or whether every filament mesh has a node at the middle.
+fn study_object(scene: &Scene, over: Over, values: &[f64]) -> StudyObject {
+    if scene.is_membrane() {
         StudyObject::Membrane {
             centre_alike: match over {
                 Over::Elements => {
@@ -1524,23 +1547,7 @@ fn linear_study(
                 Over::Dt => scene.mesh.elements.is_multiple_of(2),
             },
         }
-    };
-    let expected = (0..names.len())
-        .map(|k| expected_order(over, spec, k, object))
-        .collect();
-    let (notes, warnings) = slope_notes(scene, over, largest_slope);
-    let (limit_reference, fixed) = linear_texts(scene, spec, over);
-    Ok(Study {
-        values,
-        names,
-        expected,
-        rows,
-        limit_reference,
-        fixed,
-        failed,
-        notes,
-        warnings,
-    })
+    }
 }
 
 /// The values of a linear study (the options' or the defaults), validated, largest h
@@ -1693,99 +1700,124 @@ pub fn summarize(names: &[String], rows: &[Row], expected: &[Expected]) -> Vec<O
         .map(|(name, expected)| {
             let rs: Vec<&Row> = rows.iter().filter(|r| &r.observable == name).collect();
             if is_unsampled(&rs) {
-                return unsampled_summary(name, expected, &rs);
-            }
-            let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
-            let all_exact = !rs.is_empty() && rs.iter().all(|r| r.exact_at_rounding);
-            let within = rs.iter().filter(|r| r.sampling_floor).count();
-            let observed = if all_exact || expected.exact {
-                None
+                unsampled_summary(name, expected, &rs)
             } else {
-                fit_order(
-                    &resolved.iter().map(|r| r.h).collect::<Vec<_>>(),
-                    &resolved.iter().map(|r| r.total_error).collect::<Vec<_>>(),
-                    Some(&resolved.iter().map(|r| r.total_error_se).collect::<Vec<_>>()),
-                )
-            };
-            let agrees = match (expected.order, observed.and_then(|f| f.ci)) {
-                (Some(p), Some((lo, hi))) => Some(lo <= p && p <= hi),
-                _ => None,
-            };
-            let note = if all_exact || expected.exact {
-                let resolved_points: Vec<f64> = resolved.iter().map(|r| r.value).collect();
-                format!(
-                    "the discretization is exact for this observable: the total error is sampling noise only, no order is fitted; {within} of {} estimates within {FLOOR_SIGMAS} standard errors of the reference{}",
-                    rs.len(),
-                    if resolved_points.is_empty() {
-                        String::new()
-                    } else {
-                        format!(
-                            " (NOT within at {resolved_points:?}: an error the exact theory does not predict)"
-                        )
-                    }
-                )
-            } else if resolved.len() < 2 {
-                format!(
-                    "{} of {} points at the sampling floor: too few resolved points for an observed order{}",
-                    rs.len() - resolved.len(),
-                    rs.len(),
-                    budget_hint(&rs)
-                )
-            } else {
-                let exact_fit = exact_order_fit(&rs);
-                match (agrees, expected.order, observed) {
-                    (Some(true), Some(p), _) => {
-                        format!("observed order agrees with the expected {p} (inside its 95 % interval)")
-                    }
-                    (Some(false), Some(p), Some(f)) => {
-                        let pre = exact_fit.filter(|e| {
-                            f.ci.is_some_and(|(lo, hi)| lo <= e.order && e.order <= hi)
-                        });
-                        match pre {
-                            Some(e) => format!(
-                                "observed order {:.2} differs from the asymptotic {p} but agrees with the order {:.2} of the exact discrete error over these values: the values are not yet in the asymptotic range (pre-asymptotic), not a simulation error",
-                                f.order, e.order
-                            ),
-                            None => format!(
-                                "observed order {:.2} differs from the expected {p}: its 95 % interval excludes {p}{}",
-                                f.order,
-                                if f.points < rs.len() {
-                                    " (fitted on the resolved points only; nearer the floor the sampling error inflates the measured error, which flattens the fit)"
-                                } else {
-                                    ""
-                                }
-                            ),
-                        }
-                    }
-                    (None, Some(_), Some(_)) => format!(
-                        "two resolved points: an order but no interval to compare with the expected one{}",
-                        budget_hint(&rs)
-                    ),
-                    _ => String::new(),
-                }
-            };
-            let exact = exact_order_fit(&rs);
-            ObservableSummary {
-                observable: name.clone(),
-                expected: expected.clone(),
-                observed,
-                floor_values: rs
-                    .iter()
-                    .filter(|r| r.sampling_floor)
-                    .map(|r| r.value)
-                    .collect(),
-                exact,
-                exact_at_rounding: rs
-                    .iter()
-                    .filter(|r| r.exact_at_rounding)
-                    .map(|r| r.value)
-                    .collect(),
-                agrees,
-                unsampled: false,
-                note,
+                sampled_summary(name, expected, &rs)
             }
         })
         .collect()
+}
+
+/// The summary of sampled observable `name` from its rows `rs`: the order fitted on
+/// the points above the sampling floor, the exact discrete error's order, and whether
+/// the observed order agrees with the expected one.
+fn sampled_summary(name: &str, expected: &Expected, rs: &[&Row]) -> ObservableSummary {
+    let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+    let all_exact = !rs.is_empty() && rs.iter().all(|r| r.exact_at_rounding);
+    let observed = if all_exact || expected.exact {
+        None
+    } else {
+        fit_order(
+            &resolved.iter().map(|r| r.h).collect::<Vec<_>>(),
+            &resolved.iter().map(|r| r.total_error).collect::<Vec<_>>(),
+            Some(
+                &resolved
+                    .iter()
+                    .map(|r| r.total_error_se)
+                    .collect::<Vec<_>>(),
+            ),
+        )
+    };
+    let agrees = match (expected.order, observed.and_then(|f| f.ci)) {
+        (Some(p), Some((lo, hi))) => Some(lo <= p && p <= hi),
+        _ => None,
+    };
+    let exact = exact_order_fit(rs);
+    let note = order_note(rs, expected, (observed, exact), agrees);
+    ObservableSummary {
+        observable: name.to_string(),
+        expected: expected.clone(),
+        observed,
+        floor_values: rs
+            .iter()
+            .filter(|r| r.sampling_floor)
+            .map(|r| r.value)
+            .collect(),
+        exact,
+        exact_at_rounding: rs
+            .iter()
+            .filter(|r| r.exact_at_rounding)
+            .map(|r| r.value)
+            .collect(),
+        agrees,
+        unsampled: false,
+        note,
+    }
+}
+
+/// What the fit of sampled observable rows `rs` says: an exact discretization's
+/// sampling-only error, too few resolved points, or the observed order (`fits`: the
+/// observed and the exact discrete error's) against the expected one, telling a
+/// pre-asymptotic range from a simulation error.
+fn order_note(
+    rs: &[&Row],
+    expected: &Expected,
+    (observed, exact_fit): (Option<OrderFit>, Option<OrderFit>),
+    agrees: Option<bool>,
+) -> String {
+    let resolved: Vec<&&Row> = rs.iter().filter(|r| !r.sampling_floor).collect();
+    let all_exact = !rs.is_empty() && rs.iter().all(|r| r.exact_at_rounding);
+    let within = rs.len() - resolved.len();
+    if all_exact || expected.exact {
+        let resolved_points: Vec<f64> = resolved.iter().map(|r| r.value).collect();
+        return format!(
+            "the discretization is exact for this observable: the total error is sampling noise only, no order is fitted; {within} of {} estimates within {FLOOR_SIGMAS} standard errors of the reference{}",
+            rs.len(),
+            if resolved_points.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (NOT within at {resolved_points:?}: an error the exact theory does not predict)"
+                )
+            }
+        );
+    }
+    if resolved.len() < 2 {
+        return format!(
+            "{within} of {} points at the sampling floor: too few resolved points for an observed order{}",
+            rs.len(),
+            budget_hint(rs)
+        );
+    }
+    match (agrees, expected.order, observed) {
+        (Some(true), Some(p), _) => {
+            format!("observed order agrees with the expected {p} (inside its 95 % interval)")
+        }
+        (Some(false), Some(p), Some(f)) => {
+            let pre =
+                exact_fit.filter(|e| f.ci.is_some_and(|(lo, hi)| lo <= e.order && e.order <= hi));
+            match pre {
+                Some(e) => format!(
+                    "observed order {:.2} differs from the asymptotic {p} but agrees with the order {:.2} of the exact discrete error over these values: the values are not yet in the asymptotic range (pre-asymptotic), not a simulation error",
+                    f.order, e.order
+                ),
+                None => format!(
+                    "observed order {:.2} differs from the expected {p}: its 95 % interval excludes {p}{}",
+                    f.order,
+                    if f.points < rs.len() {
+                        " (fitted on the resolved points only; nearer the floor the sampling error inflates the measured error, which flattens the fit)"
+                    } else {
+                        ""
+                    }
+                ),
+            }
+        }
+        (None, Some(_), Some(_)) => format!(
+            "two resolved points: an order but no interval to compare with the expected one{}",
+            budget_hint(rs)
+        ),
+        _ => String::new(),
+    }
 }
 
 /// Whether the rows of an observable are of an exact observable: computed, not sampled
