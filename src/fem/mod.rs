@@ -19,9 +19,12 @@
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
 //! - [`paired`]: the paired modal form of a uniform hinged beam ([`PairedModes`]): `K`,
 //!   `C`, `G` block-diagonal with 2×2 blocks per wavenumber.
+//! - [`area`]: the membrane under imposed projected area ([`area::AreaMembrane`]), the
+//!   filament's global constraint on the plate.
 //! - [`vonkarman`]: the finite-deflection filament under imposed end-shortening
 //!   ([`vonkarman::CompressedFilament`]): energy, internal force, axial solve.
 
+pub mod area;
 pub mod banded;
 pub mod beam;
 pub mod hermite;
@@ -34,6 +37,7 @@ pub mod plate_modes;
 pub mod system;
 pub mod vonkarman;
 
+pub use area::AreaMembrane;
 pub use banded::{BandedCholesky, SymBanded};
 pub use beam::{BeamModel, UNIFORM_RATE_FACTOR};
 pub use mesh::Mesh;
@@ -48,6 +52,6 @@ pub use plate::{
     SLOPE_RATE_FACTOR,
 };
 pub use plate_modes::{
-    MAX_DENSE_MODE_DOFS, MAX_PLATE_MODE_DOFS, PlateMode, PlateModeLabel, PlateModes,
+    GeometricBlock, MAX_DENSE_MODE_DOFS, MAX_PLATE_MODE_DOFS, PlateMode, PlateModeLabel, PlateModes,
 };
 pub use system::{ElementLoad, LinearSystem};
