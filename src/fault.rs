@@ -32,6 +32,7 @@ pub use power::{PowerOptions, PowerReport, PowerRow, clopper_pearson, run_power,
 
 use crate::dynamics::{Integrator, IntegratorKind};
 use crate::error::{Error, Result};
+use crate::fem::area::AreaMembrane;
 use crate::fem::banded::{BandedCholesky, SymBanded};
 use crate::fem::beam::BeamModel;
 use crate::fem::modal::{GeneralizedModes, generalized_modes_signed};
@@ -547,6 +548,36 @@ pub(crate) fn compression_model(fault: Option<Fault>, beam: BeamModel) -> Result
         FaultKind::VonKarmanStrain => beam.with_scaled_matrices(1.0, 1.0, 1.0 + 2.0 * s),
         _ => Ok(beam),
     }
+}
+
+/// Hook of the membrane compression scenes (imposed projected area, issue #28): the
+/// chain's membrane under `fault`, as [`compression_model`] for the filament:
+/// [`FaultKind::NoiseVariance`] kT × (1 + s), [`FaultKind::IntegratorStiffness`] κ ×
+/// (1 + s), [`FaultKind::AxialStretchRigidity`] the area modulus K_A × (1 + s) in the
+/// chain's force and constraint energy, [`FaultKind::VonKarmanStrain`] the excess area's
+/// `½∫|∇h|²` → `(½ + s)∫|∇h|²` (G × (1 + 2s); s = 0.5 drops the ½). The exact theory and
+/// the unit σ_c0 keep the true parameters.
+///
+/// # Errors
+/// What [`AreaMembrane::new`] refuses.
+pub(crate) fn area_model(
+    fault: Option<Fault>,
+    params: MembraneParams,
+    (nx, ny): (usize, usize),
+    area_modulus: f64,
+    strain: f64,
+) -> Result<AreaMembrane> {
+    let (mut p, mut k_a, mut area_scale) = (params, area_modulus, 1.0);
+    if let Some(Fault { kind, size: s }) = fault {
+        match kind {
+            FaultKind::NoiseVariance => p.kt *= 1.0 + s,
+            FaultKind::IntegratorStiffness => p.bending_rigidity *= 1.0 + s,
+            FaultKind::AxialStretchRigidity => k_a *= 1.0 + s,
+            FaultKind::VonKarmanStrain => area_scale = 1.0 + 2.0 * s,
+            _ => {}
+        }
+    }
+    Ok(AreaMembrane::new(p, nx, ny, k_a, strain)?.with_area_scale(area_scale))
 }
 
 /// The noise scale factors of a faulty integrator: the variance factor and the factor of

@@ -199,7 +199,7 @@ impl<'m> ModalMetropolis<'m> {
                 rates.push(g.rates[r]);
                 order.push(i);
                 for (c, &bc) in kept.iter().enumerate() {
-                    g.b[4 * r + c] = block.matrix[br * kb + bc];
+                    g.b[4 * r + c] = model.area_scale() * block.matrix[br * kb + bc];
                 }
             }
             groups.push(g);

@@ -33,6 +33,8 @@ pub struct AreaMembrane {
     plate: PlateModel,
     area_modulus: f64,
     strain: f64,
+    /// Multiplies the area matrix G of the dynamics (1; fault injection only).
+    area_scale: f64,
 }
 
 impl AreaMembrane {
@@ -71,7 +73,21 @@ impl AreaMembrane {
             plate: PlateModel::new(params, nx, ny)?,
             area_modulus,
             strain,
+            area_scale: 1.0,
         })
+    }
+
+    /// The same membrane whose dynamics use the area matrix `G × scale` (a bug in the
+    /// excess area, e.g. a missing ½ in `ΔA = ½∫|∇h|²` at scale 2): a fault hook
+    /// ([`crate::fault`]); the references keep the true G.
+    pub(crate) fn with_area_scale(mut self, scale: f64) -> Self {
+        self.area_scale = scale;
+        self
+    }
+
+    /// The factor on the area matrix of the dynamics (1 unless a fault is injected).
+    pub fn area_scale(&self) -> f64 {
+        self.area_scale
     }
 
     /// The bending plate (`K_b`, `C`, zero tension).

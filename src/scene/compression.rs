@@ -1,14 +1,18 @@
 //! Compression scenes: the force–strain curve of the paper's Fig. 2, simulated with the
 //! finite-deflection filament ([`crate::dynamics::nonlinear`]) and judged against the exact
 //! equilibrium theory of the same discretization ([`crate::theory::compression`]), with
-//! the continuum theory beside it.
+//! the continuum theory beside it; and its relative for the membrane under imposed
+//! projected area ([`AreaMembrane`], issue #28), whose compressive stress `F = −σ` is
+//! recorded in units of `σ_c0 = κq²_min` exactly as the filament's force in units of F_c0.
 
 use crate::dynamics::{Driver, Family, ModalMetropolis, NonlinearState, Observer};
 use crate::error::{Error, Result};
+use crate::fem::area::AreaMembrane;
 use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::paired::PairedModes;
+use crate::fem::plate_modes::PlateModes;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::linear::{add_slope_squares, largest_rms_slope};
 use crate::scene::{CompressionSpec, RunSpec, Scene, StepSearch};
@@ -165,6 +169,18 @@ impl Observer<ModalMetropolis<'_>> for ModalForceRecorder<'_> {
     }
 }
 
+/// The observer of a membrane's chain: `F/σ_c0 = −σ/σ_c0` at every sample.
+struct StressRecorder {
+    unit: f64,
+    force_ratio: Vec<f64>,
+}
+
+impl Observer<ModalMetropolis<'_>> for StressRecorder {
+    fn on_sample(&mut self, _: usize, _: u64, chain: &ModalMetropolis<'_>) {
+        self.force_ratio.push(chain.force() / self.unit);
+    }
+}
+
 /// Sampled steps of each probe trajectory of a step search ([`CompressionRun::search_step`]),
 /// after its burn-in: with 16 trajectories, about 800 proposals, so the acceptance rate
 /// is known to about ±0.02.
@@ -228,14 +244,30 @@ pub struct CompressionRun {
     /// Burn-in and sampling interval (physical time), for [`Self::with_steps`].
     burn_in: f64,
     sample_interval: f64,
-    models: Vec<CompressedFilament>,
-    /// Euler buckling load F_c0 (the unit of the recorded forces).
+    /// The simulated object at each strain.
+    object: Strained,
+    /// Euler buckling load F_c0 (the unit of the recorded forces); a membrane's buckling
+    /// stress σ_c0.
     pub euler_load: f64,
-    /// Cholesky factor of the bending stiffness K, for the equilibrium start.
-    stiffness: BandedCholesky,
-    /// The paired modal form, for `metropolis-crank-nicolson` on a uniform mesh (always,
-    /// in the scenes): [`Self::simulate`] then runs [`ModalMetropolis`].
-    paired: Option<PairedModes>,
+}
+
+/// The object of a compression run at each strain.
+#[derive(Debug, Clone)]
+enum Strained {
+    Filament {
+        models: Vec<CompressedFilament>,
+        /// Cholesky factor of the bending stiffness K, for the equilibrium start.
+        stiffness: BandedCholesky,
+        /// The paired modal form, for `metropolis-crank-nicolson` on a uniform mesh
+        /// (always, in the scenes): [`CompressionRun::simulate`] then runs
+        /// [`ModalMetropolis`].
+        paired: Option<PairedModes>,
+    },
+    /// The membrane under imposed projected area, always in its plate's modes.
+    Membrane {
+        models: Vec<AreaMembrane>,
+        modes: Box<PlateModes>,
+    },
 }
 
 /// What one trajectory at one strain recorded.
@@ -267,7 +299,9 @@ impl CompressionRun {
     /// Invalid integrator or a time step above an explicit stability limit, a membrane
     /// scene ([`Scene::refuse_membrane`]) (exit 2).
     pub fn prepare(scene: &Scene, comp: &CompressionSpec, spec: &RunSpec) -> Result<Self> {
-        scene.refuse_membrane("the compression model")?;
+        if let Some(mp) = scene.membrane {
+            return Self::prepare_membrane(scene, mp, comp, spec);
+        }
         let p = scene.filament;
         let tau1 = p.tau1();
         let dt = spec.dt_tau1 * tau1;
@@ -291,13 +325,73 @@ impl CompressionRun {
             plans: vec![plan; models.len()],
             burn_in,
             sample_interval,
-            stiffness: beam.stiffness().cholesky()?,
-            paired: match spec.integrator.family() {
-                Family::Metropolis => PairedModes::new(&beam),
-                Family::Theta(_) | Family::ExactModal => None,
+            object: Strained::Filament {
+                stiffness: beam.stiffness().cholesky()?,
+                paired: match spec.integrator.family() {
+                    Family::Metropolis => PairedModes::new(&beam),
+                    Family::Theta(_) | Family::ExactModal => None,
+                },
+                models,
             },
-            models,
             euler_load: p.euler_load(),
+        })
+    }
+
+    /// [`Self::prepare`] for the membrane `mp` under imposed projected area
+    /// (`compression.area_modulus`): a BFS plate at zero tension, one [`AreaMembrane`] per
+    /// strain `ε = r·ε_c0`, `ε_c0 = σ_c0/K_A`, and the plate's modes.
+    fn prepare_membrane(
+        scene: &Scene,
+        mp: crate::spectral::membrane::MembraneParams,
+        comp: &CompressionSpec,
+        spec: &RunSpec,
+    ) -> Result<Self> {
+        let k_a = comp.area_modulus.ok_or_else(|| {
+            Error::invalid(
+                "compression.area_modulus",
+                "nothing",
+                "the area modulus K_A",
+            )
+        })?;
+        let (nx, ny) = (scene.mesh.elements, scene.mesh.elements_along_y());
+        let base = AreaMembrane::new(mp, nx, ny, k_a, 0.0)?;
+        let sigma_c0 = base.buckling_stress();
+        let model = |strain: f64| {
+            #[cfg(any(test, feature = "faults"))]
+            return crate::fault::area_model(scene.fault, mp, (nx, ny), k_a, strain);
+            #[cfg(not(any(test, feature = "faults")))]
+            AreaMembrane::new(mp, nx, ny, k_a, strain)
+        };
+        let models: Vec<AreaMembrane> = comp
+            .strain_ratios
+            .iter()
+            .map(|r| model(r * sigma_c0 / k_a))
+            .collect::<Result<_>>()?;
+        if !matches!(
+            spec.integrator.family(),
+            Family::Metropolis | Family::Theta(_)
+        ) {
+            return Err(Error::invalid(
+                "integrator",
+                spec.integrator,
+                "metropolis-crank-nicolson or a theta-scheme for a membrane under imposed area",
+            ));
+        }
+        let tau1 = scene.tau1();
+        let dt = spec.dt_tau1 * tau1;
+        let (burn_in, sample_interval) = (comp.burn_in_tau1 * tau1, comp.sample_every_tau1 * tau1);
+        let plan = StepPlan::new(dt, burn_in, sample_interval, dt);
+        let modes = Box::new(PlateModes::new(models[0].plate())?);
+        Ok(CompressionRun {
+            spec: spec.clone(),
+            dt,
+            burn_in_steps: plan.burn_in_steps,
+            sample_every: plan.sample_every,
+            plans: vec![plan; models.len()],
+            burn_in,
+            sample_interval,
+            object: Strained::Membrane { models, modes },
+            euler_load: sigma_c0,
         })
     }
 
@@ -374,15 +468,24 @@ impl CompressionRun {
     /// modes. From rest, the missing stored length of the stiff modes biased ⟨F⟩ upwards
     /// by up to 0.04 F_c0 (3D, 40 elements, Δt = 0.04 τ1), which the convergence study
     /// over Δt exposed.
+    ///
+    /// # Panics
+    /// For a membrane run (its chain starts itself, in modal coordinates).
     pub fn equilibrium_start(&self, rng: &mut TrajectoryRng) -> Vec<Vec<f64>> {
-        let model = &self.models[0];
+        let Strained::Filament {
+            models, stiffness, ..
+        } = &self.object
+        else {
+            panic!("the nodal equilibrium start is a filament's");
+        };
+        let model = &models[0];
         let kt_sqrt = model.beam().params().kt.sqrt();
         (0..model.components())
             .map(|_| {
                 let mut z: Vec<f64> = (0..model.beam().n_dofs())
                     .map(|_| kt_sqrt * rng.sample::<f64, _>(StandardNormal))
                     .collect();
-                self.stiffness.solve_upper_in_place(&mut z);
+                stiffness.solve_upper_in_place(&mut z);
                 z
             })
             .collect()
@@ -411,9 +514,14 @@ impl CompressionRun {
         rng: &mut TrajectoryRng,
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
-        let model = &self.models[point];
-        if let Some(modes) = &self.paired {
-            return self.simulate_modal(point, plan, modes, rng, sampled_steps);
+        let (model, paired) = match &self.object {
+            Strained::Filament { models, paired, .. } => (&models[point], paired),
+            Strained::Membrane { models, modes } => {
+                return self.simulate_membrane(&models[point], modes, plan, rng, sampled_steps);
+            }
+        };
+        if let Some(modes) = paired {
+            return self.simulate_modal(model, plan, modes, rng, sampled_steps);
         }
         let integrator =
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, plan.dt)?;
@@ -453,32 +561,14 @@ impl CompressionRun {
     /// bending equilibrium (moved onto the buckled branch above the Euler strain).
     fn simulate_modal(
         &self,
-        point: usize,
+        model: &CompressedFilament,
         plan: StepPlan,
         modes: &PairedModes,
         rng: &mut TrajectoryRng,
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
-        let model = &self.models[point];
         let mut chain = ModalMetropolis::new(model, modes, plan.burn_in_dt, rng)?;
-        let detail = |phase: &str, dt: f64| {
-            format!(
-                "non-finite energy with {} at strain {:.4e} ({phase}, dt = {:.3e} tau1)",
-                self.spec.integrator,
-                model.strain(),
-                dt / (self.dt / self.spec.dt_tau1)
-            )
-        };
-        Driver::new(plan.burn_in_dt, plan.burn_in_steps, 0, 1).run(
-            point,
-            &mut chain,
-            rng,
-            &mut (),
-            |_| detail("burn-in", plan.burn_in_dt),
-        )?;
-        chain.set_dt(plan.dt)?;
-        chain.proposed = 0;
-        chain.accepted = 0;
+        self.burn_in(&mut chain, plan, model.strain(), rng)?;
         let mut recorder = ModalForceRecorder {
             model,
             euler_load: self.euler_load,
@@ -488,12 +578,13 @@ impl CompressionRun {
             },
             block_squares: vec![0.0; modes.pairs().len() + modes.singles().len()],
         };
-        Driver::new(plan.dt, 0, sampled_steps, plan.sample_every).run(
-            point,
+        self.sample(
             &mut chain,
+            plan,
+            model.strain(),
             rng,
+            sampled_steps,
             &mut recorder,
-            |_| detail("sampling after the burn-in", plan.dt),
         )?;
         let mut slope_squares = vec![0.0; model.beam().mesh().n_nodes()];
         modes.add_rotation_squares(&recorder.block_squares, &mut slope_squares);
@@ -503,6 +594,93 @@ impl CompressionRun {
             slope_squares,
             ..recorder.rec
         })
+    }
+
+    /// [`Self::simulate`] for a membrane under imposed projected area: the modal chain
+    /// ([`ModalMetropolis::for_membrane`], its θ-scheme for the θ integrators) from the
+    /// free bending equilibrium, recording the compressive stress `−σ/σ_c0` (no slopes).
+    fn simulate_membrane(
+        &self,
+        model: &AreaMembrane,
+        modes: &PlateModes,
+        plan: StepPlan,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+    ) -> Result<ForceRecord> {
+        let mut chain = ModalMetropolis::for_membrane(model, modes, plan.burn_in_dt, rng)?;
+        if let Family::Theta(theta) = self.spec.integrator.family() {
+            chain = chain.with_theta(theta)?;
+        }
+        self.burn_in(&mut chain, plan, model.strain(), rng)?;
+        let mut recorder = StressRecorder {
+            unit: self.euler_load,
+            force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
+        };
+        self.sample(
+            &mut chain,
+            plan,
+            model.strain(),
+            rng,
+            sampled_steps,
+            &mut recorder,
+        )?;
+        Ok(ForceRecord {
+            force_ratio: recorder.force_ratio,
+            proposed: chain.proposed,
+            accepted: chain.accepted,
+            ..Default::default()
+        })
+    }
+
+    /// The burn-in of a modal chain at the plan's burn-in step, then the switch to its
+    /// sampling step with the counts reset.
+    fn burn_in(
+        &self,
+        chain: &mut ModalMetropolis<'_>,
+        plan: StepPlan,
+        strain: f64,
+        rng: &mut TrajectoryRng,
+    ) -> Result<()> {
+        Driver::new(plan.burn_in_dt, plan.burn_in_steps, 0, 1).run(
+            0,
+            chain,
+            rng,
+            &mut (),
+            |_| self.divergence(strain, "burn-in", plan.burn_in_dt),
+        )?;
+        chain.set_dt(plan.dt)?;
+        chain.proposed = 0;
+        chain.accepted = 0;
+        Ok(())
+    }
+
+    /// The sampled steps of a modal chain after its burn-in.
+    fn sample<'a>(
+        &self,
+        chain: &mut ModalMetropolis<'a>,
+        plan: StepPlan,
+        strain: f64,
+        rng: &mut TrajectoryRng,
+        sampled_steps: u64,
+        observer: &mut impl Observer<ModalMetropolis<'a>>,
+    ) -> Result<()> {
+        Driver::new(plan.dt, 0, sampled_steps, plan.sample_every).run(
+            0,
+            chain,
+            rng,
+            observer,
+            |_| self.divergence(strain, "sampling after the burn-in", plan.dt),
+        )
+    }
+
+    /// What a diverged modal chain reports: integrator, strain, phase and step.
+    fn divergence(&self, strain: f64, phase: &str, dt: f64) -> String {
+        format!(
+            "non-finite energy with {} at strain {:.4e} ({phase}, dt = {:.3e} tau1)",
+            self.spec.integrator,
+            strain,
+            dt / (self.dt / self.spec.dt_tau1)
+        )
     }
 
     /// Simulates `trajectories` trajectories at every strain, `sampled_steps[i]` sampled
@@ -605,7 +783,18 @@ impl CompressionRun {
 
     /// The strains of this run (ε/ε_c0 is in the theory table).
     pub fn points(&self) -> usize {
-        self.models.len()
+        match &self.object {
+            Strained::Filament { models, .. } => models.len(),
+            Strained::Membrane { models, .. } => models.len(),
+        }
+    }
+
+    /// The filament models (one per strain); `None` for a membrane.
+    fn filaments(&self) -> Option<&[CompressedFilament]> {
+        match &self.object {
+            Strained::Filament { models, .. } => Some(models),
+            Strained::Membrane { .. } => None,
+        }
     }
 
     /// What is wrong with the shapes of `records` (per strain, per trajectory) read from
@@ -622,7 +811,10 @@ impl CompressionRun {
                 self.points()
             ));
         }
-        let nodes = self.models.first().map_or(0, |m| m.beam().mesh().n_nodes());
+        let nodes = self
+            .filaments()
+            .and_then(|m| m.first())
+            .map_or(0, |m| m.beam().mesh().n_nodes());
         for (i, at) in records.iter().enumerate() {
             let samples = at.first().map(|r| r.force_ratio.len());
             for (j, r) in at.iter().enumerate() {
@@ -648,10 +840,11 @@ impl CompressionRun {
     /// one strain: `(rms slope, node x/L)`; `None` without samples. The small-slope
     /// (von Kármán) model is flagged above
     /// [`SMALL_SLOPE_LIMIT`](crate::scene::linear::SMALL_SLOPE_LIMIT).
+    /// `None` for a membrane (no slopes are recorded).
     pub fn measured_rms_slope(&self, records: &[ForceRecord]) -> Option<(f64, f64)> {
-        let beam = self.models.first()?.beam();
-        let n =
-            records.iter().map(|r| r.slope_samples).sum::<usize>() * self.models[0].components();
+        let models = self.filaments()?;
+        let beam = models.first()?.beam();
+        let n = records.iter().map(|r| r.slope_samples).sum::<usize>() * models[0].components();
         let sums: Vec<f64> = (0..beam.mesh().n_nodes())
             .map(|k| records.iter().map(|r| r.slope_squares[k]).sum())
             .collect();

@@ -335,6 +335,11 @@ pub struct CompressionSpec {
     /// The two runs compared by the Δt-halving check: `[run at Δt, run at Δt/2]`.
     #[serde(default)]
     pub halving: Option<[String; 2]>,
+    /// A membrane under imposed projected area (issue #28): the area modulus K_A (energy
+    /// per area); the strains are `ε = 1 − A_p/A₀` in units of `ε_c0 = κq²_min/K_A`.
+    /// Required with a `[membrane]` table, refused with a filament.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area_modulus: Option<f64>,
 }
 
 /// Discretization of the filament or the membrane.

@@ -354,10 +354,6 @@ impl Scene {
             let allowed = "left out of a membrane scene (a scene describes one object, and this one has a [membrane] table)";
             return Err(bad(self, "filament", &"a [filament] table", allowed));
         }
-        if self.model == ModelKind::Compression {
-            let allowed = "\"fem\" or \"spectral\" for a membrane scene (compression is the filament's Fig. 2: a filament under imposed end-shortening)";
-            return Err(bad(self, "model", &"\"compression\"", allowed));
-        }
         if self.dims != 3 {
             let allowed = "3 for a membrane scene (a surface in 3D space with one height component h(x, y) normal to its x-y rectangle; dims = 2 would hold a curve, the filament)";
             return Err(bad(self, "dims", &self.dims, allowed));
@@ -725,9 +721,58 @@ impl Scene {
         }
     }
 
+    /// `compression.area_modulus`: required in [1e-30, 1e30] for a membrane (under
+    /// imposed projected area, whose `membrane.tension` must then be 0: the tension is
+    /// `K_A(ΔA/A₀ − ε)`), refused for a filament; a membrane's compression scene takes
+    /// `metropolis-crank-nicolson` and the θ-schemes with consistent noise (its runs are
+    /// modal: [`crate::dynamics::ModalMetropolis`]).
+    fn validate_area_modulus(&self, c: &CompressionSpec) -> Result<()> {
+        let Some(m) = &self.membrane else {
+            return match c.area_modulus {
+                None => Ok(()),
+                Some(v) => Err(bad(
+                    self,
+                    "compression.area_modulus",
+                    &Num(v),
+                    "left out of a filament scene (the area modulus of a [membrane] under imposed projected area; a filament's stretch modulus is filament.stretch_rigidity)",
+                )),
+            };
+        };
+        let Some(k) = c.area_modulus else {
+            let allowed =
+                "the area modulus K_A in [1e-30, 1e30] for a membrane under imposed projected area";
+            return Err(bad(self, "compression.area_modulus", &"nothing", allowed));
+        };
+        if !(k.is_finite() && (1e-30..=1e30).contains(&k)) {
+            return Err(bad(
+                self,
+                "compression.area_modulus",
+                &Num(k),
+                "in [1e-30, 1e30]",
+            ));
+        }
+        if m.tension != 0.0 {
+            let allowed = "0 for a membrane under imposed projected area (model = \"compression\": its tension is K_A (dA/A0 - eps), set by the imposed area strain)";
+            return Err(bad(self, "membrane.tension", &Num(m.tension), allowed));
+        }
+        for (i, run) in self.runs.iter().enumerate() {
+            let ok = matches!(
+                run.integrator.family(),
+                Family::Metropolis | Family::Theta(_)
+            ) && run.noise == NoiseModel::Consistent;
+            if !ok {
+                let allowed = "metropolis-crank-nicolson, euler-maruyama, backward-euler or crank-nicolson with noise = \"consistent\" for a membrane under imposed projected area (its runs are modal)";
+                let value = format!("{} with noise {}", run.integrator, run.noise);
+                return Err(bad(self, &format!("runs[{i}].integrator"), &value, allowed));
+            }
+        }
+        Ok(())
+    }
+
     /// The `[compression]` table of a compression scene: strains, uniform mesh, burn-in
     /// and sampling interval.
     fn validate_compression_table(&self, c: &CompressionSpec) -> Result<()> {
+        self.validate_area_modulus(c)?;
         if c.strain_ratios.is_empty() {
             return Err(bad(
                 self,
