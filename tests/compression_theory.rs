@@ -797,7 +797,7 @@ fn cli_json_and_exit_codes() {
             &["--dims", "2", "--strain-ratio", "1", "--elements", "2001"],
             "--elements",
         ),
-        (&["--dims", "2", "--strain-ratio", "-1"], "--strain-ratio"),
+        (&["--dims", "2", "--strain-ratio", "-1e9"], "--strain-ratio"),
         (
             &["--dims", "2", "--strain-ratio", "1,inf"],
             "--strain-ratio",

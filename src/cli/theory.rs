@@ -6,12 +6,16 @@ use langevin_fem::dynamics::{DiscreteLaw, IntegratorKind};
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
 use langevin_fem::fem::noise::{NoiseModel, element_uniform_ratios};
 use langevin_fem::fem::plate::PlateModel;
+use langevin_fem::fem::plate_area::{
+    AREA_BENDING_RANGE, AreaCutoff, AreaParams, AreaTheory, MAX_AREA_ASPECT_RATIO,
+    MAX_AREA_CUTOFF_INDEX, MAX_AREA_ELEMENTS, max_area_strain_ratio,
+};
 use langevin_fem::fem::plate_modes::PlateModes;
 use langevin_fem::spectral::{
     HingedBeam, Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
 };
 use langevin_fem::theory::{
-    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS,
+    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS, MIN_STRAIN_RATIO,
     PERSISTENCE_RATIO_RANGE, STRETCH_BEND_RATIO_RANGE, StoredLengthLaw, max_strain_ratio,
 };
 use serde_json::json;
@@ -59,6 +63,7 @@ Examples:
   langevin-fem theory correlation --x 0.5 --y 0.5 --t 0.1 --eta 0.2
   langevin-fem theory compression --dims 2 --strain-ratio 0,1,3,10 --elements 20
   langevin-fem theory membrane --boundary periodic --m 1 --n 0 --tension 0.5 --cutoff 100
+  langevin-fem theory area --strain-ratio -10,0,1,3,10 --elements 16
 
 Every result is one JSON object on stdout.";
 
@@ -121,7 +126,8 @@ enum Query {
         #[arg(long, value_enum)]
         dims: DimsArg,
         /// Comma-separated strain ratios ε/ε_c0, each in [0, 100·√S/P] (10 at the smallest
-        /// S/P², 10⁸ at the largest; the work grows with ε/ε_c0).
+        /// S/P², 10⁸ at the largest; the work grows with ε/ε_c0) or, in tension, in
+        /// [-1e8, 0].
         #[arg(long, allow_hyphen_values = true)]
         strain_ratio: String,
         /// Number of Hermite-cubic elements (the discretized filament), in [1, 2000];
@@ -141,6 +147,48 @@ enum Query {
     /// mode (m, n) with its convention; the point variance ⟨h²(x, y)⟩ with a rigorous
     /// bound; with --cutoff, the excess area ⟨ΔA⟩ and Var ΔA of the modes with |q| ≤ Q.
     Membrane(MembraneArgs),
+    /// Exact equilibrium tension ⟨σ⟩/σ_c0 of a fluid membrane (true area A₀ = ab, bending
+    /// rigidity κ, area modulus K_A) whose frame imposes the projected area (1 − ε)A₀, at
+    /// strains ε/ε_c0 (σ_c0 = κq²_min, ε_c0 = σ_c0/K_A; no mean-field approximation): the
+    /// filament's Fig. 2 theory with EA → K_A, L → A₀, F → −σ. Units kT = 1: κ is in kT,
+    /// --stretch-ratio S = K_A·A₀/kT, σ in kT per squared length unit. The result depends on
+    /// κ and S only through S/κ², which must lie in [1e-2, 1e12], and on the sides only
+    /// through b/a. Either the exact Bogner–Fox–Schmit mesh (--elements) or the continuum
+    /// cut off at lattice indices (--cutoff: its ⟨ΔA⟩ grows as the log of the cutoff).
+    Area(AreaArgs),
+}
+
+/// Flags of `theory area` (units kT = 1).
+#[derive(Debug, Clone, Args)]
+pub struct AreaArgs {
+    /// Boundary conditions.
+    #[arg(long, value_enum, default_value = "simply-supported")]
+    boundary: BoundaryArg,
+    /// Side a along x.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    width: f64,
+    /// Side b along y, with b/a in [0.1, 10].
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    height: f64,
+    /// Bending rigidity κ/kT, in [1e-3, 1e6] (with S/κ² in [1e-2, 1e12]).
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    bending_rigidity: f64,
+    /// Stretch ratio S = K_A·A₀/kT, with S/κ² in [1e-2, 1e12].
+    #[arg(long, default_value_t = 1.0e6, allow_negative_numbers = true)]
+    stretch_ratio: f64,
+    /// Comma-separated strain ratios ε/ε_c0, each in [0, 100·√S·π²/(κq²_min·A₀)]
+    /// (compression; the work grows with ε/ε_c0) or in [-1e8, 0] (tension).
+    #[arg(long, allow_hyphen_values = true)]
+    strain_ratio: String,
+    /// The exact discrete theory of a uniform N × NY Bogner–Fox–Schmit mesh (`N` or
+    /// `N,NY`; NY defaults to N), each in [1, 128] ([2, 128] periodic).
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "cutoff")]
+    elements: Option<String>,
+    /// The continuum with the acoustic modes of an NX × NY mesh (`NX` or `NX,NY`): simply
+    /// supported 1 ≤ m < NX, 1 ≤ n < NY; periodic 2|m| < NX, 2|n| < NY; each in [2, 256]
+    /// ([3, 256] periodic).
+    #[arg(long, allow_hyphen_values = true)]
+    cutoff: Option<String>,
 }
 
 /// `theory membrane --boundary`.
@@ -334,11 +382,17 @@ fn as_flag_named(flag: &'static str) -> impl Fn(Error) -> Error {
     }
 }
 
-/// Parses `--strain-ratio`: a non-empty comma-separated list of numbers in `[0, max]`
-/// (`max` = [`max_strain_ratio`] of the already validated P and S, `context` names them).
+/// Parses `--strain-ratio`: a non-empty comma-separated list of numbers in
+/// `[MIN_STRAIN_RATIO, max]` (`max` = [`max_strain_ratio`] of the already validated
+/// parameters, `context` names them).
 fn parse_strain_ratios(list: &str, max: f64, context: &str) -> Result<Vec<f64>> {
-    let allowed =
-        || format!("a non-empty comma-separated list of numbers in [0, {max:e}] {context}");
+    let min = MIN_STRAIN_RATIO;
+    let allowed = || {
+        format!(
+            "a non-empty comma-separated list of numbers in [0, {max:e}] {context} (compression) \
+             or in [{min:e}, 0] (tension)"
+        )
+    };
     let items: Vec<&str> = list.split(',').map(str::trim).collect();
     if items.iter().all(|s| s.is_empty()) {
         return Err(Error::invalid(
@@ -350,7 +404,7 @@ fn parse_strain_ratios(list: &str, max: f64, context: &str) -> Result<Vec<f64>> 
     items
         .iter()
         .map(|item| match item.parse::<f64>() {
-            Ok(r) if r.is_finite() && (0.0..=max).contains(&r) => Ok(r),
+            Ok(r) if r.is_finite() && (min..=max).contains(&r) => Ok(r),
             _ => Err(Error::invalid(
                 "--strain-ratio",
                 format!("{item:?}"),
@@ -642,6 +696,7 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             stretch_ratio,
         )?,
         Query::Membrane(args) => membrane(&args)?,
+        Query::Area(args) => area(&args)?,
     };
     if let Some(bad) = non_finite_number(&value) {
         return Err(Error::invalid(
@@ -668,4 +723,134 @@ fn non_finite_number(value: &serde_json::Value) -> Option<String> {
         serde_json::Value::Array(items) => items.iter().find_map(non_finite_number),
         _ => None,
     }
+}
+
+/// Parses `N` or `N,NY` of `flag` (each an integer in `[min, max]`; NY defaults to N).
+fn parse_pair(flag: &str, text: &str, min: usize, max: usize) -> Result<(usize, usize)> {
+    let allowed = || format!("N or N,NY with integers in [{min}, {max}]");
+    let items: Vec<&str> = text.split(',').map(str::trim).collect();
+    if items.is_empty() || items.len() > 2 {
+        return Err(Error::invalid(flag, format!("{text:?}"), allowed()));
+    }
+    let parsed = items
+        .iter()
+        .map(|item| match item.parse::<usize>() {
+            Ok(n) if (min..=max).contains(&n) => Ok(n),
+            _ => Err(Error::invalid(flag, format!("{item:?}"), allowed())),
+        })
+        .collect::<Result<Vec<usize>>>()?;
+    Ok((parsed[0], *parsed.last().unwrap_or(&parsed[0])))
+}
+
+/// The area query: validates the flags and evaluates the exact theory.
+fn area(args: &AreaArgs) -> Result<serde_json::Value> {
+    let boundary = match args.boundary {
+        BoundaryArg::SimplySupported => MembraneBoundary::SimplySupported,
+        BoundaryArg::Periodic => MembraneBoundary::Periodic,
+    };
+    require_positive("--width", args.width)?;
+    require_positive("--height", args.height)?;
+    let (lo, hi) = (
+        args.width / MAX_AREA_ASPECT_RATIO,
+        args.width * MAX_AREA_ASPECT_RATIO,
+    );
+    if !(lo..=hi).contains(&args.height) {
+        return Err(Error::invalid(
+            "--height",
+            format!("{:e}", args.height),
+            format!(
+                "in [{lo:e}, {hi:e}] (b/a in [0.1, 10] at --width {:e})",
+                args.width
+            ),
+        ));
+    }
+    let kappa = args.bending_rigidity;
+    let (k_lo, k_hi) = AREA_BENDING_RANGE;
+    if !(kappa.is_finite() && kappa >= k_lo && kappa <= k_hi) {
+        return Err(Error::invalid(
+            "--bending-rigidity",
+            format!("{kappa:e}"),
+            format!("in [{k_lo:e}, {k_hi:e}] (kT units)"),
+        ));
+    }
+    let (l_lo, l_hi) = STRETCH_BEND_RATIO_RANGE;
+    let (s_lo, s_hi) = (l_lo * kappa * kappa, l_hi * kappa * kappa);
+    let stretch = args.stretch_ratio;
+    if !(stretch.is_finite() && stretch >= s_lo && stretch <= s_hi) {
+        return Err(Error::invalid(
+            "--stretch-ratio",
+            format!("{stretch:e}"),
+            format!(
+                "in [{s_lo:e}, {s_hi:e}] at --bending-rigidity {kappa:e} (S/κ² in \
+                 [{l_lo:e}, {l_hi:e}]: the tension ratio depends on S/κ² only; outside, the \
+                 exact theory is too slow or at a known limit, see --help)"
+            ),
+        ));
+    }
+    let min = match boundary {
+        MembraneBoundary::SimplySupported => 1,
+        MembraneBoundary::Periodic => 2,
+    };
+    let mesh = match (&args.elements, &args.cutoff) {
+        (Some(e), None) => Ok(parse_pair("--elements", e, min, MAX_AREA_ELEMENTS)?),
+        (None, Some(c)) => Err(parse_pair("--cutoff", c, min + 1, MAX_AREA_CUTOFF_INDEX)?),
+        _ => {
+            return Err(Error::invalid(
+                "--elements/--cutoff",
+                "neither",
+                "exactly one of --elements N[,NY] (the mesh) or --cutoff NX[,NY] (the continuum)",
+            ));
+        }
+    };
+    let params = AreaParams {
+        bending_rigidity: kappa,
+        area_modulus: stretch / (args.width * args.height),
+        kt: 1.0,
+        width: args.width,
+        height: args.height,
+        boundary,
+    };
+    let ratios = parse_strain_ratios(
+        &args.strain_ratio,
+        max_area_strain_ratio(&params),
+        &format!(
+            "(100·√S·π²/(κ·q²_min·A₀) at --bending-rigidity {kappa:e} and --stretch-ratio \
+             {stretch:e})"
+        ),
+    )?;
+    let theory = match mesh {
+        Ok((nx, ny)) => AreaTheory::discrete(&params, nx, ny)?,
+        Err((nx, ny)) => AreaTheory::continuum(&params, AreaCutoff::Lattice { nx, ny })?,
+    };
+    let sigma_c0 = params.reference_tension();
+    let eps_c0 = params.reference_strain();
+    let points = ratios
+        .iter()
+        .map(|&r| {
+            let eps = r * eps_c0;
+            Ok(json!({
+                "strain_ratio": r,
+                "tension_ratio": theory.tension_ratio(r)?,
+                "mean_field_tension_ratio": theory.mean_field_tension(eps)? / sigma_c0,
+                "std_dev_ratio": theory.tension_variance(eps)?.sqrt() / sigma_c0,
+            }))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut out = json!({
+        "boundary": boundary.name(),
+        "width": args.width,
+        "height": args.height,
+        "bending_rigidity": kappa,
+        "stretch_ratio": stretch,
+        "modes": theory.theory().law().weights.len(),
+        "reference_tension": sigma_c0,
+        "reference_strain": eps_c0,
+        "free_excess_area_ratio": theory.free_excess_area_ratio(),
+        "points": points,
+    });
+    match mesh {
+        Ok((nx, ny)) => out["elements"] = json!([nx, ny]),
+        Err((nx, ny)) => out["cutoff"] = json!([nx, ny]),
+    }
+    Ok(out)
 }

@@ -15,6 +15,9 @@
 //! - [`plate_modes`]: the separable modes of the uniform plate ([`PlateModes`]): `K`, `C`
 //!   block-diagonal with blocks of at most 4×4 per pair of 1D waves, labelled by the
 //!   continuum modes.
+//! - [`plate_area`]: the membrane under imposed projected area ([`plate_area::AreaTheory`]):
+//!   the stored-area law of the continuum and of the uniform plate (exact per block), and
+//!   the exact equilibrium tension through [`crate::theory::CompressionTheory`].
 //! - [`noise`]: [`NoiseModel`] and [`NoiseGenerator`] (`F = sqrt(2kT/Δt)·ζ`).
 //! - [`modal`]: [`GeneralizedModes`] and exact stationary covariances.
 //! - [`paired`]: the paired modal form of a uniform hinged beam ([`PairedModes`]): `K`,
@@ -33,6 +36,7 @@ pub mod modal;
 pub mod noise;
 pub mod paired;
 pub mod plate;
+pub mod plate_area;
 pub mod plate_modes;
 pub mod system;
 pub mod vonkarman;

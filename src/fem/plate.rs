@@ -227,7 +227,7 @@ impl Axis {
     }
 
     /// Assembles `M`, `K2`, `K4` over the free DOFs.
-    fn assemble(&self) -> Result<AxisMatrices> {
+    pub(crate) fn assemble(&self) -> Result<AxisMatrices> {
         let (n, bw, h) = (self.n_free(), self.bandwidth(), self.h());
         let mut out = AxisMatrices {
             m: SymBanded::new(n, bw),

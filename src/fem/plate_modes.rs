@@ -106,32 +106,32 @@ const TIE_TOLERANCE: f64 = 1e-10;
 
 /// Which of the two periodic waves of a wavenumber (hinged waves are all `Sine`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-enum Parity {
+pub(crate) enum Parity {
     Cosine,
     Sine,
 }
 
 /// One 1D wave of an axis and its blocks (see the module docs).
 #[derive(Debug, Clone)]
-struct Wave {
-    k: usize,
-    parity: Parity,
+pub(crate) struct Wave {
+    pub(crate) k: usize,
+    pub(crate) parity: Parity,
     /// The 1D DOF kinds of its basis vectors (0: `w` part, 1: `θ` part), 1 or 2 of them.
-    kinds: &'static [usize],
+    pub(crate) kinds: &'static [usize],
     /// `[M, K2, K4]` blocks `V_ᵀ A V` (indices below `kinds.len()` used).
-    mats: [[[f64; 2]; 2]; 3],
+    pub(crate) mats: [[[f64; 2]; 2]; 3],
     /// `∫ v_h · [cos, sin](ϕ(x))` of each basis vector, `ϕ = kπx/L` hinged, `2kπx/L`
     /// periodic.
     proj: [[f64; 2]; 2],
 }
 
 impl Wave {
-    fn size(&self) -> usize {
+    pub(crate) fn size(&self) -> usize {
         self.kinds.len()
     }
 
     /// Whether the wave has a `w` part.
-    fn has_height(&self) -> bool {
+    pub(crate) fn has_height(&self) -> bool {
         self.kinds[0] == 0
     }
 
@@ -202,7 +202,7 @@ fn projections(axis: &Axis, k: usize, parity: Parity, t: usize) -> [f64; 2] {
 
 /// The waves of one axis with their 1D blocks and projections, in the order
 /// (k ascending, cosine before sine).
-fn axis_waves(axis: &Axis, mats: &AxisMatrices) -> Vec<Wave> {
+pub(crate) fn axis_waves(axis: &Axis, mats: &AxisMatrices) -> Vec<Wave> {
     let n = axis.elements;
     let mut list: Vec<(usize, Parity, &'static [usize])> = Vec::new();
     if axis.periodic {

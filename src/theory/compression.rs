@@ -243,6 +243,15 @@ pub const STRETCH_BEND_RATIO_RANGE: (f64, f64) = (1e-2, 1e12);
 /// within 10⁻⁵ of F_c0; at κ = 100 (the paper) it is 10³ ε_c0.
 pub const STRAIN_RATIO_SCALE: f64 = 100.0;
 
+/// The smallest (most tensile) strain ratio ε/ε_c0 accepted by the CLI
+/// (`theory compression`, `theory area`), at every stretch ratio. In tension the tilted law
+/// of the stored length is narrow and the quadrature needs ≈ 500 mode evaluations whatever
+/// the strain (tested); the cost is the saddle point and the Chernoff ladder of the exact
+/// continuum tail, which sums `≈ 4√(|⟨F⟩|/F_c0)` modes one by one per evaluation:
+/// `≤ 4·10⁴` at this bound (≈ 0.25 s per strain; 1.2 s at 10¹⁰). A discrete or membrane law
+/// costs `O(weights)` per evaluation at any strain.
+pub const MIN_STRAIN_RATIO: f64 = -1e8;
+
 /// The largest strain ratio ε/ε_c0 verified at persistence ratio `p` and stretch ratio `s`:
 /// [`STRAIN_RATIO_SCALE`]`·√s/p`.
 pub fn max_strain_ratio(persistence_ratio: f64, stretch_ratio: f64) -> f64 {
@@ -678,6 +687,26 @@ impl StoredLengthLaw {
         })
     }
 
+    /// A law of explicit weights only (no tail): `s = Σ_i c_i χ²_{d,i}`, `d = copies`,
+    /// weights sorted descending. Any object whose stored measure is a quadratic form
+    /// `s = xᵀGx/(2X)` under a Gaussian `x ~ N(0, kT K⁻¹)` has such a law, with
+    /// `c_i = kT μ_i/(2X)` and `μ_i` the generalized eigenvalues of `(G, K)` (module docs,
+    /// *The stored-length law*); e.g. the membrane's stored area,
+    /// [`crate::fem::plate_area`].
+    ///
+    /// # Errors
+    /// As [`Self::validate`].
+    pub fn from_weights(mut weights: Vec<f64>, copies: usize) -> Result<Self> {
+        weights.sort_by(|a, b| b.total_cmp(a));
+        let law = StoredLengthLaw {
+            weights,
+            copies,
+            tail: Tail::None,
+        };
+        law.validate()?;
+        Ok(law)
+    }
+
     /// Checks the law is well formed: `copies ≥ 1`, weights finite and `≥ 0`, Gaussian tail
     /// cumulants finite and `≥ 0`, an inverse-square tail with a finite positive weight and
     /// `first_mode ≥ 1`.
@@ -1016,11 +1045,117 @@ impl Default for QuadratureOptions {
     }
 }
 
-/// The exact equilibrium force–strain theory for one filament (parameters + stored-length
-/// law). See the module documentation for the method.
+/// The global constraint of the stored-length theory: a stiffness S that penalizes the
+/// stored measure `s` against the imposed strain ε through the energy
+/// `(S·X/2)(s − ε)²`, X the measure, and the reference scales that make the results
+/// dimensionless (module docs, *Other constrained objects*).
+///
+/// | object | S | X | `F = S(ε − s)` | reference load | reference strain |
+/// |---|---|---|---|---|---|
+/// | filament | EA | L | compressive force | `F_c0 = π²EI/L²` | `ε_c0 = F_c0/EA` |
+/// | membrane | K_A | A₀ | `−σ` (σ the tension) | `σ_c0 = κq²_min` | `ε_c0 = σ_c0/K_A` |
+///
+/// The theory uses `A = S·X/(2kT)` (the stretching Gaussian `e^{−A(s−ε)²}`) and the force
+/// unit `kT/X`; every weight `c_i` of the [`StoredLengthLaw`] is `kT μ_i/(2X)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlobalConstraint {
+    /// The stiffness S of the constraint: EA (filament) or the area modulus K_A
+    /// (membrane).
+    pub stiffness: f64,
+    /// The measure X: the length L (filament) or the true area A₀ (membrane).
+    pub measure: f64,
+    /// Thermal energy kT.
+    pub kt: f64,
+    /// The load that [`CompressionTheory::force_ratio`] divides by: F_c0 or σ_c0.
+    pub reference_load: f64,
+    /// The strain that [`CompressionTheory::force_ratio`]'s argument multiplies: ε_c0.
+    pub reference_strain: f64,
+}
+
+impl GlobalConstraint {
+    /// The filament's constraint: S = EA, X = L, kT, reference load
+    /// [`FilamentParams::euler_load`] and strain [`FilamentParams::euler_strain`].
+    ///
+    /// # Errors
+    /// As [`FilamentParams::validate`].
+    pub fn filament(params: &FilamentParams) -> Result<Self> {
+        params.validate()?;
+        Ok(GlobalConstraint {
+            stiffness: params.stretch_rigidity,
+            measure: params.length,
+            kt: params.kt,
+            reference_load: params.euler_load(),
+            reference_strain: params.euler_strain(),
+        })
+    }
+
+    /// A membrane's constraint: S = K_A (`area_modulus`), X = A₀ (`area`), kT, reference
+    /// load `reference_tension` (σ_c0 = κq²_min) and strain `σ_c0/K_A`.
+    ///
+    /// # Errors
+    /// As [`Self::validate`].
+    pub fn membrane(area_modulus: f64, area: f64, kt: f64, reference_tension: f64) -> Result<Self> {
+        let c = GlobalConstraint {
+            stiffness: area_modulus,
+            measure: area,
+            kt,
+            reference_load: reference_tension,
+            reference_strain: reference_tension / area_modulus,
+        };
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Checks every field finite and `> 0`, and `S·X/kT` and `kT/X` finite and `> 0`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first offending field.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("stiffness", self.stiffness),
+            ("measure", self.measure),
+            ("kt", self.kt),
+            ("reference_load", self.reference_load),
+            ("reference_strain", self.reference_strain),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid(name, v, "finite and > 0"));
+            }
+        }
+        let a = self.stretch_exponent();
+        if !(a.is_finite() && a > 0.0) {
+            return Err(Error::invalid(
+                "stiffness*measure/(2kt)",
+                a,
+                "finite and > 0",
+            ));
+        }
+        let unit = self.force_unit();
+        if !(unit.is_finite() && unit > 0.0) {
+            return Err(Error::invalid("kt/measure", unit, "finite and > 0"));
+        }
+        Ok(())
+    }
+
+    /// `A = S·X/(2kT)`.
+    pub fn stretch_exponent(&self) -> f64 {
+        self.stiffness * self.measure / (2.0 * self.kt)
+    }
+
+    /// The force unit `kT/X`: the mean-field force is `(kT/X)η̂`.
+    pub fn force_unit(&self) -> f64 {
+        self.kt / self.measure
+    }
+}
+
+/// The exact equilibrium force–strain theory for one filament, or any object with a
+/// [`GlobalConstraint`] (global constraint + stored-length law). See the module
+/// documentation for the method.
 #[derive(Debug, Clone)]
 pub struct CompressionTheory {
-    params: FilamentParams,
+    constraint: GlobalConstraint,
+    /// The filament's parameters, when built from a filament ([`Self::new`]).
+    filament: Option<FilamentParams>,
     law: StoredLengthLaw,
     options: QuadratureOptions,
     /// Positive weights only, descending.
@@ -1125,7 +1260,19 @@ impl CompressionTheory {
     /// # Errors
     /// [`Error::InvalidParameter`] for invalid parameters or an ill-formed law.
     pub fn new(params: &FilamentParams, law: StoredLengthLaw) -> Result<Self> {
-        params.validate()?;
+        let mut theory = Self::with_constraint(GlobalConstraint::filament(params)?, law)?;
+        theory.filament = Some(*params);
+        Ok(theory)
+    }
+
+    /// Builds the theory for any [`GlobalConstraint`] (e.g. a membrane under imposed
+    /// projected area, [`crate::fem::plate_area`]) and a stored-length law whose weights
+    /// are `kT μ_i/(2X)` for the same constraint.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an invalid constraint or an ill-formed law.
+    pub fn with_constraint(constraint: GlobalConstraint, law: StoredLengthLaw) -> Result<Self> {
+        constraint.validate()?;
         law.validate()?;
         let mut weights: Vec<f64> = law.weights.iter().copied().filter(|&c| c > 0.0).collect();
         weights.sort_by(|a, b| b.total_cmp(a));
@@ -1141,7 +1288,8 @@ impl CompressionTheory {
             _ => None,
         };
         Ok(CompressionTheory {
-            params: *params,
+            constraint,
+            filament: None,
             half_d: 0.5 * law.copies as f64,
             max_weight: law.max_weight(),
             mean: law.mean(),
@@ -1149,8 +1297,8 @@ impl CompressionTheory {
             options: QuadratureOptions::default(),
             weights,
             exact_tail,
-            a: params.stretch_rigidity * params.length / (2.0 * params.kt),
-            force_unit: params.kt / params.length,
+            a: constraint.stretch_exponent(),
+            force_unit: constraint.force_unit(),
         })
     }
 
@@ -1178,9 +1326,20 @@ impl CompressionTheory {
         Ok(self)
     }
 
-    /// The physical parameters.
+    /// The filament's physical parameters.
+    ///
+    /// # Panics
+    /// If the theory was built by [`Self::with_constraint`] (no filament): use
+    /// [`Self::constraint`].
     pub fn params(&self) -> &FilamentParams {
-        &self.params
+        self.filament
+            .as_ref()
+            .expect("CompressionTheory::params: built from a GlobalConstraint, not a filament")
+    }
+
+    /// The global constraint (S, X, kT and the reference scales).
+    pub fn constraint(&self) -> &GlobalConstraint {
+        &self.constraint
     }
 
     /// The stored-length law.
@@ -1262,9 +1421,15 @@ impl CompressionTheory {
                 format!(
                     "strain {strain:e}: the saddle point may lie as far as eta = {lo:e}, where \
                      the exact continuum tail would sum {tail_modes} modes one by one (cap \
-                     {MAX_TAIL_MODES}); EA*L^3*kT/EI^2 = {:e} is too large",
-                    self.params.stretch_rigidity * self.params.length.powi(3) * self.params.kt
-                        / self.params.bending_rigidity.powi(2)
+                     {MAX_TAIL_MODES}); {}",
+                    match &self.filament {
+                        Some(p) => format!(
+                            "EA*L^3*kT/EI^2 = {:e} is too large",
+                            p.stretch_rigidity * p.length.powi(3) * p.kt
+                                / p.bending_rigidity.powi(2)
+                        ),
+                        None => "the constraint is too stiff for the weights".to_string(),
+                    }
                 ),
             ));
         }
@@ -1564,7 +1729,7 @@ impl CompressionTheory {
 
     fn variance_from(&self, mo: &Moments) -> f64 {
         let r1 = mo.s1 / mo.s0;
-        let ea = self.params.stretch_rigidity;
+        let ea = self.constraint.stiffness;
         (ea * self.force_unit - self.force_unit * self.force_unit * (mo.s2 / mo.s0 + r1 * r1))
             .max(0.0)
     }
@@ -1583,7 +1748,8 @@ impl CompressionTheory {
 
     /// `⟨F⟩/F_c0` at `ε = strain_ratio·ε_c0`, with the continuum `F_c0 = π²EI/L²` and
     /// `ε_c0 = π²EI/(EA·L²)` ([`FilamentParams::euler_load`], `euler_strain`), also for a
-    /// discrete law.
+    /// discrete law; in general the [`GlobalConstraint`]'s reference load and strain (for a
+    /// membrane `⟨F⟩/σ_c0 = −⟨σ⟩/σ_c0` at `ε = strain_ratio·ε_c0`).
     ///
     /// # Errors
     /// As [`Self::mean_force`].
@@ -1591,7 +1757,10 @@ impl CompressionTheory {
         if !strain_ratio.is_finite() {
             return Err(Error::invalid("strain_ratio", strain_ratio, "finite"));
         }
-        Ok(self.mean_force(strain_ratio * self.params.euler_strain())? / self.params.euler_load())
+        Ok(
+            self.mean_force(strain_ratio * self.constraint.reference_strain)?
+                / self.constraint.reference_load,
+        )
     }
 
     /// The exact equilibrium variance of F at strain ε.
@@ -1648,7 +1817,7 @@ impl CompressionTheory {
             fourier_coefficients(&mut sums, norm, du, k_cap, rigorous_bound);
         let mut dist = ForceDistribution {
             strain,
-            ea: self.params.stretch_rigidity,
+            ea: self.constraint.stiffness,
             mean_field_force: self.force_unit * s.eta,
             x0,
             period,
