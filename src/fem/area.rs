@@ -80,6 +80,7 @@ impl AreaMembrane {
     /// The same membrane whose dynamics use the area matrix `G × scale` (a bug in the
     /// excess area, e.g. a missing ½ in `ΔA = ½∫|∇h|²` at scale 2): a fault hook
     /// ([`crate::fault`]); the references keep the true G.
+    #[cfg(any(test, feature = "faults"))]
     pub(crate) fn with_area_scale(mut self, scale: f64) -> Self {
         self.area_scale = scale;
         self

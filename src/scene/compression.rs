@@ -12,6 +12,7 @@ use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::paired::PairedModes;
+use crate::fem::plate_area::{AreaCutoff, AreaParams, AreaTheory};
 use crate::fem::plate_modes::PlateModes;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::linear::{add_slope_squares, largest_rms_slope};
@@ -50,15 +51,8 @@ impl CompressionTheoryTable {
     /// Numerical failures of the theory; a membrane scene ([`Scene::refuse_membrane`],
     /// exit 2: compression is a filament's).
     pub fn new(scene: &Scene, spec: &CompressionSpec) -> Result<Self> {
-        scene.refuse_membrane("the compression model")?;
-        let p = scene.filament;
-        let dims = Dims::from_u32(scene.dims as u32)?;
-        let disc = CompressionTheory::new(
-            &p,
-            StoredLengthLaw::discrete(&p, dims, scene.mesh.elements)?,
-        )?;
-        let cont =
-            CompressionTheory::new(&p, StoredLengthLaw::continuum(&p, dims, CONTINUUM_MODES)?)?;
+        let (disc, cont) = theories(scene, spec)?;
+        let strain_unit = disc.constraint().reference_strain;
         let mut discrete = Vec::new();
         let mut continuum = Vec::new();
         let mut distributions = Vec::new();
@@ -66,7 +60,7 @@ impl CompressionTheoryTable {
             discrete.push(disc.force_ratio(r)?);
             continuum.push(cont.force_ratio(r)?);
             distributions.push(if spec.distribution_strain_ratios.contains(&r) {
-                Some(disc.force_distribution(r * p.euler_strain())?)
+                Some(disc.force_distribution(r * strain_unit)?)
             } else {
                 None
             });
@@ -95,6 +89,45 @@ impl CompressionTheoryTable {
             curve,
         })
     }
+}
+
+/// The exact theories of a compression scene's object, `(discrete, continuum)`: the
+/// filament's of its Hermite-cubic mesh and of the continuum; a membrane under imposed
+/// projected area's of its BFS mesh and of the continuum at the mesh's mode cutoff
+/// ([`AreaCutoff::Lattice`]: the same lattice indices as the mesh's acoustic modes).
+fn theories(
+    scene: &Scene,
+    spec: &CompressionSpec,
+) -> Result<(CompressionTheory, CompressionTheory)> {
+    let Some(mp) = scene.membrane else {
+        let p = scene.filament;
+        let dims = Dims::from_u32(scene.dims as u32)?;
+        let disc = CompressionTheory::new(
+            &p,
+            StoredLengthLaw::discrete(&p, dims, scene.mesh.elements)?,
+        )?;
+        let cont =
+            CompressionTheory::new(&p, StoredLengthLaw::continuum(&p, dims, CONTINUUM_MODES)?)?;
+        return Ok((disc, cont));
+    };
+    let params = AreaParams {
+        bending_rigidity: mp.bending_rigidity,
+        area_modulus: spec.area_modulus.ok_or_else(|| {
+            Error::invalid(
+                "compression.area_modulus",
+                "nothing",
+                "the area modulus K_A",
+            )
+        })?,
+        kt: mp.kt,
+        width: mp.width,
+        height: mp.height,
+        boundary: mp.boundary,
+    };
+    let (nx, ny) = (scene.mesh.elements, scene.mesh.elements_along_y());
+    let disc = AreaTheory::discrete(&params, nx, ny)?;
+    let cont = AreaTheory::continuum(&params, AreaCutoff::Lattice { nx, ny })?;
+    Ok((disc.theory().clone(), cont.theory().clone()))
 }
 
 /// Samples between two evaluations of the axial equilibrium residual
