@@ -53,7 +53,7 @@ verify: build
 # rate is above alpha or a kind's p-values are not uniform. About 21 s per seed at the
 # quick budget on 2 cores (35 min for 100 seeds).
 SEEDS ?= 100
-CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference
+CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference
 calibrate: build
 	$(BIN) calibrate $(foreach s,$(CALIBRATION_SCENES),--scene $(s)) --seeds $(SEEDS) --budget $(BUDGET) --out $(OUT)/calibration
 

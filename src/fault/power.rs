@@ -68,6 +68,7 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
             t("membrane-hinged", CN),
             t("membrane-periodic", CN),
             t("membrane-spectral", ALL),
+            t("membrane-area-stiff", ALL),
         ],
         FaultKind::NoiseTimeScaling => vec![t("hinged-linear-3d", &["exact-modal"])],
         FaultKind::IntegratorDrag | FaultKind::SharedStiffness => vec![
@@ -80,7 +81,11 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
         | FaultKind::ComponentNoiseSharing
         | FaultKind::SharedHinge => vec![t("hinged-linear-3d", CN)],
         FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
-            vec![t("compression-2d", ALL)]
+            vec![
+                t("compression-2d", ALL),
+                t("membrane-area-soft", ALL),
+                t("membrane-area-stiff", ALL),
+            ]
         }
     }
 }
