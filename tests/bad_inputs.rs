@@ -2537,6 +2537,135 @@ fn cli_cases() -> Vec<Case> {
                 "a linear finite-element scene",
             ],
         ),
+        // theory area (the membrane under imposed projected area)
+        args(
+            "theory-area-strain-tension",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "-2e8",
+                "--elements",
+                "4",
+            ],
+            &["--strain-ratio", "got \"-2e8\"", "[-1e8, 0] (tension)"],
+        ),
+        args(
+            "theory-area-strain-compression",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0,1e4",
+                "--elements",
+                "4",
+            ],
+            &["--strain-ratio", "got \"1e4\"", "[0, 2.5e3]"],
+        ),
+        args(
+            "theory-area-no-law",
+            &["theory", "area", "--strain-ratio", "0"],
+            &["--elements/--cutoff", "got neither", "exactly one of"],
+        ),
+        args(
+            "theory-area-elements-large",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--elements",
+                "4,129",
+            ],
+            &["--elements", "got \"129\"", "[1, 128]"],
+        ),
+        args(
+            "theory-area-elements-periodic",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--boundary",
+                "periodic",
+                "--elements",
+                "1",
+            ],
+            &["--elements", "got \"1\"", "[2, 128]"],
+        ),
+        args(
+            "theory-area-cutoff-text",
+            &["theory", "area", "--strain-ratio", "0", "--cutoff", "x"],
+            &["--cutoff", "got \"x\"", "[2, 256]"],
+        ),
+        args(
+            "theory-area-bending-nan",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--cutoff",
+                "8",
+                "--bending-rigidity",
+                "nan",
+            ],
+            &["--bending-rigidity", "got NaN", "[1e-3, 1e6]"],
+        ),
+        args(
+            "theory-area-stretch-large",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--cutoff",
+                "8",
+                "--stretch-ratio",
+                "1e30",
+            ],
+            &["--stretch-ratio", "got 1e30", "[4e0, 4e14]"],
+        ),
+        args(
+            "theory-area-aspect",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--cutoff",
+                "8",
+                "--height",
+                "0.05",
+            ],
+            &["--height", "got 5e-2", "b/a in [0.1, 10]"],
+        ),
+        args(
+            "theory-area-width-zero",
+            &[
+                "theory",
+                "area",
+                "--strain-ratio",
+                "0",
+                "--cutoff",
+                "8",
+                "--width",
+                "0",
+            ],
+            &["--width", "got 0", "> 0"],
+        ),
+        args(
+            "theory-compression-tension-bound",
+            &[
+                "theory",
+                "compression",
+                "--dims",
+                "2",
+                "--strain-ratio",
+                "-1.5e8",
+            ],
+            &["--strain-ratio", "got \"-1.5e8\"", "[-1e8, 0] (tension)"],
+        ),
         // A scene file given to a study is validated like one given to verify.
         Case {
             name: "converge-bad-scene",
@@ -2642,9 +2771,12 @@ fn run_case(case: &Case, logs: &Path) -> (Vec<String>, Outcome) {
                 .collect()
         }
     };
-    argv.extend(["--out".into(), "out".into()]);
-    if !argv.iter().any(|a| a == "--scene-dir") {
-        argv.extend(["--scene-dir".into(), scene_dir]);
+    // `theory` writes no files and reads no scenes: it takes neither flag
+    if argv.first().is_none_or(|c| c != "theory") {
+        argv.extend(["--out".into(), "out".into()]);
+        if !argv.iter().any(|a| a == "--scene-dir") {
+            argv.extend(["--scene-dir".into(), scene_dir]);
+        }
     }
     let (out_log, err_log) = (
         logs.join(format!("{}.out", case.name)),

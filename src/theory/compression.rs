@@ -195,6 +195,32 @@
 //! evaluation) checks the exact tail in `tests/compression_theory.rs`: ⟨F⟩/F_c0 agree to
 //! ≤ 10⁻¹⁴ over ε/ε_c0 ∈ [0, 10] for EI/(kT·L) ∈ {10, 100, 1000} and
 //! EA·L/kT ∈ {10⁴, 10⁶, 10⁸}.
+//!
+//! # Tension
+//!
+//! Nothing above assumes ε > 0: for ε < ⟨s⟩₀ the saddle point is negative (a tension), the
+//! tilted law is narrow and the contour needs ≈ 500 mode evaluations at any tension. The
+//! CLI accepts `ε/ε_c0 ≥` [`MIN_STRAIN_RATIO`] `= −10⁸`. Two closed-form limits are tested
+//! (`tests/tension_theory.rs`): far in tension (continuum, `x = |⟨F⟩|/F_c0 ≫ 1`)
+//! `⟨F⟩ = EAε − (EA d kT/(4√(EI·EA|ε|)))(1 − 1/(π√|r|) + O(|r|^{−3/2}))`, `r = ε/ε_c0`,
+//! from `Σ_n 1/(n² + x) = (π√x coth π√x − 1)/(2x)`, with the exact force → mean field; and
+//! the inextensible entropic-stretching limit (large `S = EA·L/kT`, ε → 0⁺), where
+//! `⟨F⟩ → −(kT/L)(ln p₀)'(⟨s⟩)` and the Laplace form of p₀ gives
+//! `f = −⟨F⟩ = f₀(1 − (2 + 6/d)/(π√x₀) + O(1/x₀))`, `f₀ = (d kT/(4⟨s⟩))²/EI`,
+//! `x₀ = f₀/F_c0` (−2/(π√x₀) from the mean field's `−1/(2x)` term, −6/(πd√x₀) from the
+//! fluctuation term `ψ‴/(2ψ″²)` of the Laplace prefactor).
+//!
+//! # Other constrained objects
+//!
+//! Only three numbers of the filament enter the method: the stiffness EA of the constraint,
+//! the measure L (through `A = EA·L/(2kT)` and the force unit `kT/L`) and kT, plus the
+//! reference scales F_c0, ε_c0 of [`CompressionTheory::force_ratio`]. [`GlobalConstraint`]
+//! holds them; [`CompressionTheory::with_constraint`] builds the theory for any object
+//! whose stored measure `s` is a quadratic form `xᵀGx/(2X)` of Gaussian variables
+//! `x ~ N(0, kT K⁻¹)` and whose energy adds `(S·X/2)(s − ε)²`: the weights are
+//! `c_i = kT μ_i/(2X)` ([`StoredLengthLaw::from_weights`]). The fluid membrane under an
+//! imposed projected area is one ([`crate::fem::plate_area`]: `S = K_A`, `X = A₀`,
+//! `F = −σ`).
 
 use crate::error::{Error, Result};
 use crate::fem::{BeamModel, Mesh};

@@ -4,6 +4,8 @@
 //!   imposed end shortening (the paper's Fig. 2), its variance and its full equilibrium
 //!   distribution, exactly (no mean-field approximation), for the continuum and for the
 //!   Hermite-cubic discretization the simulator uses.
+//!   Its [`GlobalConstraint`] also serves the filament in tension and the membrane under
+//!   imposed projected area ([`crate::fem::plate_area`]).
 
 pub mod compression;
 
