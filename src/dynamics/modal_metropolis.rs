@@ -221,7 +221,7 @@ impl<'m> ModalMetropolis<'m> {
         dt: f64,
         rng: &mut TrajectoryRng,
     ) -> Result<Self> {
-        let kt = constraint.kt;
+        let kt = constraint.constraint.kt;
         let n = rates.len();
         let a: Vec<f64> = (0..nc)
             .flat_map(|_| rates.iter())
@@ -257,7 +257,7 @@ impl<'m> ModalMetropolis<'m> {
         };
         let mut cur = std::mem::take(&mut chain.current);
         chain.evaluate(&mut cur);
-        if cur.force > constraint.buckling_load
+        if cur.force > constraint.constraint.reference_load
             && !(chain.pairs.is_empty() && chain.groups.is_empty())
         {
             chain.start_buckled(&mut cur);
@@ -280,9 +280,9 @@ impl<'m> ModalMetropolis<'m> {
     /// The membrane's chain does the same with the first coordinate of its slowest block
     /// (`b01 x1` then stands for `Σ_{j>0} b0j x_j` over the block).
     fn start_buckled(&self, e: &mut Evaluation) {
-        let p = &self.constraint;
-        let target_two_l_s = 2.0 * p.measure * (p.strain - p.buckling_load / p.stiffness);
-        let two_l_s = 2.0 * p.measure * (p.strain - e.force / p.stiffness);
+        let (p, strain) = (&self.constraint.constraint, self.constraint.strain);
+        let target_two_l_s = 2.0 * p.measure * (strain - p.reference_load / p.stiffness);
+        let two_l_s = 2.0 * p.measure * (strain - e.force / p.stiffness);
         let (i0, b00, b01, x1) = match self.pairs.first() {
             Some(&[_, _, b00, b01, _]) => (0, b00, b01, e.a[1]),
             None => {

@@ -26,6 +26,7 @@ use super::plate::PlateModel;
 use super::vonkarman::GlobalStrain;
 use crate::error::{Error, Result};
 use crate::spectral::membrane::MembraneParams;
+use crate::theory::compression::GlobalConstraint;
 
 /// The membrane under imposed projected area on a uniform BFS mesh.
 #[derive(Debug, Clone)]
@@ -112,15 +113,20 @@ impl AreaMembrane {
         p.bending_rigidity * p.min_wavenumber_sq()
     }
 
-    /// The global constraint: S = K_A, ℓ = A₀, F = −σ, F_c0 = σ_c0.
+    /// The global constraint: S = K_A, ℓ = A₀, F = −σ, reference load σ_c0 and strain
+    /// ε_c0 = σ_c0/K_A.
     pub fn global_strain(&self) -> GlobalStrain {
         let p = self.plate.params();
+        let sigma_c0 = self.buckling_stress();
         GlobalStrain {
-            stiffness: self.area_modulus,
-            measure: p.area(),
+            constraint: GlobalConstraint {
+                stiffness: self.area_modulus,
+                measure: p.area(),
+                kt: p.kt,
+                reference_load: sigma_c0,
+                reference_strain: sigma_c0 / self.area_modulus,
+            },
             strain: self.strain,
-            kt: p.kt,
-            buckling_load: self.buckling_stress(),
         }
     }
 
@@ -157,7 +163,7 @@ mod tests {
             let m = AreaMembrane::new(p, 4, 4, 1e4, 0.01).unwrap();
             assert!((m.buckling_stress() - 20.0 * q2).abs() < 1e-12 * 20.0 * q2);
             assert!((m.tension(0.03) - 1e4 * 0.02).abs() < 1e-9);
-            assert_eq!(m.global_strain().measure, 1.0);
+            assert_eq!(m.global_strain().constraint.measure, 1.0);
         }
         let bad = MembraneParams {
             tension: 1.0,

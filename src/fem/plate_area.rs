@@ -171,6 +171,19 @@ impl AreaParams {
         self.constraint().map(|_| ())
     }
 
+    /// The parameters of the membrane `params` (its tension ignored: under imposed
+    /// projected area the tension is `K_A(s − ε)`) with area modulus `area_modulus`.
+    pub fn from_membrane(params: &MembraneParams, area_modulus: f64) -> Self {
+        AreaParams {
+            bending_rigidity: params.bending_rigidity,
+            area_modulus,
+            kt: params.kt,
+            width: params.width,
+            height: params.height,
+            boundary: params.boundary,
+        }
+    }
+
     /// True area `A₀ = a·b`.
     pub fn area(&self) -> f64 {
         self.width * self.height

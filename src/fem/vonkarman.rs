@@ -25,48 +25,44 @@
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
 use crate::fem::hermite::geometric_matrix;
+use crate::theory::compression::GlobalConstraint;
 
-/// The global constraint shared by the von Kármán filament and the membrane under imposed
-/// projected area (issue #28): with the bending energy `½ xᵀK x` and the normalized
-/// quadratic excess `s = xᵀG x/(2ℓ)` (stored length per length, or excess area per area),
+/// The global constraint at an imposed strain, shared by the von Kármán filament and the
+/// membrane under imposed projected area (issue #28): with the bending energy `½ xᵀK x`
+/// and the normalized quadratic excess `s = xᵀG x/(2ℓ)` (stored length per length, or
+/// excess area per area),
 ///
 /// ```text
 /// U = ½ xᵀK x + (S·ℓ/2)(s − ε)²,   F = S(ε − s),   −∂U/∂x = −K x + F G x,
 /// ```
 ///
-/// with the stiffness S (EA, or the area modulus K_A), the measure ℓ (L, or A₀) and the
-/// imposed strain ε (Δ/L, or `1 − A_p/A₀`). F is the compressive force (filament) or the
-/// compressive stress `−σ` (membrane); the exact equilibrium theory of both is
-/// [`crate::theory::compression`].
+/// with the constraint's stiffness S (EA, or the area modulus K_A) and measure ℓ (L, or
+/// A₀) ([`GlobalConstraint`], the same parameters as the exact theory's) and the imposed
+/// strain ε (Δ/L, or `1 − A_p/A₀`). F is the compressive force (filament) or the
+/// compressive stress `−σ` (membrane).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GlobalStrain {
-    /// S: EA, or K_A.
-    pub stiffness: f64,
-    /// ℓ: L, or A₀.
-    pub measure: f64,
+    /// S, ℓ, kT and the reference load (F_c0 or σ_c0).
+    pub constraint: GlobalConstraint,
     /// Imposed strain ε (compression positive).
     pub strain: f64,
-    /// Thermal energy kT.
-    pub kt: f64,
-    /// The continuum's buckling load F_c0 = π²EI/L², or stress σ_c0 = κq²_min.
-    pub buckling_load: f64,
 }
 
 impl GlobalStrain {
     /// `s` from `2ℓs = xᵀG x`.
     pub fn excess(&self, two_l_s: f64) -> f64 {
-        two_l_s / (2.0 * self.measure)
+        two_l_s / (2.0 * self.constraint.measure)
     }
 
     /// `F = S(ε − s)`.
     pub fn force(&self, s: f64) -> f64 {
-        self.stiffness * (self.strain - s)
+        self.constraint.stiffness * (self.strain - s)
     }
 
     /// The constraint's energy `(S·ℓ/2)(s − ε)²`.
     pub fn energy(&self, s: f64) -> f64 {
-        let d = s - self.strain;
-        0.5 * self.stiffness * self.measure * d * d
+        let (c, d) = (&self.constraint, s - self.strain);
+        0.5 * c.stiffness * c.measure * d * d
     }
 }
 
@@ -126,11 +122,14 @@ impl CompressedFilament {
     pub fn global_strain(&self) -> GlobalStrain {
         let p = self.beam.params();
         GlobalStrain {
-            stiffness: p.stretch_rigidity,
-            measure: p.length,
+            constraint: GlobalConstraint {
+                stiffness: p.stretch_rigidity,
+                measure: p.length,
+                kt: p.kt,
+                reference_load: p.euler_load(),
+                reference_strain: p.euler_strain(),
+            },
             strain: self.strain,
-            kt: p.kt,
-            buckling_load: p.euler_load(),
         }
     }
 

@@ -110,20 +110,14 @@ fn theories(
             CompressionTheory::new(&p, StoredLengthLaw::continuum(&p, dims, CONTINUUM_MODES)?)?;
         return Ok((disc, cont));
     };
-    let params = AreaParams {
-        bending_rigidity: mp.bending_rigidity,
-        area_modulus: spec.area_modulus.ok_or_else(|| {
-            Error::invalid(
-                "compression.area_modulus",
-                "nothing",
-                "the area modulus K_A",
-            )
-        })?,
-        kt: mp.kt,
-        width: mp.width,
-        height: mp.height,
-        boundary: mp.boundary,
-    };
+    let k_a = spec.area_modulus.ok_or_else(|| {
+        Error::invalid(
+            "compression.area_modulus",
+            "nothing",
+            "the area modulus K_A",
+        )
+    })?;
+    let params = AreaParams::from_membrane(&mp, k_a);
     let (nx, ny) = (scene.mesh.elements, scene.mesh.elements_along_y());
     let disc = AreaTheory::discrete(&params, nx, ny)?;
     let cont = AreaTheory::continuum(&params, AreaCutoff::Lattice { nx, ny })?;

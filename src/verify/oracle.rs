@@ -427,14 +427,7 @@ fn area_oracle(
     use crate::fem::plate_area::{AreaCutoff, AreaParams, AreaTheory};
     use crate::spectral::membrane::MembraneBoundary;
     let mut o = Oracle::default();
-    let params = AreaParams {
-        bending_rigidity: mp.bending_rigidity,
-        area_modulus: spec.area_modulus.unwrap_or(f64::NAN),
-        kt: mp.kt,
-        width: mp.width,
-        height: mp.height,
-        boundary: mp.boundary,
-    };
+    let params = AreaParams::from_membrane(&mp, spec.area_modulus.unwrap_or(f64::NAN));
     let (nx, ny) = (scene.mesh.elements, scene.mesh.elements_along_y());
     let cont = AreaTheory::continuum(&params, AreaCutoff::Lattice { nx, ny })?;
     let disc = AreaTheory::discrete(&params, nx, ny)?;
