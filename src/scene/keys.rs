@@ -436,6 +436,14 @@ pub const KEYS: &[KeyDoc] = &[
         "Compression scenes: the runs [at Δt, at Δt/2] compared by the dt-halving check.",
     ),
     key(
+        "compression.area_modulus",
+        "energy/area",
+        "in [1e-30, 1e30]; required with a [membrane] table (whose tension must be 0), refused with a filament",
+        "none",
+        closed(1e-30, 1e30),
+        "Compression scenes of a membrane under imposed projected area (issue #28): the area modulus K_A. The strains are 1 − A_p/A₀ in units of ε_c0 = κq²_min/K_A, the recorded value the compressive stress −σ/σ_c0.",
+    ),
+    key(
         "runs[].name",
         "-",
         "non-empty [A-Za-z0-9_-], at most 64 characters, unique within the scene",
@@ -825,11 +833,17 @@ mod tests {
             "membrane-pbc",
             include_str!("../../tests/scenes/good/membrane-pbc.toml"),
         ),
+        (
+            "membrane-area-stiff",
+            include_str!("../../verification/membrane-area-stiff.toml"),
+        ),
     ];
 
     /// Whether `pattern` is a key of membrane scenes only (probed in [`MEMBRANES`]).
     fn membrane_key(pattern: &str) -> bool {
-        pattern.starts_with("membrane.") || pattern == "mesh.elements_y"
+        pattern.starts_with("membrane.")
+            || pattern == "mesh.elements_y"
+            || pattern == "compression.area_modulus"
     }
 
     /// Every scene the tests know, as (name, text, the scene): the built-in ones, then
