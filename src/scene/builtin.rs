@@ -82,6 +82,7 @@ pub const BUILTIN: &[BuiltinScene] = &[
     builtin!("membrane-periodic"),
     builtin!("membrane-spectral"),
     builtin!("spectral-reference"),
+    builtin!("tension-2d"),
     builtin!(extreme "compression-floppy-2d"),
     builtin!(extreme "compression-stiff-ea-2d"),
     builtin!(extreme "compression-stiff-ea-explicit-2d"),
@@ -341,7 +342,8 @@ mod tests {
                 "membrane-hinged",
                 "membrane-periodic",
                 "membrane-spectral",
-                "spectral-reference"
+                "spectral-reference",
+                "tension-2d"
             ]
         );
     }

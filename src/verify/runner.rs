@@ -497,14 +497,19 @@ fn run_compression_scene(
             dir.join(format!("{}-force-strain.csv", run.spec.name))
         };
         outputs.write_table(path, &FORCE_STRAIN_HEADER, &rows)?;
-        points.push(
-            Series::markers(
-                format!("simulated: {} (±1 s.e.)", run.spec.name),
-                rows.iter().map(|r| (r[0], r[1])).collect(),
-            )
-            .with_errors(rows.iter().map(|r| r[2]).collect()),
-        );
-        if k == 0 {
+        let markers = Series::markers(
+            format!("simulated: {} (±1 s.e.)", run.spec.name),
+            rows.iter().map(|r| (r[0], r[1])).collect(),
+        )
+        .with_errors(rows.iter().map(|r| r[2]).collect());
+        // The tension figure has two more reference curves before the points: the points
+        // keep palette colours 2, 3, … (a compression figure's by their index).
+        points.push(if theory.reaches_tension() {
+            markers.palette(2 + k)
+        } else {
+            markers
+        });
+        if k == 0 && !theory.reaches_tension() {
             curves.retain(|c| c.dims != scene.dims);
             curves.push(Curve {
                 dims: scene.dims,
@@ -525,8 +530,12 @@ fn run_compression_scene(
         .into_iter()
         .fold(force_strain_figure(scene, theory), Figure::series);
     outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
-    let fig2 = fig2_figure(curves);
-    outputs.write_figure(&fig2, opts.out.join("fig2.svg"))?;
+    // The paper's Fig. 2 is the filament under imposed compression: a scene reaching into
+    // tension has its own figure only.
+    if !theory.reaches_tension() {
+        let fig2 = fig2_figure(curves);
+        outputs.write_figure(&fig2, opts.out.join("fig2.svg"))?;
+    }
     let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((what, slope)) = largest_slope {
         add_slope_status(scene, &mut summary, &what, slope);
@@ -903,8 +912,12 @@ const STRAIN_LABEL: &str = "imposed strain ε / ε_c0 (Euler strain)";
 const FORCE_LABEL: &str = "⟨F⟩ / F_c0 (Euler load)";
 
 /// The scene's force–strain figure with the exact theory; runs add their points (in
-/// palette colours 2, 3, …).
+/// palette colours 2, 3, …). A scene reaching into tension gets
+/// [`tension_force_strain_figure`] instead.
 fn force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure {
+    if theory.reaches_tension() {
+        return tension_force_strain_figure(scene, theory);
+    }
     Figure::new(
         format!("{}: mean force against imposed strain", scene.name),
         STRAIN_LABEL,
@@ -929,6 +942,67 @@ fn force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure
          black line is the Euler load. The markers should lie on the solid line within \
          their error bars; a systematic offset is a sampling, integrator or force-estimator \
          error.",
+    )
+}
+
+/// The force–strain figure of a scene whose strains reach into tension (negative ⟨F⟩ is
+/// a tension): the exact curves as in [`force_strain_figure`], and the two limits they
+/// interpolate between: the Gaussian mean field of the discretized filament (accurate in
+/// tension, never above the buckling load) and the athermal rod, `F = EA·ε` up to the
+/// Euler load and `F_c0` beyond (the distance below it is the thermal stored length,
+/// `EA·⟨s⟩`). Runs add their points (palette colours 2, 3, …; the mean field is drawn in
+/// purple, palette colour 4's, which a scene with at most two runs leaves free).
+fn tension_force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure {
+    let (lo, hi) = (
+        theory.curve.first().map_or(0.0, |c| c.0),
+        theory.curve.last().map_or(0.0, |c| c.0),
+    );
+    let mut athermal = vec![(lo, lo.min(1.0))];
+    if lo < 1.0 && hi > 1.0 {
+        athermal.push((1.0, 1.0));
+    }
+    athermal.push((hi, hi.min(1.0)));
+    Figure::new(
+        format!("{}: mean force from tension through buckling", scene.name),
+        STRAIN_LABEL,
+        "⟨F⟩ / F_c0 (Euler load; negative: tension)",
+    )
+    .series(Series::line(
+        "exact, discretized filament",
+        theory.curve.iter().map(|c| (c.0, c.1)).collect(),
+    ))
+    .series(
+        Series::line(
+            "exact, continuum",
+            theory.curve.iter().map(|c| (c.0, c.2)).collect(),
+        )
+        .dashed(),
+    )
+    .series(
+        Series::line(
+            "Gaussian mean field, discretized (not exact)",
+            theory
+                .curve
+                .iter()
+                .zip(&theory.mean_field)
+                .map(|(c, m)| (c.0, m.0))
+                .collect(),
+        )
+        .dashed()
+        .rgb(148, 103, 189),
+    )
+    .series(Series::line("athermal rod: EA ε up to F_c0", athermal).rgb(140, 140, 140))
+    .hline(1.0, "Euler load F_c0")
+    .caption(
+        "Mean force ⟨F⟩/F_c0 from tension (negative) through buckling against the imposed \
+         strain ε/ε_c0, simulated per run (markers, ±1 s.e.) against the exact equilibrium \
+         force of the discretized filament (solid line) and of the continuum (dashed line); \
+         the Gaussian mean field (purple, dashed) and the athermal rod (grey: F = EA ε up to \
+         the Euler load, then F_c0) for comparison; the dashed black line is the Euler load. \
+         The markers should lie on the solid line within their error bars. The vertical \
+         distance below the grey line is the thermal stored length EA⟨s⟩: pulled out in \
+         tension, where the mean field is accurate; past the Euler strain the 2D force \
+         rises above F_c0, which the mean field never does.",
     )
 }
 
