@@ -38,7 +38,9 @@
 //!   and `.svg` and a note, written right after the outputs of the first such run;
 //! - a compression scene: `force-strain.csv` (first run), `<run>-force-strain.csv` (other
 //!   runs), `force-strain.svg`, and `fig2.svg` under `--out` with the first run of every
-//!   compression scene so far (one per dimension).
+//!   compression scene so far (one per dimension) whose strains are all ≥ 0 (the paper's
+//!   Fig. 2 is imposed compression; a scene reaching into tension writes no `fig2.svg`,
+//!   and its `force-strain.svg` adds the Gaussian mean field and the athermal rod).
 //!
 //! Every figure has axis labels with units and a caption, listed beside it in
 //! `summary.json` (`captions`, parallel to `figures`) and written into the SVG as its
@@ -497,18 +499,12 @@ fn run_compression_scene(
             dir.join(format!("{}-force-strain.csv", run.spec.name))
         };
         outputs.write_table(path, &FORCE_STRAIN_HEADER, &rows)?;
-        let markers = Series::markers(
+        points.push(force_points(
             format!("simulated: {} (±1 s.e.)", run.spec.name),
-            rows.iter().map(|r| (r[0], r[1])).collect(),
-        )
-        .with_errors(rows.iter().map(|r| r[2]).collect());
-        // The tension figure has two more reference curves before the points: the points
-        // keep palette colours 2, 3, … (a compression figure's by their index).
-        points.push(if theory.reaches_tension() {
-            markers.palette(2 + k)
-        } else {
-            markers
-        });
+            &rows,
+            k,
+            theory,
+        ));
         if k == 0 && !theory.reaches_tension() {
             curves.retain(|c| c.dims != scene.dims);
             curves.push(Curve {
@@ -904,6 +900,25 @@ fn force_strain_rows(theory: &CompressionTheoryTable, est: &ForceEstimates) -> V
             ]
         })
         .collect()
+}
+
+/// The points of run `k` (rows of `force-strain.csv`) in a force–strain figure: markers
+/// with ±1 s.e. bars. The tension figure ([`tension_force_strain_figure`]) has two more
+/// reference curves before the points, so there they keep palette colours 2, 3, … by
+/// `k`; a compression figure's take theirs from their index (the same colours).
+fn force_points(
+    label: String,
+    rows: &[Vec<f64>],
+    k: usize,
+    theory: &CompressionTheoryTable,
+) -> Series {
+    let markers = Series::markers(label, rows.iter().map(|r| (r[0], r[1])).collect())
+        .with_errors(rows.iter().map(|r| r[2]).collect());
+    if theory.reaches_tension() {
+        markers.palette(2 + k)
+    } else {
+        markers
+    }
 }
 
 /// Label of the imposed-strain axis of the force–strain figures.
@@ -1326,7 +1341,7 @@ fn check_compression_data(
     let mut outputs = SceneOutputs::new(scene, &report);
     outputs.notes.push(data_note(sidecar, data_dir));
     let mut fig: Option<Figure> = None;
-    for c in &checks {
+    for (k, c) in checks.iter().enumerate() {
         let name = &c.run.spec.name;
         outputs.runs.push(name.clone());
         let failed = |e: Error| {
@@ -1355,15 +1370,12 @@ fn check_compression_data(
         let f = fig
             .take()
             .unwrap_or_else(|| force_strain_figure(scene, &c.theory));
-        fig = Some(
-            f.series(
-                Series::markers(
-                    format!("data: {name} (±1 s.e.)"),
-                    rows.iter().map(|r| (r[0], r[1])).collect(),
-                )
-                .with_errors(rows.iter().map(|r| r[2]).collect()),
-            ),
-        );
+        fig = Some(f.series(force_points(
+            format!("data: {name} (±1 s.e.)"),
+            &rows,
+            k,
+            &c.theory,
+        )));
     }
     if let Some(f) = fig {
         outputs.write_figure(&f, dir.join("force-strain.svg"))?;
