@@ -134,7 +134,8 @@ bench:
 # and size, verified at POWER_SEEDS fixed seeds at the quick budget; detection rates with
 # Clopper-Pearson intervals in $(POWER_OUT)/power.{csv,json,md}. Builds with
 # `--features faults`, which replaces target/release/langevin-fem by the faults build (a
-# later `make verify` or `make build` relinks it without). About 25 min on 2 cores.
+# later `make verify` or `make build` relinks it without). About 30 min on 2 cores (the
+# tension-2d targets, added with issue #28, about 4 of them).
 POWER_OUT   ?= $(OUT)/power
 POWER_SEEDS ?= 20
 power:
