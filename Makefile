@@ -50,10 +50,10 @@ verify: build
 # (seed k = 1 + k, each exactly `verify --scene S --seed <seed>`): the false-alarm rate
 # per scene with its exact binomial interval against alpha, and the uniformity of the
 # checks' p-values per check kind (KS, Holm), in $(OUT)/calibration/. Exit 1 if a scene's
-# rate is above alpha or a kind's p-values are not uniform. About 21 s per seed at the
-# quick budget on 2 cores (35 min for 100 seeds).
+# rate is above alpha or a kind's p-values are not uniform. About 22 s per seed at the
+# quick budget on 2 cores (37 min for 100 seeds).
 SEEDS ?= 100
-CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference
+CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference tension-2d
 calibrate: build
 	$(BIN) calibrate $(foreach s,$(CALIBRATION_SCENES),--scene $(s)) --seeds $(SEEDS) --budget $(BUDGET) --out $(OUT)/calibration
 
@@ -88,9 +88,12 @@ docs-check: numpy-venv
 # src/scene/keys.rs (a test in tests/docs.rs fails when the committed page differs from
 # it), every `--help` block of the commands page (docs/dev/refresh_help.py; the docs test
 # fails when one drifts), and the paper's Fig. 2 shown by the README (fig2-shards, part of `make test`,
-# fails when the committed figure differs from the full-budget run's, byte for byte).
+# fails when the committed figure differs from the full-budget run's, byte for byte), and the
+# README's filament from tension through buckling (tension-2d at the full budget, about 2 s; a
+# test in tests/docs.rs fails when the committed figure differs from that run's, byte for byte).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
 FIG2_IMAGE      = docs/src/images/fig2.svg
+TENSION_IMAGE   = docs/src/images/tension-2d.svg
 docs: build
 	$(BIN) scene keys --format markdown > $(SCENE_KEYS_PAGE).tmp
 	mv $(SCENE_KEYS_PAGE).tmp $(SCENE_KEYS_PAGE)
@@ -98,6 +101,8 @@ docs: build
 	$(BIN) verify -q $(FIG2_ARGS) --out target/docs-fig2
 	mkdir -p $(dir $(FIG2_IMAGE))
 	cp target/docs-fig2/fig2.svg $(FIG2_IMAGE)
+	$(BIN) verify -q --scene tension-2d --budget full --out target/docs-tension
+	cp target/docs-tension/tension-2d/force-strain.svg $(TENSION_IMAGE)
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered
@@ -129,7 +134,8 @@ bench:
 # and size, verified at POWER_SEEDS fixed seeds at the quick budget; detection rates with
 # Clopper-Pearson intervals in $(POWER_OUT)/power.{csv,json,md}. Builds with
 # `--features faults`, which replaces target/release/langevin-fem by the faults build (a
-# later `make verify` or `make build` relinks it without). About 25 min on 2 cores.
+# later `make verify` or `make build` relinks it without). About 30 min on 2 cores (the
+# tension-2d targets, added with issue #28, about 4 of them).
 POWER_OUT   ?= $(OUT)/power
 POWER_SEEDS ?= 20
 power:

@@ -1,7 +1,8 @@
 //! The guide runs as shown (issue #26): every command line of `README.md` and
 //! `docs/src/**/*.md` is executed and its output and exit code checked, so that a page
-//! that drifts from the program fails `make test`; and the generated page of scene keys
-//! equals its generator's output.
+//! that drifts from the program fails `make test`; the generated page of scene keys
+//! equals its generator's output; and the README's figure of the filament from tension
+//! through buckling is the full-budget run's.
 //!
 //! What: the runner itself first (the matcher on known input, the parser, fixture pages
 //! under `tests/docs-fixtures/` that must pass or must be rejected, a timeout), then every
@@ -57,6 +58,11 @@ const COMMAND_TIMEOUT: Duration = Duration::from_secs(120);
 /// The generated page of scene keys and its generator's arguments.
 const SCENE_KEYS_PAGE: &str = "docs/src/reference/scene-keys.md";
 const SCENE_KEYS_ARGS: &[&str] = &["scene", "keys", "--format", "markdown"];
+
+/// The README's figure of the filament from tension through buckling, and the run that
+/// writes it (as `tension-2d/force-strain.svg` under `--out`; `make docs` copies it).
+const TENSION_IMAGE: &str = "docs/src/images/tension-2d.svg";
+const TENSION_ARGS: &[&str] = &["verify", "-q", "--scene", "tension-2d", "--budget", "full"];
 
 /// The environment variable naming a Python with NumPy, for the `numpy` blocks.
 const PYTHON_VAR: &str = "LANGEVIN_FEM_PYTHON";
@@ -646,4 +652,27 @@ fn scene_key_page_is_generated() {
             g.get(i)
         );
     }
+}
+
+/// What: the committed figure of the filament from tension through buckling (README,
+/// `docs/src/images/tension-2d.svg`) is byte for byte the figure that `langevin-fem verify
+/// --scene tension-2d --budget full` writes (about 2 s), as `fig2-shards` holds Fig. 2 to
+/// its run; else `make docs` is the fix.
+#[test]
+fn tension_figure_is_the_full_budget_run() {
+    let dir = common::TempDir::new("docs-tension");
+    let out = dir.path().display().to_string();
+    let mut args = TENSION_ARGS.to_vec();
+    args.extend(["--out", &out]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let generated = std::fs::read(dir.join("tension-2d/force-strain.svg")).unwrap();
+    let committed = std::fs::read(manifest_dir().join(TENSION_IMAGE))
+        .unwrap_or_else(|e| panic!("{TENSION_IMAGE}: {e}: run `make docs` to write it"));
+    assert!(
+        committed == generated,
+        "{TENSION_IMAGE} differs from the figure of `langevin-fem {}`: run `make docs` and \
+         commit it",
+        TENSION_ARGS.join(" ")
+    );
 }

@@ -65,6 +65,7 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
             t("spectral-reference", ALL),
             t("compression-2d", ALL),
             t("compression-3d", ALL),
+            t("tension-2d", ALL),
             t("membrane-hinged", CN),
             t("membrane-periodic", CN),
             t("membrane-spectral", ALL),
@@ -80,9 +81,11 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
         | FaultKind::IntegratorHinge
         | FaultKind::ComponentNoiseSharing
         | FaultKind::SharedHinge => vec![t("hinged-linear-3d", CN)],
+        // The stretch rigidity matters most in tension (F ≈ EA·ε there): tension-2d.
         FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
             vec![
                 t("compression-2d", ALL),
+                t("tension-2d", ALL),
                 t("membrane-area-soft", ALL),
                 t("membrane-area-stiff", ALL),
             ]

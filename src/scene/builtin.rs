@@ -84,6 +84,7 @@ pub const BUILTIN: &[BuiltinScene] = &[
     builtin!("membrane-periodic"),
     builtin!("membrane-spectral"),
     builtin!("spectral-reference"),
+    builtin!("tension-2d"),
     builtin!(extreme "compression-floppy-2d"),
     builtin!(extreme "compression-stiff-ea-2d"),
     builtin!(extreme "compression-stiff-ea-explicit-2d"),
@@ -345,7 +346,8 @@ mod tests {
                 "membrane-hinged",
                 "membrane-periodic",
                 "membrane-spectral",
-                "spectral-reference"
+                "spectral-reference",
+                "tension-2d"
             ]
         );
     }

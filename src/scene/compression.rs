@@ -39,6 +39,11 @@ pub struct CompressionTheoryTable {
     pub distributions: Vec<Option<ForceDistribution>>,
     /// The exact curves on a fine grid for figures: (ε/ε_c0, discrete, continuum).
     pub curve: Vec<(f64, f64, f64)>,
+    /// The Gaussian mean-field force ⟨F⟩/F_c0 ([`CompressionTheory::mean_field_force`],
+    /// not exact) at the strains of `curve`, (discretized filament, continuum): the
+    /// textbook approximation, accurate in tension, below the buckling load at every
+    /// strain.
+    pub mean_field: Vec<(f64, f64)>,
 }
 
 /// Points of the fine theory curve drawn in the figures.
@@ -75,10 +80,19 @@ impl CompressionTheoryTable {
             .iter()
             .copied()
             .fold(f64::NEG_INFINITY, f64::max);
-        let curve = (0..CURVE_POINTS)
+        let curve: Vec<(f64, f64, f64)> = (0..CURVE_POINTS)
             .map(|k| {
                 let r = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
                 Ok((r, disc.force_ratio(r)?, cont.force_ratio(r)?))
+            })
+            .collect::<Result<_>>()?;
+        let mean_field = curve
+            .iter()
+            .map(|c| {
+                let e = c.0 * strain_unit;
+                let load = disc.constraint().reference_load;
+                let f = |t: &CompressionTheory| Ok(t.mean_field_force(e)? / load);
+                Ok((f(&disc)?, f(&cont)?))
             })
             .collect::<Result<_>>()?;
         Ok(CompressionTheoryTable {
@@ -87,7 +101,15 @@ impl CompressionTheoryTable {
             continuum,
             distributions,
             curve,
+            mean_field,
         })
+    }
+
+    /// Whether the strains reach into tension (a negative ratio): the scene's force–strain
+    /// figure then also draws the Gaussian mean field and the athermal rod, and the scene
+    /// stays out of the paper's Fig. 2 (imposed compression, `fig2.svg`).
+    pub fn reaches_tension(&self) -> bool {
+        self.strain_ratios.iter().any(|&r| r < 0.0)
     }
 }
 

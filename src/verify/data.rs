@@ -1003,6 +1003,9 @@ fn compression_data_check(
             for c in &mut theory.curve {
                 c.1 = c.2;
             }
+            for m in &mut theory.mean_field {
+                m.0 = m.1;
+            }
             theory.distributions.iter_mut().for_each(|d| *d = None);
             notes.push(format!(
                 "run {name}: references: the continuum theory (the producer's discretization is not this tool's finite elements); the distribution of F is not checked (its exact law is known for the discretized filament only)"

@@ -588,7 +588,7 @@ mod tests {
     /// of another mesh (a stored length off by the wrong δ) fails it.
     #[test]
     fn compression_theory_against_the_continuum() {
-        for name in ["compression-2d", "compression-3d"] {
+        for name in ["compression-2d", "compression-3d", "tension-2d"] {
             for ne in [5, 10, 20] {
                 let sc = scene(name, ne);
                 let o = compression_oracle(&sc, sc.compression.as_ref().unwrap()).unwrap();

@@ -38,7 +38,9 @@
 //!   and `.svg` and a note, written right after the outputs of the first such run;
 //! - a compression scene: `force-strain.csv` (first run), `<run>-force-strain.csv` (other
 //!   runs), `force-strain.svg`, and `fig2.svg` under `--out` with the first run of every
-//!   compression scene so far (one per dimension).
+//!   compression scene so far (one per dimension) whose strains are all ≥ 0 (the paper's
+//!   Fig. 2 is imposed compression; a scene reaching into tension writes no `fig2.svg`,
+//!   and its `force-strain.svg` adds the Gaussian mean field and the athermal rod).
 //!
 //! Every figure has axis labels with units and a caption, listed beside it in
 //! `summary.json` (`captions`, parallel to `figures`) and written into the SVG as its
@@ -497,14 +499,13 @@ fn run_compression_scene(
             dir.join(format!("{}-force-strain.csv", run.spec.name))
         };
         outputs.write_table(path, &FORCE_STRAIN_HEADER, &rows)?;
-        points.push(
-            Series::markers(
-                format!("simulated: {} (±1 s.e.)", run.spec.name),
-                rows.iter().map(|r| (r[0], r[1])).collect(),
-            )
-            .with_errors(rows.iter().map(|r| r[2]).collect()),
-        );
-        if k == 0 {
+        points.push(force_points(
+            format!("simulated: {} (±1 s.e.)", run.spec.name),
+            &rows,
+            k,
+            theory,
+        ));
+        if k == 0 && !theory.reaches_tension() {
             curves.retain(|c| c.dims != scene.dims);
             curves.push(Curve {
                 dims: scene.dims,
@@ -525,8 +526,12 @@ fn run_compression_scene(
         .into_iter()
         .fold(force_strain_figure(scene, theory), Figure::series);
     outputs.write_figure(&fig, dir.join("force-strain.svg"))?;
-    let fig2 = fig2_figure(curves);
-    outputs.write_figure(&fig2, opts.out.join("fig2.svg"))?;
+    // The paper's Fig. 2 is the filament under imposed compression: a scene reaching into
+    // tension has its own figure only.
+    if !theory.reaches_tension() {
+        let fig2 = fig2_figure(curves);
+        outputs.write_figure(&fig2, opts.out.join("fig2.svg"))?;
+    }
     let mut summary = finish_scene(scene, outputs, start, opts.alpha, &opts.out)?;
     if let Some((what, slope)) = largest_slope {
         add_slope_status(scene, &mut summary, &what, slope);
@@ -897,14 +902,37 @@ fn force_strain_rows(theory: &CompressionTheoryTable, est: &ForceEstimates) -> V
         .collect()
 }
 
+/// The points of run `k` (rows of `force-strain.csv`) in a force–strain figure: markers
+/// with ±1 s.e. bars. The tension figure ([`tension_force_strain_figure`]) has two more
+/// reference curves before the points, so there they keep palette colours 2, 3, … by
+/// `k`; a compression figure's take theirs from their index (the same colours).
+fn force_points(
+    label: String,
+    rows: &[Vec<f64>],
+    k: usize,
+    theory: &CompressionTheoryTable,
+) -> Series {
+    let markers = Series::markers(label, rows.iter().map(|r| (r[0], r[1])).collect())
+        .with_errors(rows.iter().map(|r| r[2]).collect());
+    if theory.reaches_tension() {
+        markers.palette(2 + k)
+    } else {
+        markers
+    }
+}
+
 /// Label of the imposed-strain axis of the force–strain figures.
 const STRAIN_LABEL: &str = "imposed strain ε / ε_c0 (Euler strain)";
 /// Label of the force axis of the force–strain figures.
 const FORCE_LABEL: &str = "⟨F⟩ / F_c0 (Euler load)";
 
 /// The scene's force–strain figure with the exact theory; runs add their points (in
-/// palette colours 2, 3, …).
+/// palette colours 2, 3, …). A scene reaching into tension gets
+/// [`tension_force_strain_figure`] instead.
 fn force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure {
+    if theory.reaches_tension() {
+        return tension_force_strain_figure(scene, theory);
+    }
     Figure::new(
         format!("{}: mean force against imposed strain", scene.name),
         STRAIN_LABEL,
@@ -930,6 +958,110 @@ fn force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure
          their error bars; a systematic offset is a sampling, integrator or force-estimator \
          error.",
     )
+}
+
+/// What the force–strain figure of a scene reaching into tension says: the filament's
+/// force or the membrane's stress.
+struct TensionWording {
+    title: &'static str,
+    x: &'static str,
+    y: &'static str,
+    discrete: &'static str,
+    athermal: &'static str,
+    load: &'static str,
+    caption: &'static str,
+}
+
+/// The filament's [`TensionWording`].
+const FILAMENT_TENSION: TensionWording = TensionWording {
+    title: "mean force from tension through buckling",
+    x: STRAIN_LABEL,
+    y: "⟨F⟩ / F_c0 (Euler load; negative: tension)",
+    discrete: "exact, discretized filament",
+    athermal: "athermal rod: EA ε up to F_c0",
+    load: "Euler load F_c0",
+    caption: "Mean force ⟨F⟩/F_c0 from tension (negative) through buckling against the imposed \
+         strain ε/ε_c0, simulated per run (markers, ±1 s.e.) against the exact equilibrium \
+         force of the discretized filament (solid line) and of the continuum (dashed line); \
+         the Gaussian mean field (purple, dashed) and the athermal rod (grey: F = EA ε up to \
+         the Euler load, then F_c0) for comparison; the dashed black line is the Euler load. \
+         The markers should lie on the solid line within their error bars. The vertical \
+         distance below the grey line is the thermal stored length EA⟨s⟩: pulled out in \
+         tension, where the mean field is accurate; past the Euler strain the 2D force \
+         rises above F_c0, which the mean field never does.",
+};
+
+/// The membrane's [`TensionWording`] (imposed projected area, issue #28).
+const MEMBRANE_TENSION: TensionWording = TensionWording {
+    title: "mean tension against imposed projected area",
+    x: "imposed area strain ε / ε_c0 (ε = 1 − A_p/A₀, ε_c0 = σ_c0/K_A)",
+    y: "−⟨σ⟩ / σ_c0 (compressive stress; negative: tension)",
+    discrete: "exact, discretized membrane (BFS mesh)",
+    athermal: "athermal membrane: K_A ε up to σ_c0",
+    load: "buckling stress σ_c0 = κ q²_min",
+    caption: "Mean compressive stress −⟨σ⟩/σ_c0 (negative: the membrane is under tension) \
+         against the imposed area strain ε/ε_c0, ε = 1 − A_p/A₀, simulated per run (markers, \
+         ±1 s.e.) against the exact equilibrium of the discretized membrane (solid line) and \
+         of the continuum at the mesh's mode cutoff (dashed line); the Gaussian mean field \
+         (purple, dashed) and the athermal membrane (grey: K_A ε up to the buckling stress \
+         σ_c0 = κq²_min, then σ_c0) for comparison; the dashed black line is σ_c0. The \
+         markers should lie on the solid line within their error bars. The vertical distance \
+         below the grey line is K_A times the thermal excess area ⟨ΔA⟩/A₀: it keeps a soft \
+         membrane under tension well past ε_c0, and it grows with the mode cutoff \
+         (Helfrich–Servuss), so the continuum curve depends on the mesh — physics, not \
+         discretization error.",
+};
+
+/// The force–strain figure of a scene whose strains reach into tension (negative ⟨F⟩ is
+/// a tension): the exact curves as in [`force_strain_figure`], and the two limits they
+/// interpolate between: the Gaussian mean field of the discretized object (accurate in
+/// tension, never above the buckling load) and the athermal object, `F = S·ε` up to the
+/// buckling load and the load beyond (the distance below it is the thermal stored length
+/// or area, `S·⟨s⟩`). Runs add their points (palette colours 2, 3, …; the mean field is
+/// drawn in purple, palette colour 4's, which a scene with at most two runs leaves free).
+fn tension_force_strain_figure(scene: &Scene, theory: &CompressionTheoryTable) -> Figure {
+    let w = if scene.is_membrane() {
+        &MEMBRANE_TENSION
+    } else {
+        &FILAMENT_TENSION
+    };
+    let (lo, hi) = (
+        theory.curve.first().map_or(0.0, |c| c.0),
+        theory.curve.last().map_or(0.0, |c| c.0),
+    );
+    let mut athermal = vec![(lo, lo.min(1.0))];
+    if lo < 1.0 && hi > 1.0 {
+        athermal.push((1.0, 1.0));
+    }
+    athermal.push((hi, hi.min(1.0)));
+    Figure::new(format!("{}: {}", scene.name, w.title), w.x, w.y)
+        .series(Series::line(
+            w.discrete,
+            theory.curve.iter().map(|c| (c.0, c.1)).collect(),
+        ))
+        .series(
+            Series::line(
+                "exact, continuum",
+                theory.curve.iter().map(|c| (c.0, c.2)).collect(),
+            )
+            .dashed(),
+        )
+        .series(
+            Series::line(
+                "Gaussian mean field, discretized (not exact)",
+                theory
+                    .curve
+                    .iter()
+                    .zip(&theory.mean_field)
+                    .map(|(c, m)| (c.0, m.0))
+                    .collect(),
+            )
+            .dashed()
+            .rgb(148, 103, 189),
+        )
+        .series(Series::line(w.athermal, athermal).rgb(140, 140, 140))
+        .hline(1.0, w.load)
+        .caption(w.caption)
 }
 
 /// The Δt-halving check of a compression scene and its note, if the scene asks for it.
@@ -1252,7 +1384,7 @@ fn check_compression_data(
     let mut outputs = SceneOutputs::new(scene, &report);
     outputs.notes.push(data_note(sidecar, data_dir));
     let mut fig: Option<Figure> = None;
-    for c in &checks {
+    for (k, c) in checks.iter().enumerate() {
         let name = &c.run.spec.name;
         outputs.runs.push(name.clone());
         let failed = |e: Error| {
@@ -1281,15 +1413,12 @@ fn check_compression_data(
         let f = fig
             .take()
             .unwrap_or_else(|| force_strain_figure(scene, &c.theory));
-        fig = Some(
-            f.series(
-                Series::markers(
-                    format!("data: {name} (±1 s.e.)"),
-                    rows.iter().map(|r| (r[0], r[1])).collect(),
-                )
-                .with_errors(rows.iter().map(|r| r[2]).collect()),
-            ),
-        );
+        fig = Some(f.series(force_points(
+            format!("data: {name} (±1 s.e.)"),
+            &rows,
+            k,
+            &c.theory,
+        )));
     }
     if let Some(f) = fig {
         outputs.write_figure(&f, dir.join("force-strain.svg"))?;
