@@ -90,7 +90,9 @@ docs-check: numpy-venv
 # fails when one drifts), and the paper's Fig. 2 shown by the README (fig2-shards, part of `make test`,
 # fails when the committed figure differs from the full-budget run's, byte for byte), and the
 # README's filament from tension through buckling (tension-2d at the full budget, about 2 s; a
-# test in tests/docs.rs fails when the committed figure differs from that run's, byte for byte).
+# test in tests/docs.rs fails when the committed figure differs from that run's, byte for byte),
+# and the README's membrane under imposed projected area (both membrane-area scenes at the
+# standard budget, about 80 s).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
 FIG2_IMAGE      = docs/src/images/fig2.svg
 TENSION_IMAGE   = docs/src/images/tension-2d.svg
@@ -103,6 +105,9 @@ docs: build
 	cp target/docs-fig2/fig2.svg $(FIG2_IMAGE)
 	$(BIN) verify -q --scene tension-2d --budget full --out target/docs-tension
 	cp target/docs-tension/tension-2d/force-strain.svg $(TENSION_IMAGE)
+	$(BIN) verify -q --scene membrane-area-soft --scene membrane-area-stiff --budget standard --out target/docs-area
+	cp target/docs-area/membrane-area-soft/force-strain.svg docs/src/images/membrane-area-soft.svg
+	cp target/docs-area/membrane-area-stiff/force-strain.svg docs/src/images/membrane-area-stiff.svg
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered
