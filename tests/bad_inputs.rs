@@ -151,12 +151,50 @@ standard = { trajectories = 8, duration_tau1 = 100.0 }
 full = { trajectories = 16, duration_tau1 = 400.0 }
 "#;
 
+/// A small valid membrane under imposed projected area (issue #28: simply supported
+/// square, 4 x 4 elements, K_A A0/kT = 1e6).
+const MEMBRANE_AREA: &str = r#"description = "bad-input corpus: membrane under imposed area"
+seed = 14
+dims = 3
+model = "compression"
+checks = ["force-strain"]
+
+[membrane]
+bending_rigidity = 200.0
+tension = 0.0
+drag = 1.0
+kt = 1.0
+width = 1.0
+height = 1.0
+boundary = "simply-supported"
+
+[mesh]
+elements = 4
+elements_y = 4
+
+[compression]
+area_modulus = 1.0e6
+strain_ratios = [0.0, 2.0]
+burn_in_tau1 = 1.0
+sample_every_tau1 = 0.05
+
+[[runs]]
+name = "mcn"
+integrator = "metropolis-crank-nicolson"
+noise = "consistent"
+dt_tau1 = 0.02
+quick = { trajectories = 4, duration_tau1 = 10.0 }
+standard = { trajectories = 4, duration_tau1 = 20.0 }
+full = { trajectories = 4, duration_tau1 = 40.0 }
+"#;
+
 /// The scene a case starts from.
 #[derive(Clone, Copy)]
 enum Base {
     Linear,
     Compression,
     Membrane,
+    MembraneArea,
 }
 
 impl Base {
@@ -165,6 +203,7 @@ impl Base {
             Base::Linear => LINEAR,
             Base::Compression => COMPRESSION,
             Base::Membrane => MEMBRANE,
+            Base::MembraneArea => MEMBRANE_AREA,
         }
     }
 }
@@ -211,6 +250,14 @@ const fn comp(name: &'static str, edits: &'static [Edit], expect: &'static [&'st
     Case {
         name,
         input: Input::Scene(Base::Compression, edits),
+        expect,
+    }
+}
+
+const fn area(name: &'static str, edits: &'static [Edit], expect: &'static [&'static str]) -> Case {
+    Case {
+        name,
+        input: Input::Scene(Base::MembraneArea, edits),
         expect,
     }
 }
@@ -752,9 +799,59 @@ fn membrane_cases() -> Vec<Case> {
             "membrane-model-compression",
             &[("model = \"fem\"", "model = \"compression\"")],
             &[
-                "key `model`",
-                "got \"compression\"",
-                "compression is the filament's Fig. 2",
+                "key `checks[0]`",
+                "force-strain, force-distribution or dt-halving for model = \"compression\"",
+            ],
+        ),
+        area(
+            "membrane-area-modulus-missing",
+            &[("area_modulus = 1.0e6\n", "")],
+            &[
+                "key `compression.area_modulus`",
+                "got nothing",
+                "the area modulus K_A in [1e-30, 1e30]",
+            ],
+        ),
+        area(
+            "membrane-area-modulus-nan",
+            &[("area_modulus = 1.0e6", "area_modulus = nan")],
+            &[
+                "key `compression.area_modulus`",
+                "got NaN",
+                "in [1e-30, 1e30]",
+            ],
+        ),
+        area(
+            "membrane-area-tension",
+            &[("tension = 0.0", "tension = 1.0")],
+            &[
+                "key `membrane.tension`",
+                "got 1",
+                "0 for a membrane under imposed projected area",
+            ],
+        ),
+        area(
+            "membrane-area-exact-modal",
+            &[(
+                "integrator = \"metropolis-crank-nicolson\"",
+                "integrator = \"exact-modal\"",
+            )],
+            &[
+                "key `runs[0].integrator`",
+                "got exact-modal with noise consistent",
+                "for a membrane under imposed projected area",
+            ],
+        ),
+        comp(
+            "filament-area-modulus",
+            &[(
+                "burn_in_tau1 = 1.0",
+                "burn_in_tau1 = 1.0\narea_modulus = 5.0",
+            )],
+            &[
+                "key `compression.area_modulus`",
+                "got 5",
+                "left out of a filament scene",
             ],
         ),
         memb(

@@ -513,3 +513,40 @@ fn membrane_output_round_trips_and_a_bias_fails() {
         "{err}"
     );
 }
+
+/// What: the membrane under imposed projected area (issue #28) goes through `verify`, and
+/// the commands not written for it yet refuse it before anything runs, exit 2, naming the
+/// key `membrane` and what is refused (not a filament's numbers from the scene's unused
+/// default `[filament]`). Set-up: `run` and `converge` of `membrane-area-stiff`.
+#[test]
+fn membrane_under_imposed_area_is_refused_where_not_supported() {
+    let tmp = TempDir::new("area-refused");
+    let out = tmp.path().join("out");
+    let out = out.to_str().unwrap();
+    for (args, what) in [
+        (
+            vec!["run", "--scene", "membrane-area-stiff", "--out", out],
+            "run of a membrane under imposed projected area",
+        ),
+        (
+            vec![
+                "converge",
+                "--scene",
+                "membrane-area-stiff",
+                "--over",
+                "elements",
+                "--values",
+                "4,8",
+                "--out",
+                out,
+            ],
+            "converge of a membrane under imposed projected area",
+        ),
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let e = stderr_of(&o);
+        assert!(e.contains("key `membrane`") && e.contains(what), "{e}");
+        assert!(!Path::new(out).join("manifest.json").exists());
+    }
+}

@@ -668,6 +668,7 @@ fn compression_what(job: &Job) -> String {
 /// data run per strain in the sidecar.
 fn run_compression(job: &Job) -> Result<i32> {
     let scene = &job.scene;
+    scene.refuse_membrane("run of a membrane under imposed projected area")?;
     let runs = prepare_compression(job)?;
     // This shard's share of the work.
     let work = compression_projection(job).scaled(job.shard.fraction());

@@ -69,7 +69,10 @@
 //! ```
 //!
 //! (`[[runs]]` as for the filament.) Every command of the linear filament takes membrane
-//! scenes; the compression model refuses them ([`Scene::refuse_membrane`]).
+//! scenes. With `model = "compression"` and `compression.area_modulus`, a membrane scene is
+//! the membrane under imposed projected area (issue #28), which `verify` (also sharded),
+//! `calibrate` and `power` take; `run`, `check` and `converge` refuse it for now
+//! ([`Scene::refuse_membrane`]).
 //!
 //! An ensemble's keys (every budget: `quick`, `standard`, `full`):
 //!
@@ -624,8 +627,8 @@ impl Scene {
     }
 
     /// Refuses a membrane scene where only filament scenes can go (issue #27: every
-    /// command of the linear filament takes membranes; the compression model of Fig. 2 is
-    /// the filament's):
+    /// command of the linear filament takes membranes; of the membrane under imposed
+    /// projected area, `run`, `check` and `converge` are not written yet):
     /// `what` names the command or path, e.g. `run`.
     ///
     /// # Errors

@@ -1424,7 +1424,10 @@ fn study_of(
 ) -> Result<Study> {
     let (scene, run, ensemble) = (&setup.scene, setup.run, setup.ensemble);
     match scene.model {
-        ModelKind::Compression => compression::study(scene, run, opts, ensemble, source),
+        ModelKind::Compression => {
+            scene.refuse_membrane("converge of a membrane under imposed projected area")?;
+            compression::study(scene, run, opts, ensemble, source)
+        }
         ModelKind::Fem | ModelKind::Spectral => linear_study(scene, run, opts, ensemble, source),
     }
 }

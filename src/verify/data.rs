@@ -947,6 +947,7 @@ fn compression_data_check(
     name: &str,
     max_bytes: u64,
 ) -> Result<CompressionDataCheck> {
+    scene.refuse_membrane("check of a membrane under imposed projected area")?;
     let sidecar_path = dir.join(crate::data::SIDECAR);
     let bad = |key: String, message: String| Error::Scene {
         file: sidecar_path.clone(),
