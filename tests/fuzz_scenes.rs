@@ -245,10 +245,18 @@ fn check_bounded(scene: &Scene) -> Result<(), String> {
                 scene.mesh.grading
             ));
         }
-        if scene.dims != 3 || scene.model == ModelKind::Compression {
+        let area = scene.compression.as_ref().and_then(|c| c.area_modulus);
+        let area_ok = match scene.model {
+            // the membrane under imposed projected area (issue #28)
+            ModelKind::Compression => {
+                area.is_some_and(|k| (1e-30..=1e30).contains(&k)) && m.tension == 0.0
+            }
+            ModelKind::Fem | ModelKind::Spectral => area.is_none(),
+        };
+        if scene.dims != 3 || !area_ok {
             return Err(format!(
-                "membrane in {} dims, model {:?}",
-                scene.dims, scene.model
+                "membrane in {} dims, model {:?}, area modulus {area:?}, tension {}",
+                scene.dims, scene.model, m.tension
             ));
         }
         let tau1 = scene.tau1();
