@@ -598,7 +598,7 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
     let pv = mb.point_variance(x, y, args.tolerance).map_err(as_flag)?;
     let [qx, qy] = mb.wavevector(mode);
     let mut out = json!({
-        "boundary": boundary.name(),
+        "boundary": params.boundary.name(),
         "m": args.m,
         "n": args.n,
         "wavevector": [sign * qx, sign * qy],
@@ -742,8 +742,12 @@ fn parse_pair(flag: &str, text: &str, min: usize, max: usize) -> Result<(usize, 
     Ok((parsed[0], *parsed.last().unwrap_or(&parsed[0])))
 }
 
-/// The area query: validates the flags and evaluates the exact theory.
-fn area(args: &AreaArgs) -> Result<serde_json::Value> {
+/// The mesh of an area query: `Ok((nx, ny))` elements, or `Err((nx, ny))` the lattice
+/// cutoff of the continuum.
+type AreaMesh = std::result::Result<(usize, usize), (usize, usize)>;
+
+/// The validated geometry, moduli and mesh (or cutoff) of an area query.
+fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
     let boundary = match args.boundary {
         BoundaryArg::SimplySupported => MembraneBoundary::SimplySupported,
         BoundaryArg::Periodic => MembraneBoundary::Periodic,
@@ -810,6 +814,13 @@ fn area(args: &AreaArgs) -> Result<serde_json::Value> {
         height: args.height,
         boundary,
     };
+    Ok((params, mesh))
+}
+
+/// The area query: validates the flags ([`area_params`]) and evaluates the exact theory.
+fn area(args: &AreaArgs) -> Result<serde_json::Value> {
+    let (params, mesh) = area_params(args)?;
+    let (kappa, stretch) = (args.bending_rigidity, args.stretch_ratio);
     let ratios = parse_strain_ratios(
         &args.strain_ratio,
         max_area_strain_ratio(&params),
@@ -837,7 +848,7 @@ fn area(args: &AreaArgs) -> Result<serde_json::Value> {
         })
         .collect::<Result<Vec<_>>>()?;
     let mut out = json!({
-        "boundary": boundary.name(),
+        "boundary": params.boundary.name(),
         "width": args.width,
         "height": args.height,
         "bending_rigidity": kappa,
