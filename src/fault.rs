@@ -353,13 +353,52 @@ pub fn end_rotation_hinge_index(g: usize, n_nodes: usize) -> Option<usize> {
     (g != 0 && g < last_theta).then(|| g - 1)
 }
 
-/// The beam of `beam`'s parameters and mesh with the hinge at x = L on the rotation.
+/// The beam of `beam`'s parameters, mesh and ends with one hinge on the rotation instead
+/// of the deflection: the hinge at x = L if that end is hinged, else the one at x = 0
+/// (issue #29); the other end as `beam`'s. Both ends hinged: exactly
+/// [`end_rotation_hinge_index`]. A beam without a hinged end is returned unchanged.
 fn rotation_hinged(beam: &BeamModel) -> Result<BeamModel> {
-    BeamModel::with_free_numbering(
-        *beam.params(),
-        beam.mesh().clone(),
-        end_rotation_hinge_index,
-    )
+    use crate::params::End;
+    let ends = beam.ends();
+    if ends.is_hinged() {
+        return BeamModel::with_free_numbering(
+            *beam.params(),
+            beam.mesh().clone(),
+            end_rotation_hinge_index,
+        );
+    }
+    let at_right = ends.right == End::Hinged;
+    if !at_right && ends.left != End::Hinged {
+        return Ok(beam.clone());
+    }
+    let fixed = move |g: usize, n_nodes: usize| {
+        let last = 2 * (n_nodes - 1);
+        let (end, w, node_is_faulty) = match g {
+            0 | 1 => (ends.left, 0, !at_right),
+            _ if g == last || g == last + 1 => (ends.right, last, at_right),
+            _ => return false,
+        };
+        let theta = g != w;
+        if node_is_faulty {
+            // The hinge imposed on θ instead of w.
+            theta
+        } else if theta {
+            end.fixes_slope()
+        } else {
+            end.fixes_deflection()
+        }
+    };
+    BeamModel::with_free_numbering(*beam.params(), beam.mesh().clone(), move |g, n| {
+        let last = 2 * (n - 1);
+        if g > last + 1 || fixed(g, n) {
+            return None;
+        }
+        let before = [0, 1, last, last + 1]
+            .iter()
+            .filter(|&&h| h < g && fixed(h, n))
+            .count();
+        Some(g - before)
+    })
 }
 
 /// Hook of the linear finite-element scenes: the shared model that the integrator and the

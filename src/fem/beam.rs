@@ -6,7 +6,7 @@ use super::mesh::Mesh;
 use super::modal::symmetric_pencil;
 use super::system::{ElementLoad, LinearSystem};
 use crate::error::{Error, Result};
-use crate::params::FilamentParams;
+use crate::params::{End, Ends, FilamentParams};
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Half-bandwidth of the assembled free-DOF matrices (DOFs of one element span at most
@@ -54,6 +54,9 @@ pub struct BeamModel {
     system: LinearSystem,
     geometric: SymBanded,
     dofs: Vec<[Option<usize>; 4]>,
+    ends: Ends,
+    /// The rigid modes `ψ_r` with `Cψ_r` ([`BeamModel::rigid_modes`]).
+    rigid: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 impl std::ops::Deref for BeamModel {
@@ -64,16 +67,32 @@ impl std::ops::Deref for BeamModel {
     }
 }
 
-/// Free index of global DOF `g` for a mesh with `n_nodes` nodes (see [`BeamModel`]).
-fn free_index(g: usize, n_nodes: usize) -> Option<usize> {
-    let last_w = 2 * (n_nodes - 1);
-    if g == 0 || g == last_w || g > last_w + 1 {
-        None
-    } else if g < last_w {
-        Some(g - 1)
-    } else {
-        Some(g - 2)
+/// Free index of global DOF `g` (`w_i = 2i`, `θ_i = 2i + 1`) for a mesh with `n_nodes`
+/// nodes and ends `ends`: `None` where an end imposes it (hinged: `w`; clamped: `w` and
+/// `θ`; free: nothing, [`crate::params::End`]) or `g` is beyond the last node; otherwise
+/// `g` less the number of imposed DOFs before it, so the free DOFs keep node order.
+fn free_index_with(ends: Ends, g: usize, n_nodes: usize) -> Option<usize> {
+    let last = 2 * (n_nodes - 1);
+    let fixed = |g: usize| {
+        let (end, node_w) = match g {
+            0 | 1 => (ends.left, 0),
+            _ if g == last || g == last + 1 => (ends.right, last),
+            _ => return false,
+        };
+        if g == node_w {
+            end.fixes_deflection()
+        } else {
+            end.fixes_slope()
+        }
+    };
+    if g > last + 1 || fixed(g) {
+        return None;
     }
+    let before = [0, 1, last, last + 1]
+        .iter()
+        .filter(|&&h| h < g && fixed(h))
+        .count();
+    Some(g - before)
 }
 
 impl BeamModel {
@@ -83,11 +102,34 @@ impl BeamModel {
     /// [`Error::InvalidParameter`] if the parameters are invalid or the mesh length
     /// differs from `params.length` (relative tolerance 1e-12).
     pub fn new(params: FilamentParams, mesh: Mesh) -> Result<Self> {
-        Self::assemble(params, mesh, free_index)
+        Self::with_ends(params, mesh, Ends::HINGED)
+    }
+
+    /// [`BeamModel::new`] with any ends (issue #29): each end's essential conditions
+    /// imposed on the end node's DOFs (hinged `w`, clamped `w` and `θ`, free none), the
+    /// natural ones left to hold weakly. With a free end and no clamp, `K` is singular:
+    /// its null space is the rigid motions `w = a + bx` that the ends allow
+    /// ([`Ends::rigid_modes`]; [`BeamModel::rigid_modes`]).
+    ///
+    /// # Errors
+    /// As [`BeamModel::new`].
+    pub fn with_ends(params: FilamentParams, mesh: Mesh, ends: Ends) -> Result<Self> {
+        let mut beam = Self::assemble(params, mesh, |g, n| free_index_with(ends, g, n))?;
+        beam.ends = ends;
+        beam.rigid = beam
+            .rigid_basis()
+            .into_iter()
+            .map(|psi| {
+                let mut c_psi = vec![0.0; psi.len()];
+                beam.damping().mul_vec(&psi, &mut c_psi);
+                (psi, c_psi)
+            })
+            .collect();
+        Ok(beam)
     }
 
     /// [`BeamModel::new`] with the free-DOF numbering `free(g, n_nodes)` (global DOF `g`
-    /// to its free index, `None` where constrained): the hinged one, [`free_index`], or a
+    /// to its free index, `None` where constrained): the ends' one, [`free_index_with`], or a
     /// fault's ([`crate::fault`]).
     fn assemble(
         params: FilamentParams,
@@ -104,7 +146,9 @@ impl BeamModel {
             ));
         }
         let n_nodes = mesh.n_nodes();
-        let n_dofs = 2 * n_nodes - 2;
+        let n_dofs = (0..2 * n_nodes)
+            .filter(|&g| free(g, n_nodes).is_some())
+            .count();
         let mut k = SymBanded::new(n_dofs, BANDWIDTH);
         let mut c = SymBanded::new(n_dofs, BANDWIDTH);
         let mut g = SymBanded::new(n_dofs, BANDWIDTH);
@@ -138,6 +182,8 @@ impl BeamModel {
             mesh,
             geometric: g,
             dofs: element_dofs,
+            ends: Ends::HINGED,
+            rigid: Vec::new(),
         })
     }
 
@@ -194,16 +240,98 @@ impl BeamModel {
         self.dofs[e]
     }
 
-    /// Free index of the deflection `w_node` (`None` for the hinged end nodes and for
-    /// `node > N`): `2·node − 1`.
-    pub fn node_deflection_index(&self, node: usize) -> Option<usize> {
-        free_index(2 * node, self.mesh.n_nodes())
+    /// The ends ([`BeamModel::with_ends`]; a fault's model: hinged).
+    pub fn ends(&self) -> Ends {
+        self.ends
     }
 
-    /// Free index of the rotation `θ_node` (`None` for `node > N`): `2·node` for
-    /// `node < N`, `2N − 1` for `node = N`.
+    /// Free index of the deflection `w_node` (`None` where an end imposes it and for
+    /// `node > N`); hinged ends: `2·node − 1`.
+    pub fn node_deflection_index(&self, node: usize) -> Option<usize> {
+        free_index_with(self.ends, 2 * node, self.mesh.n_nodes())
+    }
+
+    /// Free index of the rotation `θ_node` (`None` where an end imposes it and for
+    /// `node > N`); hinged ends: `2·node` for `node < N`, `2N − 1` for `node = N`.
     pub fn node_rotation_index(&self, node: usize) -> Option<usize> {
-        free_index(2 * node + 1, self.mesh.n_nodes())
+        free_index_with(self.ends, 2 * node + 1, self.mesh.n_nodes())
+    }
+
+    /// The rigid motions the ends allow ([`Ends::rigid_modes`]), as free-DOF vectors
+    /// `ψ_r` (exact: Hermite cubics represent `w = a + bx` exactly, `Kψ_r = 0`),
+    /// orthonormal in the damping metric (`ΨᵀCΨ = I`): free–free the translation
+    /// `w = 1` and the rotation about the drag-weighted centre, hinged–free the rotation
+    /// about the hinge `w = x − x_h`; empty otherwise.
+    pub fn rigid_modes(&self) -> Vec<Vec<f64>> {
+        self.rigid.iter().map(|(psi, _)| psi.clone()).collect()
+    }
+
+    /// The amplitudes `r_k = ψ_kᵀ C w` of the rigid modes in state `state` (each
+    /// diffuses: `⟨Δr²⟩ = 2kT·t·ψᵀΣψ/ψᵀCψ` under noise of covariance Σ, `2kT·t` for the
+    /// consistent noise), written to `out` (length [`Ends::rigid_modes`]).
+    pub fn rigid_amplitudes(&self, state: &[f64], out: &mut [f64]) {
+        for (o, (_, c_psi)) in out.iter_mut().zip(&self.rigid) {
+            *o = c_psi.iter().zip(state).map(|(a, b)| a * b).sum();
+        }
+    }
+
+    /// The elastic deflection at `x`: [`BeamModel::deflection_at`] less the rigid
+    /// motion `Σ_k r_k ψ_k(x)` (the C-orthogonal projection onto the elastic modes; the
+    /// deflection itself where the ends allow no rigid motion). NaN outside `[0, L]`.
+    ///
+    /// # Panics
+    /// If `state.len() != n_dofs()`.
+    pub fn elastic_deflection_at(&self, state: &[f64], x: f64) -> f64 {
+        let w = self.deflection_at(state, x);
+        if self.rigid.is_empty() {
+            return w;
+        }
+        self.rigid.iter().fold(w, |w, (psi, c_psi)| {
+            let r: f64 = c_psi.iter().zip(state).map(|(a, b)| a * b).sum();
+            w - r * self.deflection_at(psi, x)
+        })
+    }
+
+    /// The rigid basis before caching ([`BeamModel::rigid_modes`]).
+    fn rigid_basis(&self) -> Vec<Vec<f64>> {
+        let nodes = self.mesh.nodes();
+        let line = |a: f64, b: f64| {
+            let mut v = vec![0.0; self.n_dofs()];
+            for (i, &x) in nodes.iter().enumerate() {
+                if let Some(j) = self.node_deflection_index(i) {
+                    v[j] = a + b * x;
+                }
+                if let Some(j) = self.node_rotation_index(i) {
+                    v[j] = b;
+                }
+            }
+            v
+        };
+        let l = self.mesh.length();
+        let raw = match (self.ends.left, self.ends.right) {
+            (End::Free, End::Free) => vec![line(1.0, 0.0), line(0.0, 1.0)],
+            (End::Hinged, End::Free) => vec![line(0.0, 1.0)],
+            (End::Free, End::Hinged) => vec![line(l, -1.0)],
+            _ => vec![],
+        };
+        // Gram–Schmidt in the C metric.
+        let c = self.damping();
+        let dot = |a: &[f64], b: &[f64]| {
+            let mut cb = vec![0.0; b.len()];
+            c.mul_vec(b, &mut cb);
+            a.iter().zip(&cb).map(|(x, y)| x * y).sum::<f64>()
+        };
+        let mut out: Vec<Vec<f64>> = Vec::new();
+        for mut v in raw {
+            for u in &out {
+                let p = dot(u, &v);
+                v.iter_mut().zip(u).for_each(|(x, y)| *x -= p * y);
+            }
+            let norm = dot(&v, &v).sqrt();
+            v.iter_mut().for_each(|x| *x /= norm);
+            out.push(v);
+        }
+        out
     }
 
     /// Hermite interpolation `w_h(x) = Σ_a N_a(x − x_e) d_a` on the element containing
@@ -285,7 +413,9 @@ mod tests {
     #[test]
     fn free_numbering() {
         // N = 3: nodes 0..=3, globals 0..8
-        let f: Vec<Option<usize>> = (0..9).map(|g| free_index(g, 4)).collect();
+        let f: Vec<Option<usize>> = (0..9)
+            .map(|g| free_index_with(Ends::HINGED, g, 4))
+            .collect();
         assert_eq!(
             f,
             vec![

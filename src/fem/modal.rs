@@ -26,8 +26,8 @@ pub struct GeneralizedModes {
     pub rates: DVector<f64>,
     /// Column `i` is `φ_i`, normalized `ΦᵀCΦ = I` (hence `ΦᵀKΦ = diag λ`). Sign: fixed by
     /// the object that assembled the system; for the beam ([`generalized_modes`]) the
-    /// projection `∫₀ᴸ w_h(x) sin((i+1)πx/L) dx` of the interpolated mode on the
-    /// continuum mode of the same index is positive (computed by 5-point Gauss per
+    /// projection `∫₀ᴸ w_h(x) φ_{i+1}(x) dx` of the interpolated mode on the
+    /// continuum mode of the same index (the sine for hinged ends) is positive (computed by 5-point Gauss per
     /// element); if that projection is negligible (< 1e-8 of its Cauchy–Schwarz bound),
     /// the largest-magnitude component is made positive.
     pub vectors: DMatrix<f64>,
@@ -46,8 +46,24 @@ fn numerical(routine: &str, detail: impl Into<String>) -> Error {
 ///
 /// # Errors
 /// [`Error::Numerical`] if `C` is not positive definite or the eigensolver fails.
+///
+/// A beam with rigid modes ([`BeamModel::rigid_modes`], a free end and no clamp) has as
+/// many zero rates: they are left out, so the columns are the elastic modes only (the
+/// rigid motions diffuse and have no stationary law; [`BeamModel::rigid_modes`] gives
+/// them, C-orthogonal to every column here).
 pub fn generalized_modes(beam: &BeamModel) -> Result<GeneralizedModes> {
-    generalized_modes_signed(beam, |i, col| beam_mode_flips(beam, i, col))
+    let skip = beam.ends().rigid_modes();
+    if beam.ends().is_hinged() {
+        let len = beam.mesh().length();
+        return pencil_modes(beam, skip, |i, col| {
+            let kk = (i + 1) as f64 * PI / len;
+            beam_mode_flips(beam, col, |x| (kk * x).sin())
+        });
+    }
+    let continuum = crate::spectral::EndedBeam::new(*beam.params(), beam.ends())?;
+    pencil_modes(beam, skip, |i, col| {
+        beam_mode_flips(beam, col, |x| continuum.mode_shape(i + 1, x))
+    })
 }
 
 /// [`generalized_modes`] of any [`LinearSystem`], with the sign rule of the object that
@@ -57,6 +73,17 @@ pub fn generalized_modes(beam: &BeamModel) -> Result<GeneralizedModes> {
 /// As [`generalized_modes`].
 pub fn generalized_modes_signed(
     system: &LinearSystem,
+    flip: impl Fn(usize, &[f64]) -> bool,
+) -> Result<GeneralizedModes> {
+    pencil_modes(system, 0, flip)
+}
+
+/// [`generalized_modes_signed`] leaving out the `skip` slowest modes, which must be zero
+/// modes: their rates at most 1e-10 of the largest in magnitude (round-off of an exact
+/// null space); the kept rates must be positive.
+fn pencil_modes(
+    system: &LinearSystem,
+    skip: usize,
     flip: impl Fn(usize, &[f64]) -> bool,
 ) -> Result<GeneralizedModes> {
     let k = system.stiffness().to_dense();
@@ -71,8 +98,23 @@ pub fn generalized_modes_signed(
     })?;
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    let rates = DVector::from_iterator(n, order.iter().map(|&i| eig.eigenvalues[i]));
-    let ysorted = DMatrix::from_fn(n, n, |r, col| eig.eigenvectors[(r, order[col])]);
+    let top = eig.eigenvalues.amax();
+    if let Some(&i) = order[..skip.min(n)]
+        .iter()
+        .find(|&&i| eig.eigenvalues[i].abs() > 1e-10 * top)
+    {
+        return Err(numerical(
+            "generalized_modes",
+            format!(
+                "expected {skip} zero modes, rate {:e} is not zero (largest {top:e})",
+                eig.eigenvalues[i]
+            ),
+        ));
+    }
+    let order = &order[skip.min(n)..];
+    let n_kept = order.len();
+    let rates = DVector::from_iterator(n_kept, order.iter().map(|&i| eig.eigenvalues[i]));
+    let ysorted = DMatrix::from_fn(n, n_kept, |r, col| eig.eigenvectors[(r, order[col])]);
     let mut phi = l
         .tr_solve_lower_triangular(&ysorted)
         .ok_or_else(|| numerical("generalized_modes", "triangular solve L^-T Y failed"))?;
@@ -82,7 +124,7 @@ pub fn generalized_modes_signed(
             format!("rate {i} is {:e}, expected finite and > 0", rates[i]),
         ));
     }
-    for i in 0..n {
+    for i in 0..n_kept {
         let col: Vec<f64> = phi.column(i).iter().copied().collect();
         if flip(i, &col) {
             phi.column_mut(i).neg_mut();
@@ -118,13 +160,13 @@ pub(crate) fn symmetric_pencil(
     Ok((l, a))
 }
 
-/// The beam's sign rule for mode `i` with C-normalized vector `col` (see
-/// [`GeneralizedModes::vectors`]): whether its projection on the continuum sine mode of the
-/// same index is negative (or, where that projection is negligible, its largest-magnitude
-/// component is).
-fn beam_mode_flips(beam: &BeamModel, i: usize, col: &[f64]) -> bool {
+/// The beam's sign rule for a mode with C-normalized vector `col` (see
+/// [`GeneralizedModes::vectors`]): whether its projection on `shape`, the continuum mode
+/// of the same index (normalized ∫shape² = L/2: the sine for hinged ends,
+/// [`crate::spectral::EndedBeam::mode_shape`] for any), is negative (or, where that
+/// projection is negligible, its largest-magnitude component is).
+fn beam_mode_flips(beam: &BeamModel, col: &[f64], mode: impl Fn(f64) -> f64) -> bool {
     let len = beam.mesh().length();
-    let kk = (i + 1) as f64 * PI / len;
     let mut proj = 0.0;
     let mut norm2 = 0.0;
     let mesh = beam.mesh();
@@ -140,7 +182,7 @@ fn beam_mode_flips(beam: &BeamModel, i: usize, col: &[f64]) -> bool {
                 .zip(nv)
                 .filter_map(|(d, na)| d.map(|j| na * col[j]))
                 .sum();
-            proj += 0.5 * h * wq * w * (kk * (x0 + s)).sin();
+            proj += 0.5 * h * wq * w * mode(x0 + s);
             norm2 += 0.5 * h * wq * w * w;
         }
     }

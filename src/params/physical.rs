@@ -95,6 +95,9 @@ pub struct FilamentInput {
     pub diameter_nm: Option<f64>,
     /// Temperature T in K.
     pub temperature_k: Option<f64>,
+    /// The ends, `"<left>-<right>"` ([`crate::params::Ends`]; default both hinged). Not a
+    /// parameter of [`FilamentParams`]: the scene reads it ([`crate::scene::Scene::ends`]).
+    pub ends: Option<crate::params::Ends>,
 }
 
 /// How a physical filament gives its bending stiffness.

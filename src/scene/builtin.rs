@@ -73,8 +73,10 @@ macro_rules! builtin {
 /// Every scene file of the project, top-level scenes first, each group sorted by name.
 pub const BUILTIN: &[BuiltinScene] = &[
     builtin!("actin-10um"),
+    builtin!("clamped-clamped-3d"),
     builtin!("compression-2d"),
     builtin!("compression-3d"),
+    builtin!("grafted-clamped-free"),
     builtin!("hinged-linear-2d"),
     builtin!("hinged-linear-3d"),
     builtin!("membrane-area-soft"),
@@ -83,6 +85,7 @@ pub const BUILTIN: &[BuiltinScene] = &[
     builtin!("membrane-hinged"),
     builtin!("membrane-periodic"),
     builtin!("membrane-spectral"),
+    builtin!("microtubule-free-free"),
     builtin!("spectral-reference"),
     builtin!("tension-2d"),
     builtin!(extreme "compression-floppy-2d"),

@@ -218,6 +218,14 @@ pub const KEYS: &[KeyDoc] = &[
         "Thermal energy k_B T (an energy).",
     ),
     key(
+        "filament.ends",
+        "-",
+        "\"<left>-<right>\", each of hinged, clamped, free (or one name for both)",
+        "\"hinged-hinged\"",
+        None,
+        "The ends at x = 0 and x = L (issue #29): hinged imposes w = 0, clamped w = 0 and w' = 0, free nothing. A free end without a clamp has rigid modes (free-free 2, hinged-free 1): they diffuse, are projected out of the observables and checked by `rigid-diffusion`. Model \"fem\" only.",
+    ),
+    key(
         "filament.contour_length_um",
         "µm",
         "positive; the converted parameters must lie in [1e-30, 1e30]",

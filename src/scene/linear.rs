@@ -20,6 +20,7 @@ use crate::fem::banded::LANES;
 use crate::fem::beam::BeamModel;
 use crate::fem::modal::GeneralizedModes;
 use crate::fem::noise::NoiseModel;
+use crate::params::End;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
@@ -100,6 +101,27 @@ pub struct LinearReference {
     pub dt: f64,
     /// Largest rate of the discrete system (λ_max).
     pub max_rate: f64,
+    /// Per rigid mode of the ends (issue #29; empty without), its exact diffusion law.
+    pub rigid: Vec<RigidReference>,
+}
+
+/// The exact law of one rigid mode's amplitude `r = ψᵀCw` (C-normalized `ψ`, a free
+/// end's translation or rotation): a random walk, `⟨(r(t+τ) − r(t))²⟩ = D_discrete·τ`
+/// for τ a whole number of steps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidReference {
+    /// What the mode is (`translation`, `rotation about the centre`, …).
+    pub name: String,
+    /// `2kT·ψᵀΣψ`: Σ the covariance of the standardized noise of the run's noise model
+    /// (`C` for the consistent noise, so `2kT`; the element-uniform load misses the
+    /// within-element variation of a rotation).
+    pub diffusion_discrete: f64,
+    /// The continuum's `2kT` (the centre-of-mass MSD `2kT·t/(ξL)` and the angle MSD
+    /// `2kT·t/(ξI)` in this normalization).
+    pub diffusion_continuum: f64,
+    /// Whether the integrator steps the rigid motion (the exact-modal integrator steps
+    /// the elastic modes only: its rigid amplitudes stay 0).
+    pub simulated: bool,
 }
 
 /// The probe vector `a_x = Φᵀ p_x` of the deflection at `x`, where `w(x) = p_xᵀ w`
@@ -178,6 +200,9 @@ trait Observables {
     /// Adds θ² of every node (slope w'; summed over components) to `acc`, if the model
     /// carries nodal rotations (the finite-element model does, the spectral one not).
     fn add_slope_squares(&self, _acc: &mut [f64]) {}
+    /// The rigid-mode amplitudes `r_k = ψ_kᵀCw` ([`BeamModel::rigid_amplitudes`]),
+    /// component-major `out[c * n_rigid + k]`; nothing for an object without rigid modes.
+    fn rigid(&self, _out: &mut [f64]) {}
 }
 
 /// A filament being simulated ([`Trajectory`]: advances all its transverse components by
@@ -243,6 +268,14 @@ impl Observables for LaneOf<'_, FemBatch<'_>> {
                 .each_component(self.lane, |_, s| add_slope_squares(beam, s, acc));
         }
     }
+    fn rigid(&self, out: &mut [f64]) {
+        if let Some(beam) = self.batch.object.beam() {
+            let r = beam.ends().rigid_modes();
+            self.batch.each_component(self.lane, |c, s| {
+                beam.rigid_amplitudes(s, &mut out[c * r..(c + 1) * r]);
+            });
+        }
+    }
 }
 
 struct FemSampler<'a> {
@@ -278,6 +311,14 @@ impl Observables for FemSampler<'_> {
         if let Some(beam) = self.object.beam() {
             for s in &self.filament.states {
                 add_slope_squares(beam, s, acc);
+            }
+        }
+    }
+    fn rigid(&self, out: &mut [f64]) {
+        if let Some(beam) = self.object.beam() {
+            let r = beam.ends().rigid_modes();
+            for (c, s) in self.filament.states.iter().enumerate() {
+                beam.rigid_amplitudes(s, &mut out[c * r..(c + 1) * r]);
             }
         }
     }
@@ -410,6 +451,7 @@ struct Recorder<'r> {
     at_t: Vec<f64>,
     buf_m: Vec<f64>,
     buf_p: Vec<f64>,
+    buf_r: Vec<f64>,
     one: Vec<f64>,
 }
 
@@ -430,6 +472,10 @@ impl<'r> Recorder<'r> {
                     .map(|k| Vec::with_capacity(cap(run.mode_every[k % nm])))
                     .collect(),
                 profile: vec![Vec::with_capacity(cap(run.profile_every)); c * np],
+                rigid: vec![
+                    Vec::with_capacity(cap(run.profile_every));
+                    c * run.reference.rigid.len()
+                ],
                 two_time: vec![0.0; c * ntt],
                 slope_squares: vec![0.0; run.n_nodes()],
                 slope_samples: 0,
@@ -437,6 +483,7 @@ impl<'r> Recorder<'r> {
             at_t: vec![0.0; c * ntt],
             buf_m: vec![0.0; c * nm],
             buf_p: vec![0.0; c * np],
+            buf_r: vec![0.0; c * run.reference.rigid.len()],
             one: vec![0.0; c],
         }
     }
@@ -482,8 +529,49 @@ impl<S: Observables + ?Sized> Observer<S> for Recorder<'_> {
             }
             sampler.add_slope_squares(&mut rec.slope_squares);
             rec.slope_samples += 1;
+            if !rec.rigid.is_empty() {
+                sampler.rigid(&mut self.buf_r);
+                for (s, v) in rec.rigid.iter_mut().zip(&self.buf_r) {
+                    s.push(*v);
+                }
+            }
         }
     }
+}
+
+/// The exact diffusion laws of the rigid modes of `beam` ([`RigidReference`]) under the
+/// noise model `noise`, stepped by `integrator`.
+///
+/// # Errors
+/// As [`NoiseGenerator::new`](crate::fem::NoiseGenerator::new).
+fn rigid_references(
+    beam: &BeamModel,
+    noise: NoiseModel,
+    integrator: IntegratorKind,
+) -> Result<Vec<RigidReference>> {
+    let rigid = beam.rigid_modes();
+    if rigid.is_empty() {
+        return Ok(Vec::new());
+    }
+    let sigma = crate::fem::NoiseGenerator::new(noise, beam)?.covariance();
+    let names: &[&str] = match (beam.ends().left, beam.ends().right) {
+        (End::Free, End::Free) => &["translation", "rotation about the centre"],
+        _ => &["rotation about the hinge"],
+    };
+    let kt = beam.kt();
+    Ok(rigid
+        .iter()
+        .zip(names)
+        .map(|(psi, name)| {
+            let v = DVector::from_column_slice(psi);
+            RigidReference {
+                name: (*name).to_string(),
+                diffusion_discrete: 2.0 * kt * v.dot(&(&sigma * &v)),
+                diffusion_continuum: 2.0 * kt,
+                simulated: !integrator.needs_modes(),
+            }
+        })
+        .collect())
 }
 
 /// `rates` × `factor` (the rates themselves, bit for bit, at factor 1).
@@ -515,6 +603,9 @@ pub struct TrajectoryRecord {
     /// Deflection series at the profile points: `profile[c * n_points + j]`, every
     /// `profile_every` steps, at most [`MAX_SAMPLES`] samples.
     pub profile: Vec<Vec<f64>>,
+    /// Rigid-mode amplitude series `rigid[c * n_rigid + k]` (issue #29: free ends),
+    /// sampled with the profile (every `profile_every` steps); empty without rigid modes.
+    pub rigid: Vec<Vec<f64>>,
     /// Two-time products w(x,t)·w(y,η), `two_time[c * n_points + j]`.
     pub two_time: Vec<f64>,
     /// Per node, the sum of θ² = w'² over the profile samples and components (empty for
@@ -599,6 +690,7 @@ struct Prepared {
     profile_discrete: Vec<f64>,
     two_time: Vec<TwoTimeReference>,
     max_rate: f64,
+    rigid: Vec<RigidReference>,
 }
 
 /// The quantities shared by the preparation steps of a run.
@@ -621,7 +713,8 @@ impl Setup<'_> {
     /// profile truncated to the simulated modes.
     fn spectral(&self) -> Result<Prepared> {
         let continuum = match &self.continuum {
-            Continuum::Filament(beam) => beam,
+            // Validation keeps the spectral model to hinged ends.
+            Continuum::Filament(beam) => &HingedBeam::new(beam.params)?,
             Continuum::Membrane { membrane, modes } => {
                 return self.spectral_membrane(membrane, modes);
             }
@@ -669,6 +762,7 @@ impl Setup<'_> {
             });
         }
         Ok(Prepared {
+            rigid: Vec::new(),
             amplitude_scale: vec![1.0; self.scene.sampling.modes],
             model: Model::Spectral {
                 beam: *continuum,
@@ -751,6 +845,7 @@ impl Setup<'_> {
             .map(|m| membrane.mode_rate(*m))
             .fold(0.0, f64::max);
         Ok(Prepared {
+            rigid: Vec::new(),
             amplitude_scale: vec![1.0; checked.len()],
             model: Model::SpectralMembrane {
                 simulator: Box::new(simulator),
@@ -807,7 +902,16 @@ impl Setup<'_> {
         // amplitude a = c·q of φ, c = 1/√(ξ‖φ‖²): √(2/(ξL)) for the filament's sines
         // (signed as the sine at L/(2n)), 1/√(ξ‖φ‖²) for a membrane's real modes
         // (‖φ‖² = A/4 or A/2, (M3); signs free).
+        let rigid = match &object {
+            FemObject::Beam(beam) => rigid_references(beam, spec.noise, spec.integrator)?,
+            FemObject::Plate { .. } => Vec::new(),
+        };
         let amplitude_scale = match &object {
+            // Other ends: the modes are signed by their continuum mode already
+            // (generalized_modes), whose normalization ∫φ² = L/2 is the sine's.
+            FemObject::Beam(b) if !b.ends().is_hinged() => {
+                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
+            }
             FemObject::Beam(_) => {
                 let scale = (2.0 / (p.drag * p.length)).sqrt();
                 (1..=self.scene.sampling.modes)
@@ -824,6 +928,7 @@ impl Setup<'_> {
             }
         };
         Ok(Prepared {
+            rigid,
             amplitude_scale,
             model: Model::Fem {
                 object,
@@ -849,7 +954,8 @@ impl Setup<'_> {
         let p = self.scene.filament;
         Ok(match &self.continuum {
             Continuum::Filament(_) => {
-                let beam = BeamModel::new(p, self.scene.mesh.build(p.length)?)?;
+                let beam =
+                    BeamModel::with_ends(p, self.scene.mesh.build(p.length)?, self.scene.ends)?;
                 #[cfg(any(test, feature = "faults"))]
                 let beam = crate::fault::shared_model(self.scene.fault, beam)?;
                 FemObject::Beam(Box::new(beam))
@@ -1008,6 +1114,7 @@ impl LinearRun {
                 two_time: prepared.two_time,
                 dt,
                 max_rate: prepared.max_rate,
+                rigid: prepared.rigid,
             },
             mode_every,
             profile_every,

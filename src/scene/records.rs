@@ -23,7 +23,8 @@ use crate::scene::compression::ForceRecord;
 use crate::scene::linear::TrajectoryRecord;
 
 /// The magic of linear-run records.
-pub const LINEAR_MAGIC: &[u8; 8] = b"LFEMLIN1";
+/// Version 2 (issue #29) adds the rigid-mode series after the profile.
+pub const LINEAR_MAGIC: &[u8; 8] = b"LFEMLIN2";
 /// The magic of compression-run records.
 pub const FORCE_MAGIC: &[u8; 8] = b"LFEMFRC1";
 
@@ -192,6 +193,7 @@ pub fn encode_linear(records: &[TrajectoryRecord], extra: &[Vec<f64>]) -> Vec<u8
     for r in records {
         e.series(&r.modes);
         e.series(&r.profile);
+        e.series(&r.rigid);
         e.numbers(&r.two_time);
         e.numbers(&r.slope_squares);
         e.count(r.slope_samples);
@@ -213,6 +215,7 @@ pub fn decode_linear(bytes: &[u8], source: &str) -> Result<(Vec<TrajectoryRecord
         records.push(TrajectoryRecord {
             modes: d.series()?,
             profile: d.series()?,
+            rigid: d.series()?,
             two_time: d.numbers()?,
             slope_squares: d.numbers()?,
             slope_samples: d.u64()? as usize,
@@ -300,6 +303,7 @@ mod tests {
             .map(|j| TrajectoryRecord {
                 modes: vec![awkward(j, 10), awkward(j + 10, 3), vec![]],
                 profile: vec![awkward(j + 20, 7)],
+                rigid: vec![awkward(j + 60, 5)],
                 two_time: awkward(j + 30, 2),
                 slope_squares: awkward(j + 40, 4),
                 slope_samples: 17 + j as usize,

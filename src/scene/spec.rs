@@ -132,8 +132,8 @@ use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
 use crate::fem::noise::NoiseModel;
 use crate::output::provenance::{DescribeScene, SceneProvenance};
-use crate::params::FilamentParams;
 use crate::params::physical::{self, FilamentInput, PhysicalFilament};
+use crate::params::{Ends, FilamentParams};
 use crate::spectral::membrane::MembraneParams;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
@@ -302,6 +302,11 @@ pub enum CheckKind {
     /// variances of the modes (m, n) and (n, m) are equal; per independent series the
     /// pooled difference of their normalized time averages, t-tested against 0.
     XySymmetry,
+    /// A filament with rigid modes (a free end and no clamp, issue #29): the increments
+    /// of each rigid amplitude `r = ψᵀCw` between profile samples against their exact
+    /// random-walk law, a χ² variance test of the increments (independent by the
+    /// Markov property of a zero mode).
+    RigidDiffusion,
     /// Compression: ⟨F⟩ at every strain against the exact discrete equilibrium theory
     /// (per-point z-tests and a χ² over all points).
     ForceStrain,
@@ -478,6 +483,11 @@ pub struct Scene {
     /// from physical units ([`crate::params::physical`]).
     #[serde(default, deserialize_with = "deserialize_filament")]
     pub filament: FilamentParams,
+    /// The filament's ends (`[filament] ends`, issue #29; not in the file under this
+    /// name: read from the `[filament]` table): both hinged unless the scene says
+    /// otherwise.
+    #[serde(skip)]
+    pub ends: Ends,
     /// The membrane of a membrane scene (its `[membrane]` table, consistent units), or
     /// `None` for a filament scene (see the module docs). A membrane scene leaves
     /// `filament` at its defaults and never reads it.
@@ -579,6 +589,10 @@ impl Scene {
         let mut scene: Scene = toml::from_str(text).map_err(|e| parse_error(text, path, &e))?;
         let table = FilamentTable::read(text);
         scene.filament_table = table.as_ref().is_some_and(|t| t.filament.is_some());
+        scene.ends = table
+            .as_ref()
+            .and_then(|t| t.filament.and_then(|f| f.ends))
+            .unwrap_or_default();
         scene.physical = table.and_then(FilamentTable::physical);
         scene.source_text = text.to_string();
         scene.path = path.to_path_buf();
@@ -598,10 +612,13 @@ impl Scene {
     /// slowest mode ([`Membrane::modes`], c_q = κq⁴ + σq², [`Membrane::stiffness`]): with
     /// q² = π²(1/a² + 1/b²) simply supported, (2π/max(a, b))² periodic. NaN for a membrane
     /// whose parameters [`MembraneParams::validate`] refuses (validation refuses the
-    /// scene).
+    /// scene). A filament with other ends (issue #29): the slowest elastic mode's,
+    /// ξL⁴/(EI β₁⁴) ([`EndedBeam::tau1`]; NaN for parameters it refuses).
     pub fn tau1(&self) -> f64 {
         match &self.membrane {
-            None => self.filament.tau1(),
+            None if self.ends.is_hinged() => self.filament.tau1(),
+            None => crate::spectral::EndedBeam::new(self.filament, self.ends)
+                .map_or(f64::NAN, |b| b.tau1()),
             Some(p) => p.tau1(),
         }
     }

@@ -96,11 +96,20 @@ impl Display for Num {
 }
 
 /// The allowed checks of a linear scene, for messages.
-const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance; xy-symmetry for a membrane) for model \"fem\" or \"spectral\"";
+const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance; xy-symmetry for a membrane; rigid-diffusion for a filament with a free end) for model \"fem\" or \"spectral\"";
 /// The allowed positions x/L of the profile and two-time checks, for messages: the
 /// hinges x/L = 0 and 1 have w = 0 exactly, so nothing fluctuates there to check.
 const INTERIOR: &str = "in (0, 1) (inside the filament: w = 0 at the hinges x/L = 0 and 1)";
 /// The allowed positions x/a of a simply supported membrane, for messages.
+/// As [`INTERIOR`] for hinged or clamped ends other than two hinges.
+const FIXED_ENDS: &str =
+    "in (0, 1) (inside the filament: w = 0 at its hinged or clamped ends x/L = 0 and 1)";
+/// A free end at x = 0 fluctuates: it may be checked.
+const FREE_LEFT: &str = "in [0, 1) (w = 0 at the end x/L = 1; the free end x/L = 0 fluctuates)";
+/// A free end at x = L fluctuates: it may be checked (the tip of a grafted filament).
+const FREE_RIGHT: &str = "in (0, 1] (w = 0 at the end x/L = 0; the free end x/L = 1 fluctuates)";
+/// Both ends free.
+const FREE_BOTH: &str = "in [0, 1] (both ends are free)";
 const MEMBRANE_INTERIOR: &str = "in (0, 1) (x/a on the midline y = b/2, inside the membrane: h = 0 on the simply supported edges x/a = 0 and 1)";
 /// The allowed positions x/a of a periodic membrane, for messages.
 const MEMBRANE_PERIOD: &str =
@@ -305,6 +314,10 @@ impl Scene {
                 self.validate_filament()?;
                 if self.dims != 2 && self.dims != 3 {
                     return Err(bad(self, "dims", &self.dims, "2 or 3"));
+                }
+                if !self.ends.is_hinged() && self.model != ModelKind::Fem {
+                    let allowed = "hinged-hinged with model = \"spectral\" or \"compression\" (their modes and their theory are the hinged filament's); other ends with model = \"fem\"";
+                    return Err(bad(self, "filament.ends", &self.ends, allowed));
                 }
             }
         }
@@ -566,11 +579,15 @@ impl Scene {
         } else {
             LINEAR_CHECKS
         };
+        let rigid = self.membrane.is_none() && self.ends.rigid_modes() > 0;
         let misplaced = |k: &CheckKind| {
             k.is_compression() != compression
                 || (*k == CheckKind::XySymmetry && !self.is_square_membrane())
+                || (*k == CheckKind::RigidDiffusion && !rigid)
         };
-        let allowed = if kinds.contains(&CheckKind::XySymmetry) && !self.is_square_membrane() {
+        let allowed = if kinds.contains(&CheckKind::RigidDiffusion) && !rigid {
+            "rigid-diffusion only for a filament with rigid modes (filament.ends free-free, hinged-free or free-hinged); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"
+        } else if kinds.contains(&CheckKind::XySymmetry) && !self.is_square_membrane() {
             "xy-symmetry only for a membrane on a square patch (width = height, elements_y = elements); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"
         } else {
             allowed
@@ -714,8 +731,24 @@ impl Scene {
         fn period(x: f64) -> bool {
             x.is_finite() && (0.0..1.0).contains(&x)
         }
+        fn from_left(x: f64) -> bool {
+            x.is_finite() && (0.0..1.0).contains(&x)
+        }
+        fn to_right(x: f64) -> bool {
+            x.is_finite() && x > 0.0 && x <= 1.0
+        }
+        fn closed(x: f64) -> bool {
+            x.is_finite() && (0.0..=1.0).contains(&x)
+        }
+        let free = |e: crate::params::End| e == crate::params::End::Free;
         match self.membrane.map(|m| m.boundary) {
-            None => (interior, INTERIOR),
+            None => match (free(self.ends.left), free(self.ends.right)) {
+                (false, false) if self.ends.is_hinged() => (interior, INTERIOR),
+                (false, false) => (interior, FIXED_ENDS),
+                (true, false) => (from_left, FREE_LEFT),
+                (false, true) => (to_right, FREE_RIGHT),
+                (true, true) => (closed, FREE_BOTH),
+            },
             Some(MembraneBoundary::SimplySupported) => (interior, MEMBRANE_INTERIOR),
             Some(MembraneBoundary::Periodic) => (period, MEMBRANE_PERIOD),
         }

@@ -679,12 +679,12 @@ pub fn default_values(scene: &Scene, run: usize, over: Over) -> Result<Vec<f64>>
                 return Ok(DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect());
             }
             let p = scene.filament;
-            let beam = BeamModel::new(p, scene.mesh.build(p.length)?)?;
+            let beam = BeamModel::with_ends(p, scene.mesh.build(p.length)?, scene.ends)?;
             let limit = scene.runs[run]
                 .integrator
                 .stability_limit(beam.max_rate()?)
                 .unwrap_or(f64::INFINITY)
-                / p.tau1();
+                / scene.tau1();
             DEFAULT_EM_FRACTIONS.iter().map(|f| f * limit).collect()
         }
         Over::Dt => DEFAULT_DT_TAU1.to_vec(),

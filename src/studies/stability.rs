@@ -457,7 +457,7 @@ pub(crate) fn uniform_object(scene: &Scene, elements: usize) -> Result<FemObject
     match scene.membrane {
         None => {
             let p = scene.filament;
-            let beam = BeamModel::new(p, Mesh::uniform(p.length, elements)?)?;
+            let beam = BeamModel::with_ends(p, Mesh::uniform(p.length, elements)?, scene.ends)?;
             Ok(FemObject::Beam(Box::new(beam)))
         }
         Some(m) => FemObject::plate(

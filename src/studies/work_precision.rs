@@ -448,9 +448,10 @@ fn method_dts(
     Ok(if method.0 == IntegratorKind::EulerMaruyama {
         let s = point_scene(opts, method, 1.0);
         let object = match s.membrane {
-            None => FemObject::Beam(Box::new(crate::fem::beam::BeamModel::new(
+            None => FemObject::Beam(Box::new(crate::fem::beam::BeamModel::with_ends(
                 s.filament,
                 s.mesh.build(s.filament.length)?,
+                s.ends,
             )?)),
             Some(_) => super::stability::uniform_object(&s, s.mesh.elements)?,
         };

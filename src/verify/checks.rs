@@ -221,6 +221,7 @@ fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
         CheckKind::TwoTime => Step::AfterModes(two_time_check),
         CheckKind::PooledVariance => Step::AfterModes(pooled_variance_check),
         CheckKind::XySymmetry => Step::AfterModes(xy_symmetry_check),
+        CheckKind::RigidDiffusion => Step::AfterModes(rigid_diffusion_check),
         CheckKind::ForceStrain | CheckKind::ForceDistribution | CheckKind::DtHalving => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
@@ -302,6 +303,7 @@ fn kind_name(kind: CheckKind) -> &'static str {
         CheckKind::TwoTime => "two-time",
         CheckKind::PooledVariance => "pooled-variance",
         CheckKind::XySymmetry => "xy-symmetry",
+        CheckKind::RigidDiffusion => "rigid-diffusion",
         CheckKind::ForceStrain => "force-strain",
         CheckKind::ForceDistribution => "force-distribution",
         CheckKind::DtHalving => "dt-halving",
@@ -761,6 +763,66 @@ fn xy_symmetry_check(ctx: &mut LinearContext<'_>) -> Result<()> {
             described.join(", ")
         ),
     )
+}
+
+/// [`CheckKind::RigidDiffusion`]: per rigid mode, the increments `Δr` of its amplitude
+/// between consecutive profile samples (lag τ, a whole number of steps) over every
+/// trajectory and component, χ²-tested against the exact variance `D·τ`
+/// ([`RigidReference`](crate::scene::linear::RigidReference)): a zero mode is a random
+/// walk, so its increments are independent and normal with mean 0. Skipped (noted)
+/// where the integrator does not step the rigid motion.
+fn rigid_diffusion_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let run = ctx.run;
+    let nr = run.reference.rigid.len();
+    let prefix = &run.spec.name;
+    let tau = run.profile_every as f64 * run.reference.dt;
+    for (k, law) in run.reference.rigid.iter().enumerate() {
+        let name = format!("{prefix}/rigid-diffusion/mode={k}");
+        if !law.simulated {
+            ctx.est.skipped.push(SkippedCheck {
+                name,
+                reason: format!(
+                    "the {} integrator steps the elastic modes only: the {} is not simulated",
+                    run.spec.integrator.name(),
+                    law.name
+                ),
+            });
+            continue;
+        }
+        let increments: Vec<f64> = ctx
+            .records
+            .iter()
+            .flat_map(|t| (0..run.components).map(move |c| &t.rigid[c * nr + k]))
+            .flat_map(|s| s.windows(2).map(|w| w[1] - w[0]))
+            .collect();
+        let reference = law.diffusion_discrete * tau;
+        let o = stats::chi2_variance_test(&increments, reference, Some(0.0))?;
+        let s2 = increments.iter().map(|d| d * d).sum::<f64>() / increments.len() as f64;
+        ctx.out.push(check(
+            name,
+            "chi2-variance",
+            (
+                s2,
+                reference,
+                reference * (2.0 / increments.len() as f64).sqrt(),
+            ),
+            &o,
+            Some(law.diffusion_continuum * tau),
+            format!(
+                "{}: mean squared increment of r = psi^T C w over lag {:.6e} ({} independent increments), exact random walk D*tau",
+                law.name,
+                tau,
+                increments.len()
+            ),
+        ));
+    }
+    if nr == 0 {
+        ctx.est.skipped.push(SkippedCheck {
+            name: format!("{prefix}/rigid-diffusion"),
+            reason: "the ends allow no rigid motion".into(),
+        });
+    }
+    Ok(())
 }
 
 /// Spectrum of mode `i` against the exact expectation of the Welch estimator for the

@@ -52,7 +52,8 @@ fn compression_step(
         | CheckKind::Spectrum
         | CheckKind::TwoTime
         | CheckKind::PooledVariance
-        | CheckKind::XySymmetry => {
+        | CheckKind::XySymmetry
+        | CheckKind::RigidDiffusion => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
                 format!("{kind:?}"),

@@ -104,6 +104,7 @@ pub fn prepare_data_check(
         two_time,
         dt: dts,
         max_rate,
+        rigid: Vec::new(),
     };
     let run = LinearRun::for_data(
         spec,
@@ -707,6 +708,7 @@ fn read_record(
     let record = TrajectoryRecord {
         modes,
         profile,
+        rigid: Vec::new(),
         two_time: two_time.clone(),
         slope_squares: Vec::new(),
         slope_samples: 0,

@@ -14,7 +14,7 @@ use crate::fem::modal::{GeneralizedModes, generalized_modes};
 use crate::fem::plate::PlateModel;
 use crate::fem::plate_modes::PlateModes;
 use crate::fem::system::LinearSystem;
-use crate::spectral::HingedBeam;
+use crate::spectral::EndedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode};
 use nalgebra::{DMatrix, DVector};
 
@@ -25,8 +25,9 @@ const MEMBRANE_TOLERANCE: f64 = 1e-12;
 /// The continuum reference of a linear run's object.
 #[derive(Debug, Clone)]
 pub(crate) enum Continuum {
-    /// The hinged filament of eq. (2).
-    Filament(HingedBeam),
+    /// The filament of eq. (2) with its ends (hinged: the sine modes of eq. 3; any
+    /// ends, issue #29: [`EndedBeam`], the elastic modes, rigid motion projected out).
+    Filament(EndedBeam),
     /// The Helfrich membrane of (M1) on its midline, with its checked modes (slowest
     /// first, [`Membrane::modes`]).
     Membrane {
@@ -55,7 +56,10 @@ impl Continuum {
     pub(crate) fn of(scene: &crate::scene::Scene) -> Result<Self> {
         match scene.membrane {
             Some(m) => Continuum::membrane(Membrane::new(m)?, scene.sampling.modes),
-            None => Ok(Continuum::Filament(HingedBeam::new(scene.filament)?)),
+            None => Ok(Continuum::Filament(EndedBeam::new(
+                scene.filament,
+                scene.ends,
+            )?)),
         }
     }
 
@@ -244,7 +248,8 @@ impl FemObject {
     /// The field at position `x` of the sampling line for state `state` (NaN outside).
     pub(crate) fn value_at(&self, state: &[f64], x: f64) -> f64 {
         match self {
-            FemObject::Beam(b) => b.deflection_at(state, x),
+            // The rigid motion of free ends is projected out, as the continuum's.
+            FemObject::Beam(b) => b.elastic_deflection_at(state, x),
             FemObject::Plate { plate, mean, .. } => {
                 let h = plate.height_at(state, x, 0.5 * plate.params().height);
                 // Periodic: the height relative to the spatial mean (the q = 0 mode, a
