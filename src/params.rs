@@ -4,7 +4,10 @@
 //! filament given in physical units (µm, pN, Pa·s, K, …) to the consistent units µm, s,
 //! pN.
 
+pub mod ends;
 pub mod physical;
+
+pub use ends::{End, Ends};
 
 use crate::error::{Result, require_positive};
 use serde::{Deserialize, Serialize};
