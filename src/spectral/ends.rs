@@ -208,9 +208,11 @@ impl CharacteristicEquation {
         match self {
             Self::SinZero => n as f64 * PI,
             Self::CosCoshPlusOne | Self::CosCoshMinusOne => {
-                // sin δ = σ sech(β⁰ + δ), σ = (−1)ⁿ⁺¹: from cos((n ± ½)π + δ) = ∓(−1)ⁿ… sin δ,
-                // see the module docs. Newton's method on g(δ) = sin δ − σ sech(β⁰ + δ),
-                // started at the fixed-point iterate arcsin(σ sech β⁰).
+                // cos((n + ½)π + δ) = −(−1)ⁿ sin δ and cos((n − ½)π + δ) = (−1)ⁿ sin δ, so
+                // cos β = sech β (β⁰ = (n + ½)π) and cos β = −sech β (β⁰ = (n − ½)π) both
+                // read sin δ = σ sech(β⁰ + δ), σ = (−1)ⁿ⁺¹. Newton's method on
+                // g(δ) = sin δ − σ sech(β⁰ + δ), started at the fixed-point iterate
+                // arcsin(σ sech β⁰).
                 let sigma = if n % 2 == 1 { 1.0 } else { -1.0 };
                 let mut d = (sigma * sech(b0)).asin();
                 for _ in 0..60 {
@@ -799,9 +801,17 @@ impl EndedBeam {
     /// conditions on each side, continuity of G, ∂G/∂x, ∂²G/∂x² at x = y and the unit
     /// jump of EI ∂³G/∂x³ there are eight linear equations for the eight coefficients;
     /// with rigid modes they leave the rigid motions free, which the orthogonality
-    /// ∫₀ᴸ G ψₖ dx = 0 fixes. The solutions (obtained symbolically, then simplified so that
-    /// no term cancels near a clamped or hinged end) are the table of the module docs;
-    /// each is symmetric in (x, y), and each is tested against the mode sums.
+    /// ∫₀ᴸ G ψₖ dx = 0 fixes. The solutions (obtained symbolically by
+    /// `docs/dev/ends_green.py`, then simplified so that no term cancels near a clamped or
+    /// hinged end) are the table of the module docs; each is symmetric in (x, y), and each
+    /// is tested against the mode sums.
+    ///
+    /// Worked example, clamped–free (u = x/L, v = y/L, G in units L³/EI). For u < v the
+    /// clamp leaves G = αu² + βu³; for u > v the free end (G″ = G‴ = 0) leaves
+    /// G = γ + δu. The jump G‴(v⁺) − G‴(v⁻) = −6β = 1 gives β = −1/6; continuity of G″,
+    /// 2α + 6βv = 0, gives α = v/2; continuity of G′ and G gives δ = v²/2 and
+    /// γ = −v³/6. So G = u²(3v − u)/6 for u ≤ v, the cantilever's deflection at x under a
+    /// unit load at y, and G(u, u) = u³/3: ⟨w²(x)⟩ = kT x³/(3EI).
     pub fn equilibrium_covariance(&self, x: f64, y: f64) -> f64 {
         if let Some(h) = self.hinged() {
             return h.equilibrium_covariance(x, y);
