@@ -11,8 +11,9 @@ use langevin_fem::fem::plate_area::{
     MAX_AREA_CUTOFF_INDEX, MAX_AREA_ELEMENTS, max_area_strain_ratio,
 };
 use langevin_fem::fem::plate_modes::PlateModes;
+use langevin_fem::params::Ends;
 use langevin_fem::spectral::{
-    HingedBeam, Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
+    EndedBeam, HingedBeam, Membrane, MembraneBoundary, MembraneMode, MembraneParams, ModeShape,
 };
 use langevin_fem::theory::{
     CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, MAX_DISCRETE_ELEMENTS, MIN_STRAIN_RATIO,
@@ -36,9 +37,33 @@ pub struct PhysicalArgs {
     /// Thermal energy k_B T.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     kt: f64,
+    /// Ends of the filament, `<left>-<right>` with the left end at x = 0, each hinged
+    /// (w = w'' = 0), clamped (w = w' = 0) or free (w'' = w''' = 0), e.g. clamped-free; one
+    /// name for both ends. Other than hinged, the output adds the ends and, where the ends
+    /// allow rigid motions (free-free, hinged-free, free-hinged), their diffusion laws.
+    #[arg(long, default_value = "hinged")]
+    ends: String,
 }
 
+/// The values `--ends` allows.
+const ENDS_ALLOWED: &str = "`<left>-<right>` (left end at x = 0) with each of hinged, clamped, \
+                            free (e.g. clamped-free), or one name for both ends";
+
 impl PhysicalArgs {
+    /// The parsed `--ends`.
+    fn parsed_ends(&self) -> Result<Ends> {
+        self.ends
+            .parse::<Ends>()
+            .map_err(|_| Error::invalid("--ends", format!("{:?}", self.ends), ENDS_ALLOWED))
+    }
+
+    /// Validates the flags (naming them as typed) and builds the filament with its ends.
+    fn ended(&self) -> Result<EndedBeam> {
+        let ends = self.parsed_ends()?;
+        let hinged = self.beam()?;
+        EndedBeam::new(hinged.params, ends)
+    }
+
     /// Validates the flags (naming them as typed) and builds the hinged beam.
     fn beam(&self) -> Result<HingedBeam> {
         require_positive("--length", self.length)?;
@@ -61,6 +86,8 @@ Examples:
   langevin-fem theory variance --x 0.5
   langevin-fem theory mode --n 3 --length 10 --bending-rigidity 17 --drag 1 --kt 4.1e-3
   langevin-fem theory correlation --x 0.5 --y 0.5 --t 0.1 --eta 0.2
+  langevin-fem theory mode --n 3 --ends clamped-free
+  langevin-fem theory variance --x 1 --ends clamped-free
   langevin-fem theory compression --dims 2 --strain-ratio 0,1,3,10 --elements 20
   langevin-fem theory membrane --boundary periodic --m 1 --n 0 --tension 0.5 --cutoff 100
   langevin-fem theory area --strain-ratio -10,0,1,3,10 --elements 16
@@ -77,8 +104,9 @@ pub struct TheoryArgs {
 
 #[derive(Debug, Subcommand)]
 enum Query {
-    /// Equilibrium variance ⟨w²(x)⟩ of the hinged filament (closed form of the
-    /// equipartition sum, the t → ∞ limit of eq. 4).
+    /// Equilibrium variance ⟨w²(x)⟩ of the filament (closed form of the equipartition
+    /// sum, the t → ∞ limit of eq. 4); with --ends other than hinged, of its elastic part
+    /// (rigid modes projected out).
     Variance {
         /// Position along the filament, in [0, L].
         #[arg(long, allow_negative_numbers = true)]
@@ -87,7 +115,8 @@ enum Query {
         phys: PhysicalArgs,
     },
     /// Two-time correlation ⟨w(x,t) w(y,η)⟩ from w(x,0) = 0, eq. (4), with a rigorous
-    /// bound on the truncation error of the mode sum.
+    /// bound on the truncation error of the mode sum; with --ends other than hinged, over
+    /// the elastic modes of those ends, with the rigid modes' part given separately.
     Correlation {
         /// First position, in [0, L].
         #[arg(long, allow_negative_numbers = true)]
@@ -107,7 +136,9 @@ enum Query {
         #[command(flatten)]
         phys: PhysicalArgs,
     },
-    /// Relaxation rate λ_n and stationary variance of mode n (hinged ends).
+    /// Relaxation rate λ_n and stationary variance of mode n; with --ends other than
+    /// hinged, of elastic mode n of those ends, with its wavenumber q_n, the convention and
+    /// the rigid modes' diffusion laws.
     Mode {
         /// Mode number n ≥ 1.
         #[arg(long, allow_negative_numbers = true)]
@@ -505,6 +536,45 @@ fn compression(
     Ok(json!({ "dims": dims.as_u32(), "points": points }))
 }
 
+/// The convention line of `theory mode --ends` (other than hinged).
+const ENDED_MODE_CONVENTION: &str = "w = Σ a_n φ_n(x) + Σ_k b_k ψ_k(x) (ψ_k the rigid modes), \
+     ∫₀ᴸ φ_n² dx = ∫₀ᴸ ψ_k² dx = L/2 (hinged-hinged: φ_n = sin(nπx/L)), the first non-zero \
+     Taylor coefficient of φ_n at x = 0 positive; variance = ⟨a_n²⟩ = 2kT/(EI q_n⁴ L), rate = \
+     EI q_n⁴/ξ; a rigid amplitude diffuses, ⟨(b_k(t) − b_k(0))²⟩ = amplitude_msd_rate·t";
+
+/// `theory mode --ends` (other than hinged): the elastic mode n's wavenumber, rate and
+/// variance with their convention, and the rigid modes with their diffusion laws.
+fn ended_mode(beam: &EndedBeam, n: usize) -> serde_json::Value {
+    let rigid: Vec<serde_json::Value> = beam
+        .rigid_modes()
+        .iter()
+        .map(|m| {
+            let mut r = json!({
+                "name": m.name(),
+                "shape": m.shape_formula(),
+                "amplitude_msd_rate": m.amplitude_msd_rate,
+                "physical_quantity": m.physical_quantity(),
+                "physical_msd_rate": m.physical_msd_rate,
+            });
+            if let Some(i) = m.moment_of_inertia() {
+                r["moment_of_inertia"] = json!(i);
+            }
+            r
+        })
+        .collect();
+    json!({
+        "ends": beam.ends.to_string(),
+        "n": n,
+        "characteristic_equation": beam.characteristic_equation().formula(),
+        "wavenumber": beam.wavenumber(n),
+        "wavenumber_length": beam.wavenumber(n) * beam.params.length,
+        "rate": beam.mode_rate(n),
+        "variance": beam.mode_variance(n),
+        "convention": ENDED_MODE_CONVENTION,
+        "rigid_modes": rigid,
+    })
+}
+
 /// `err` with the library's parameter name turned into the flag (`tension` → `--tension`).
 fn as_flag(err: Error) -> Error {
     match err {
@@ -638,9 +708,18 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
 pub fn run(args: TheoryArgs) -> Result<i32> {
     let value = match args.query {
         Query::Variance { x, phys } => {
-            let beam = phys.beam()?;
+            let ended = phys.ended()?;
             require_in_range("--x", x, 0.0, phys.length)?;
-            json!({ "x": x, "variance": beam.profile_variance(x) })
+            if ended.ends.is_hinged() {
+                json!({ "x": x, "variance": ended.profile_variance(x) })
+            } else {
+                json!({
+                    "ends": ended.ends.to_string(),
+                    "x": x,
+                    "variance": ended.profile_variance(x),
+                    "rigid_modes": ended.rigid_modes().len(),
+                })
+            }
         }
         Query::Correlation {
             x,
@@ -650,7 +729,7 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             tolerance,
             phys,
         } => {
-            let beam = phys.beam()?;
+            let ended = phys.ended()?;
             require_in_range("--x", x, 0.0, phys.length)?;
             require_in_range("--y", y, 0.0, phys.length)?;
             if !(eta.is_finite() && eta >= 0.0) {
@@ -666,21 +745,30 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
             if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
                 return Err(Error::invalid("--tolerance", tolerance, "in (0, 1)"));
             }
-            let c = beam.correlation(x, y, t, eta, tolerance)?;
-            json!({
+            let c = ended.correlation(x, y, t, eta, tolerance)?;
+            let mut out = json!({
                 "x": x, "y": y, "t": t, "eta": eta,
                 "correlation": c.value,
                 "truncation_error": c.truncation_error,
                 "modes": c.n_modes,
-            })
+            });
+            if !ended.ends.is_hinged() {
+                out["ends"] = json!(ended.ends.to_string());
+                out["rigid_correlation"] = json!(ended.rigid_correlation(x, y, t, eta)?);
+            }
+            out
         }
         Query::Mode { n, phys } => {
-            let beam = phys.beam()?;
+            let ended = phys.ended()?;
             if n < 1 {
                 return Err(Error::invalid("--n", n, ">= 1"));
             }
             let n = n as usize;
-            json!({ "n": n, "rate": beam.mode_rate(n), "variance": beam.mode_variance(n) })
+            if ended.ends.is_hinged() {
+                json!({ "n": n, "rate": ended.mode_rate(n), "variance": ended.mode_variance(n) })
+            } else {
+                ended_mode(&ended, n)
+            }
         }
         Query::Compression {
             dims,

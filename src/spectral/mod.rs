@@ -44,9 +44,11 @@
 //! Helfrich membrane with tension, simply supported or periodic): [`Membrane`] and
 //! [`MembraneParams`]. Its conventions are stated once, in its module docs.
 
+pub mod ends;
 pub mod membrane;
 pub mod simulator;
 
+pub use ends::{CharacteristicEquation, EndedBeam, RigidMode, RigidMotion};
 pub use membrane::{
     ExcessArea, MAX_ASPECT_RATIO, MAX_LISTED_MODES, MAX_MEMBRANE_MODES, Membrane, MembraneBoundary,
     MembraneMode, MembraneParams, ModeShape,
