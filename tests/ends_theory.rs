@@ -649,10 +649,9 @@ fn classical_compliances() {
 
 /// What: where there are rigid modes, the closed-form G is the projected (pseudo-inverse)
 /// Green's function: ∫₀ᴸ G(x, y) ψ(x) dx = 0 for every rigid mode ψ and every y.
-/// Reference: the definition (module docs). Quadrature: 200 panels × 16 nodes, exact for
-/// the piecewise polynomial up to the kink at x = y (a node-free panel edge is not
-/// needed: the error is below 1e-13·kTL⁴/EI at this resolution).
-/// Tolerance: 1e-12·kTL⁴/EI.
+/// Reference: the definition (module docs). Quadrature: 200 panels × 16 nodes; G is a
+/// polynomial of degree ≤ 5 in x on each side of y, and every y used is a panel edge, so
+/// the rule is exact up to rounding. Tolerance: 1e-12·kTL⁴/EI.
 #[test]
 fn projected_green_function_is_orthogonal_to_rigid_modes() {
     let s = kt_l3_ei() * sample().length;
