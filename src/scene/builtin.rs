@@ -86,6 +86,7 @@ pub const BUILTIN: &[BuiltinScene] = &[
     builtin!("membrane-periodic"),
     builtin!("membrane-spectral"),
     builtin!("microtubule-free-free"),
+    builtin!("pinned-free-2d"),
     builtin!("spectral-reference"),
     builtin!("tension-2d"),
     builtin!(extreme "compression-floppy-2d"),
@@ -339,8 +340,10 @@ mod tests {
             names,
             [
                 "actin-10um",
+                "clamped-clamped-3d",
                 "compression-2d",
                 "compression-3d",
+                "grafted-clamped-free",
                 "hinged-linear-2d",
                 "hinged-linear-3d",
                 "membrane-area-soft",
@@ -349,6 +352,8 @@ mod tests {
                 "membrane-hinged",
                 "membrane-periodic",
                 "membrane-spectral",
+                "microtubule-free-free",
+                "pinned-free-2d",
                 "spectral-reference",
                 "tension-2d"
             ]
@@ -367,7 +372,9 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         let m = e.to_string();
         assert!(
-            m.starts_with("--scene must be one of: actin-10um, compression-2d, "),
+            m.starts_with(
+                "--scene must be one of: actin-10um, clamped-clamped-3d, compression-2d, "
+            ),
             "{m}"
         );
         assert!(
@@ -380,7 +387,7 @@ mod tests {
         assert!(e.to_string().contains("no file no/such/file.toml"), "{e}");
         assert!(
             e.to_string()
-                .contains("one of: actin-10um, compression-2d, "),
+                .contains("one of: actin-10um, clamped-clamped-3d, compression-2d, "),
             "{e}"
         );
         let bad = Scene::parse_named("seed = 1", &find("compression-2d").unwrap().label(), "x");

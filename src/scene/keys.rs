@@ -390,7 +390,7 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "sampling.profile_points",
         "x/L (membrane: x/a)",
-        "at most 100 positions, each in (0, 1); a periodic membrane: in [0, 1); non-empty when the checks have profile",
+        "at most 100 positions, each in (0, 1) (a free end's x/L = 0 or 1 allowed too); a periodic membrane: in [0, 1); non-empty when the checks have profile",
         "[]",
         open(0.0, 1.0),
         "Linear scenes: positions where the equilibrium profile ⟨w²(x)⟩ is checked. A membrane: ⟨h²⟩ at x/a on the midline y = b/2.",
@@ -398,7 +398,7 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "sampling.two_time",
         "[x/L, y/L, t/τ₁, η/τ₁] (membrane: [x/a, x'/a, t/τ₁, η/τ₁])",
-        "at most 100 points; x/L and y/L in (0, 1) (a periodic membrane: x/a, x'/a in [0, 1)), 0 < t <= η <= sampling.burn_in_tau1; non-empty when the checks have two-time",
+        "at most 100 points; x/L and y/L in (0, 1) (a free end's 0 or 1 allowed too; a periodic membrane: x/a, x'/a in [0, 1)), 0 < t <= η <= sampling.burn_in_tau1; non-empty when the checks have two-time",
         "[]",
         None,
         "Linear scenes: points (x, y, t, η) of the two-time correlation ⟨w(x,t) w(y,η)⟩ from w(x, 0) = 0, eq. (4). A membrane: ⟨h(x,t) h(x',η)⟩ from h = 0, both points on the midline y = b/2.",
@@ -613,6 +613,9 @@ pub fn key_paths(value: &Value) -> Vec<String> {
 /// scene).
 pub fn effective_toml(scene: &Scene) -> Result<String> {
     match membrane_as_run(scene) {
+        None if !scene.ends.is_hinged() => {
+            toml::to_string(&effective_value(scene)?).map_err(not_written)
+        }
         None => toml::to_string(scene).map_err(not_written),
         Some(m) => Ok(without_table(
             &toml::to_string(&m).map_err(not_written)?,
@@ -627,7 +630,16 @@ pub fn effective_toml(scene: &Scene) -> Result<String> {
 /// As [`effective_toml`].
 pub fn effective_value(scene: &Scene) -> Result<Value> {
     match membrane_as_run(scene) {
-        None => Value::try_from(scene).map_err(not_written),
+        None => {
+            let mut v = Value::try_from(scene).map_err(not_written)?;
+            // `ends` is the scene's, read from `[filament]` (not a filament parameter).
+            if !scene.ends.is_hinged()
+                && let Some(Value::Table(f)) = v.get_mut("filament")
+            {
+                f.insert("ends".to_string(), Value::String(scene.ends.to_string()));
+            }
+            Ok(v)
+        }
         Some(m) => {
             let mut v = Value::try_from(&m).map_err(not_written)?;
             if let Value::Table(t) = &mut v {
@@ -999,9 +1011,19 @@ mod tests {
             MEMBRANES.to_vec()
         } else {
             // The filament's bounds; the membranes' own are probed on MEMBRANES.
+            // A free end's position (x/L = 0 or 1) is allowed: the positions' bounds are
+            // probed on the scenes without one.
+            let position = pattern.starts_with("sampling.profile_points")
+                || pattern.starts_with("sampling.two_time");
             BUILTIN
                 .iter()
                 .filter(|b| !b.text.lines().any(|l| l.trim() == "[membrane]"))
+                .filter(|b| {
+                    !(position
+                        && b.text
+                            .lines()
+                            .any(|l| l.trim().starts_with("ends =") && l.contains("free")))
+                })
                 .map(|b| (b.name, b.text))
                 .collect()
         };

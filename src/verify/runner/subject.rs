@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::output::AxisUnits;
 use crate::scene::linear::ModeReference;
 use crate::scene::{ModelKind, Scene};
-use crate::spectral::HingedBeam;
+use crate::spectral::EndedBeam;
 use crate::spectral::membrane::{Membrane, MembraneBoundary, MembraneMode, ModeShape};
 
 /// Points on each continuum curve drawn in the profile, two-time and spectrum figures.
@@ -55,7 +55,7 @@ pub(super) enum Subject {
     /// continuum curves are drawn).
     Filament {
         /// Its continuum.
-        beam: Option<HingedBeam>,
+        beam: Option<EndedBeam>,
         /// Its length L, the unit of the two-time figure's positions.
         length: f64,
     },
@@ -79,7 +79,7 @@ impl Subject {
     pub(super) fn of(scene: &Scene) -> Result<Subject> {
         Ok(match scene.membrane {
             None => Subject::Filament {
-                beam: HingedBeam::new(scene.filament).ok(),
+                beam: EndedBeam::new(scene.filament, scene.ends).ok(),
                 length: scene.filament.length,
             },
             Some(p) => {
@@ -98,6 +98,31 @@ impl Subject {
     /// Whether this is a membrane.
     pub(super) fn is_membrane(&self) -> bool {
         matches!(self, Subject::Membrane { .. })
+    }
+
+    /// A filament whose ends are not both hinged (issue #29): the ends' name and their
+    /// characteristic equation; `None` for the hinged filament and the membrane.
+    fn other_ends(&self) -> Option<(String, &'static str)> {
+        match self {
+            Subject::Filament { beam: Some(b), .. } if !b.ends.is_hinged() => {
+                Some((b.ends.to_string(), b.characteristic_equation().formula()))
+            }
+            _ => None,
+        }
+    }
+
+    /// How the rigid modes of a filament's ends are treated, for captions (empty without).
+    fn rigid_words(&self) -> String {
+        match self {
+            Subject::Filament { beam: Some(b), .. } if b.ends.rigid_modes() > 0 => {
+                let names: Vec<String> = b.rigid_modes().iter().map(|m| m.name()).collect();
+                format!(
+                    " (its rigid motion, {}, projected out: the elastic shape)",
+                    names.join(" and ")
+                )
+            }
+            _ => String::new(),
+        }
     }
 
     /// The wavenumber |q| of a membrane's mode `mr` (NaN for a filament's mode, or a mode
@@ -240,7 +265,10 @@ impl Subject {
                 title,
                 x_label,
                 y_label: "rate / λₙ (dimensionless)".to_string(),
-                continuum: "continuum λₙ = n⁴/τ₁".to_string(),
+                continuum: match self.other_ends() {
+                    None => "continuum λₙ = n⁴/τ₁".to_string(),
+                    Some((ends, eq)) => format!("continuum λₙ = EI qₙ⁴/ξ ({ends}: {eq})"),
+                },
                 discrete: "exact, discrete update: −ln(m)/Δt".to_string(),
                 caption:
                     "Decay rate of each mode's autocorrelation relative to the continuum rate λₙ = \
@@ -391,6 +419,25 @@ impl Subject {
     /// The words of the profile figure of run `name`.
     pub(super) fn profile_words(&self, name: &str, units: AxisUnits) -> Words {
         match self {
+            Subject::Filament { .. } if self.other_ends().is_some() => {
+                let (ends, _) = self.other_ends().unwrap_or_default();
+                let rigid = self.rigid_words();
+                Words {
+                    title: format!("{name}: equilibrium profile ⟨w²(x)⟩"),
+                    x_label: format!("position x {}", units.length()),
+                    y_label: format!("⟨w²(x)⟩ {}", units.area()),
+                    continuum: format!("continuum, {ends} ends (closed form)"),
+                    discrete: "exact, discretized filament".to_string(),
+                    caption: format!(
+                        "Equilibrium variance of the deflection ⟨w²(x)⟩ of the filament with {ends} \
+                         ends{rigid} at the scene's profile points, simulated (markers, ±1 s.e.) \
+                         against the exact value of the discretized filament (light discs) and \
+                         the continuum's closed form, kT/EI times the Green's function of the \
+                         ends (dashed curve). Each marker should sit on its disc within its error \
+                         bar; the discs lie on the curve up to the discretization error."
+                    ),
+                }
+            }
             Subject::Filament { .. } => Words {
                 title: format!("{name}: equilibrium profile ⟨w²(x)⟩"),
                 x_label: format!("position x {}", units.length()),
