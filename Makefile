@@ -53,7 +53,7 @@ verify: build
 # rate is above alpha or a kind's p-values are not uniform. About 22 s per seed at the
 # quick budget on 2 cores (37 min for 100 seeds).
 SEEDS ?= 100
-CALIBRATION_SCENES = actin-10um compression-2d compression-3d hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral spectral-reference tension-2d
+CALIBRATION_SCENES = actin-10um clamped-clamped-3d compression-2d compression-3d grafted-clamped-free hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral microtubule-free-free pinned-free-2d spectral-reference tension-2d
 calibrate: build
 	$(BIN) calibrate $(foreach s,$(CALIBRATION_SCENES),--scene $(s)) --seeds $(SEEDS) --budget $(BUDGET) --out $(OUT)/calibration
 

@@ -16,7 +16,7 @@ use super::{Verbosity, usize_in};
 use clap::Args;
 use langevin_fem::data::{
     COMPRESSION_COLUMNS, DataFilament, DataMembrane, DataRun, DataSidecar, Discretization, FORMAT,
-    SIDECAR, Start, TrajectoryFile, VERSION, trajectory_columns,
+    SIDECAR, Start, TrajectoryFile, VERSION, trajectory_columns_with_ends,
 };
 use langevin_fem::error::{Error, Result};
 use langevin_fem::fem::banded::LANES;
@@ -395,7 +395,10 @@ impl Job {
                 "journal": "manifest.json",
                 "record": provenance,
             })),
-            columns: Some(trajectory_columns(scene.is_membrane())),
+            columns: Some(trajectory_columns_with_ends(
+                scene.is_membrane(),
+                scene.ends,
+            )),
         }
     }
 

@@ -138,7 +138,9 @@ pub struct DataSidecar {
 /// The units and meanings of the trajectory files' columns (`#` stands for the index
 /// `j` of `positions` or the mode number `n`), in the base dimensions of the object's
 /// unit system ([`crate::output::columns`]: `[L]` its length unit, `[T]` its time unit):
-/// a filament's, or (`membrane`) a membrane's.
+/// a filament's, or (`membrane`) a membrane's. A filament with other ends than two hinges
+/// (issue #29; `ends`) has its own modes and, with a free end, its rigid motion
+/// projected out of the deflection columns: [`trajectory_columns_with_ends`].
 pub fn trajectory_columns(membrane: bool) -> serde_json::Value {
     if membrane {
         return serde_json::json!([
@@ -161,6 +163,38 @@ pub fn trajectory_columns(membrane: bool) -> serde_json::Value {
         { "name": "positions (sidecar)", "unit": "[L]", "meaning": "positions of the deflection columns" },
         { "name": "dt_sample, burn_in, discretization.dt (sidecar)", "unit": "[T]", "meaning": "time between rows, burn-in, integration step" }
     ])
+}
+
+/// [`trajectory_columns`] of a filament with ends `ends`: for two hinges the same; for
+/// other ends the deflections are the elastic shape (the rigid motion of free ends
+/// projected out in the damping metric) and the amplitudes those of the ends' modes φ_n
+/// (∫φ_n² = L/2, [`crate::spectral::EndedBeam::mode_shape`]).
+pub fn trajectory_columns_with_ends(
+    membrane: bool,
+    ends: crate::params::Ends,
+) -> serde_json::Value {
+    let mut columns = trajectory_columns(membrane);
+    if membrane || ends.is_hinged() {
+        return columns;
+    }
+    let rigid = if ends.rigid_modes() > 0 {
+        ", its rigid motion (free ends) projected out: the elastic shape"
+    } else {
+        ""
+    };
+    if let Some(list) = columns.as_array_mut() {
+        for c in list.iter_mut() {
+            let meaning = match c["name"].as_str() {
+                Some("w_#") => format!("transverse deflection w at positions[#]{rigid}"),
+                Some("aw_#") => format!(
+                    "modal amplitude a_n of w, w(x) = sum_n a_n phi_n(x), phi_n the n-th mode of the {ends} filament (int phi_n^2 = L/2), n = #"
+                ),
+                _ => continue,
+            };
+            c["meaning"] = serde_json::Value::String(meaning);
+        }
+    }
+    columns
 }
 
 /// The filament of a data directory.

@@ -70,17 +70,23 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
             t("membrane-periodic", CN),
             t("membrane-spectral", ALL),
             t("membrane-area-stiff", ALL),
+            t("grafted-clamped-free", CN),
+            t("microtubule-free-free", CN),
         ],
         FaultKind::NoiseTimeScaling => vec![t("hinged-linear-3d", &["exact-modal"])],
         FaultKind::IntegratorDrag | FaultKind::SharedStiffness => vec![
             t("hinged-linear-3d", CN),
             t("membrane-hinged", CN),
             t("membrane-periodic", CN),
+            t("microtubule-free-free", CN),
         ],
-        FaultKind::CorrelatedNoise
-        | FaultKind::IntegratorHinge
-        | FaultKind::ComponentNoiseSharing
-        | FaultKind::SharedHinge => vec![t("hinged-linear-3d", CN)],
+        // Other ends (issue #29): the hinge of a pinned–free filament on its rotation.
+        FaultKind::IntegratorHinge | FaultKind::SharedHinge => {
+            vec![t("hinged-linear-3d", CN), t("pinned-free-2d", CN)]
+        }
+        FaultKind::CorrelatedNoise | FaultKind::ComponentNoiseSharing => {
+            vec![t("hinged-linear-3d", CN)]
+        }
         // The stretch rigidity matters most in tension (F ≈ EA·ε there): tension-2d.
         FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
             vec![

@@ -819,7 +819,7 @@ fn rigid_diffusion_check(ctx: &mut LinearContext<'_>) -> Result<()> {
     if nr == 0 {
         ctx.est.skipped.push(SkippedCheck {
             name: format!("{prefix}/rigid-diffusion"),
-            reason: "the ends allow no rigid motion".into(),
+            reason: "no rigid-mode amplitudes: the ends allow no rigid motion, or the run's data carry none (trajectory files record the elastic shape and the elastic modes)".into(),
         });
     }
     Ok(())
