@@ -278,6 +278,17 @@ fn fem_oracle(scene: &Scene, run: &LinearRun, o: &mut Oracle) {
             ),
         ));
     }
+    fem_profile_oracle(scene, run, o);
+}
+
+/// The finite-element profile reference, for consistent noise with an exact-variance
+/// integrator: the continuum less what the model misses between nodes (and, for free
+/// ends, the rigid projection of the element bubbles); a note otherwise.
+fn fem_profile_oracle(scene: &Scene, run: &LinearRun, o: &mut Oracle) {
+    let p = &scene.filament;
+    let r = &run.reference;
+    let name = &run.spec.name;
+    let h = p.length / scene.mesh.elements as f64;
     let exact_variance = matches!(
         run.spec.integrator,
         IntegratorKind::CrankNicolson | IntegratorKind::ExactModal
