@@ -169,6 +169,35 @@ fn an_injected_bias_fails_naming_the_checks() {
 }
 
 /// Every file under `dir` with its bytes.
+/// Modal amplitudes scaled by 3 (variances 9×, the size of a wrong boundary condition in
+/// an integrator): every mode-variance check fails with p < 1e-12 — its null law, scale
+/// included, comes from the reference, so it cannot saturate the way a t-test whose error
+/// comes from the same data does (issue #30).
+#[test]
+fn a_nine_fold_variance_fails_every_mode_variance_check_with_a_tiny_p() {
+    let dir = TempDir::new("run-check-nine");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let side = json(&Path::new(&data).join("data.json"));
+    scale_columns(&data, &side, |h| h.starts_with("aw_"), 3.0);
+    let report = dir.join("report");
+    let (o, args) = check(&data, report.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
+    let s = json(&report.join("summary.json"));
+    let variance: Vec<&serde_json::Value> = s["scenes"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["check"] == "mode-variance")
+        .collect();
+    assert!(!variance.is_empty());
+    for c in variance {
+        let p = c["p_value"].as_f64().unwrap();
+        assert!(p < 1e-12, "{}: p = {p:e}", c["name"]);
+        assert_eq!(c["kind"], "quadratic-form");
+    }
+}
+
 fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
     all_files(dir)
         .into_iter()

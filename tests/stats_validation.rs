@@ -3,7 +3,9 @@
 //! What: interval coverage of the mean, variance and decay-rate estimators; the
 //! integrated autocorrelation time and its Madras–Sokal error; blocking vs τ_int errors;
 //! false-rejection rates, p-value uniformity and power of the hypothesis tests; Holm's
-//! correction; Welch spectra against the exact AR(1) density.
+//! correction; Welch spectra against the exact AR(1) density; the exact-null variance test
+//! of AR(1) series (uniform p-values, tail probabilities against Monte Carlo, power, no
+//! saturation at a 9× variance).
 //!
 //! Reference processes: i.i.d. Gaussians and the stationary Gaussian AR(1) sequence
 //! x_{k+1} = ρ x_k + sqrt(1 − ρ²) σ ξ_k (the exactly sampled Ornstein–Uhlenbeck process),
@@ -23,13 +25,14 @@ mod common;
 
 use common::seeds::{
     SEED_AR1_MOMENTS, SEED_AR1_TAU, SEED_BLOCKING, SEED_DECAY, SEED_DECAY_POWER, SEED_HOLM,
-    SEED_IID_MEAN, SEED_NULL, SEED_POWER, SEED_WELCH,
+    SEED_IID_MEAN, SEED_NULL, SEED_POWER, SEED_QUADFORM, SEED_WELCH,
 };
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::stats::{
-    TestOutcome, blocking_std_error, chi2_gof_normal, chi2_sum_test, chi2_variance_test,
-    decay_rate, ensemble_mean, holm, integrated_autocorrelation_time, ks_normal, mean_with_error,
-    variance_with_error, welch, welch_pooled, z_test,
+    Ar1SquareSum, TestOutcome, ar1_square_sum_test, blocking_std_error, chi2_gof_normal,
+    chi2_sum_test, chi2_variance_test, decay_rate, ensemble_mean, holm,
+    integrated_autocorrelation_time, ks_normal, mean_with_error, variance_with_error, welch,
+    welch_pooled, z_test,
 };
 use rand::RngExt;
 use rand_distr::StandardNormal;
@@ -550,5 +553,103 @@ fn welch_white_noise_and_normalization() {
     assert!(
         (integral - 1.0).abs() < tol,
         "AR(1) integral {integral} (tol {tol})"
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// The exact-null variance test of AR(1) series (issue #30).
+// ---------------------------------------------------------------------------------------
+
+/// Series of a stationary AR(1) process (one per index), as a verification run's modal
+/// amplitudes are: `count` series of `len` samples.
+fn ar1_ensemble(index0: u64, count: usize, len: usize, rho: f64, sd: f64) -> Vec<Vec<f64>> {
+    (0..count)
+        .map(|k| ar1(SEED_QUADFORM, index0 + k as u64, len, rho, 0.0, sd))
+        .collect()
+}
+
+#[test]
+fn ar1_square_sum_p_values_are_uniform_under_the_null() {
+    // Positive, negative and no correlation; few and many series; short series.
+    for (case, &(rho, count, len)) in [(0.6, 16, 80), (-0.8, 4, 200), (0.0, 1, 30), (0.9, 8, 400)]
+        .iter()
+        .enumerate()
+    {
+        let mut p = Vec::new();
+        let mut rejected = 0;
+        for rep in 0..400u64 {
+            let series = ar1_ensemble(((case as u64) << 32) + rep * 1000, count, len, rho, 1.3);
+            let refs: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
+            let (o, _, _) = ar1_square_sum_test(&refs, 1.69, rho).unwrap();
+            rejected += usize::from(o.p_value < 0.05);
+            p.push(o.p_value);
+        }
+        assert_uniform(&format!("rho {rho}, {count} x {len}"), &p);
+        assert_rate(&format!("rho {rho}: false alarms"), rejected, 400, 0.05);
+    }
+}
+
+#[test]
+fn ar1_square_sum_tail_matches_monte_carlo() {
+    // P(S >= s) and P(S <= s) at the Monte Carlo 0.1 % and 99.9 % quantiles of 40 000 sums
+    // of 4 series of 50 samples at rho = 0.7: the saddle-point tail is within the Monte
+    // Carlo error (binomial sd of a 1e-3 tail over 40 000: 16 %; accepted within 3.5 sd).
+    let (rho, n_mc) = (0.7, 40_000);
+    let law = Ar1SquareSum::new(1.0, rho, &[50; 4]).unwrap();
+    let mut sums: Vec<f64> = (0..n_mc as u64)
+        .map(|rep| {
+            ar1_ensemble((1 << 40) | (rep * 8), 4, 50, rho, 1.0)
+                .iter()
+                .flatten()
+                .map(|x| x * x)
+                .sum()
+        })
+        .collect();
+    sums.sort_by(f64::total_cmp);
+    for &q in &[1e-3, 0.05, 0.5, 0.95, 1.0 - 1e-3] {
+        let s = sums[(q * n_mc as f64) as usize];
+        let upper = law.upper_tail(s).unwrap();
+        let expected = 1.0 - q;
+        let tail = expected.min(q);
+        let sd = (tail * (1.0 - tail) / n_mc as f64).sqrt();
+        assert!(
+            (upper - expected).abs() <= BAND_SIGMAS * sd + 1e-4,
+            "quantile {q}: saddle-point P(S >= s) = {upper:.5}, Monte Carlo {expected:.5}"
+        );
+    }
+}
+
+#[test]
+fn ar1_square_sum_test_rejects_wrong_variances_without_saturating() {
+    // 32 series of 1000 samples at rho = 0.8 (about 220 effective samples each for a
+    // variance: 1000 (1 − ρ²)/(1 + ρ²)).
+    let rho = 0.8;
+    let series = ar1_ensemble(1 << 41, 32, 1000, rho, 1.0);
+    let refs: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
+    // The truth passes.
+    let (truth, estimate, se) = ar1_square_sum_test(&refs, 1.0, rho).unwrap();
+    assert!(
+        truth.p_value > 0.01,
+        "truth rejected: p = {}",
+        truth.p_value
+    );
+    assert!((estimate - 1.0).abs() < 4.0 * se);
+    // The data have 1/9 of the variance the reference states (i.e. variances 9x too large
+    // against the truth): p below 1e-12, where a t-test on the same data stays near
+    // t ≈ (1 − 9)/(9 · se) with 31 dof.
+    let (nine, _, _) = ar1_square_sum_test(&refs, 1.0 / 9.0, rho).unwrap();
+    assert!(nine.p_value < 1e-12, "9x variance: p = {:e}", nine.p_value);
+    let (ninth, _, _) = ar1_square_sum_test(&refs, 9.0, rho).unwrap();
+    assert!(
+        ninth.p_value < 1e-12,
+        "1/9 variance: p = {:e}",
+        ninth.p_value
+    );
+    // A 10 % error is rejected at this sample size (null sd of the estimate ≈ 1.7 %).
+    let (ten, _, _) = ar1_square_sum_test(&refs, 1.1, rho).unwrap();
+    assert!(
+        ten.p_value < 1e-4,
+        "10 % variance error: p = {:e}",
+        ten.p_value
     );
 }

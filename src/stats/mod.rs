@@ -20,6 +20,9 @@
 //! - [`hypothesis`]: KS and χ² goodness-of-fit tests against a normal law, the χ² test of
 //!   a variance, z-tests, the χ² combination of z-scores, and the Holm–Bonferroni
 //!   family-wise correction.
+//! - [`quadform`]: the exact null law of a sum of squares of stationary Gaussian AR(1)
+//!   series (a modal amplitude of a linear scheme) and the variance test built on it,
+//!   whose scale comes from the reference instead of the data under test.
 //!
 //! # Pitfall: correlated samples
 //! The goodness-of-fit tests ([`ks_normal`], [`chi2_gof_normal`], [`chi2_variance_test`])
@@ -37,6 +40,7 @@ pub mod acf;
 pub mod decay;
 pub mod hypothesis;
 pub mod moments;
+pub mod quadform;
 pub mod spectrum;
 
 pub use acf::{autocorrelation, autocovariance};
@@ -49,6 +53,7 @@ pub use moments::{
     IatEstimate, MeanEstimate, blocking_std_error, combine_independent, ensemble_mean,
     integrated_autocorrelation_time, mean_with_error, variance_with_error,
 };
+pub use quadform::{Ar1SquareSum, ar1_square_sum_test};
 pub use spectrum::{
     Psd, ar1_density, welch, welch_expectation, welch_expectation_ar1, welch_pooled,
 };

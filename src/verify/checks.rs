@@ -53,6 +53,9 @@ pub struct LinearEstimates {
     pub skipped: Vec<SkippedCheck>,
 }
 
+/// The kind of the exact-null test of a sum of squares ([`stats::ar1_square_sum_test`]).
+const QUADRATIC_FORM: &str = "quadratic-form";
+
 /// A check result before the family-wise correction (see [`CheckResult::statistical`]).
 fn check(
     name: String,
@@ -183,6 +186,8 @@ struct ModeData<'a> {
     thinned: Vec<f64>,
     /// The thinning stride (samples).
     stride: usize,
+    /// The exact lag correlation between successive samples, `m^every` (signed).
+    lag_correlation: f64,
     /// Time between samples of the series.
     dt_sample: f64,
     /// The mode's estimates, filled by the checks.
@@ -333,6 +338,9 @@ fn mode_data<'a>(run: &LinearRun, records: &'a [TrajectoryRecord], i: usize) -> 
         series,
         thinned,
         stride,
+        lag_correlation: mr
+            .multiplier
+            .powi(run.mode_every[i].min(i32::MAX as u64) as i32),
         dt_sample: run.mode_dt(i),
         me: ModeEstimate {
             n: mr.n,
@@ -420,22 +428,26 @@ fn time_reversal_checks(ctx: &mut LinearContext<'_>) -> Result<()> {
 fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
     let mr = &ctx.run.reference.modes[m.i];
     let prefix = &ctx.run.spec.name;
-    // The variance about the known mean 0: the average of q², tested as for the profile.
-    let squares: Vec<Vec<f64>> = m
-        .series
-        .iter()
-        .map(|s| s.iter().map(|q| q * q).collect())
-        .collect();
-    let (mean, se, o, kind, how) = series_average_test(&squares, mr.variance_discrete)?;
+    // The variance about the known mean 0: the sum of q² over every sample of every series
+    // against its exact null law. Each series of a linear scheme's modal amplitude is a
+    // stationary Gaussian AR(1) sequence with the discrete variance and lag correlation
+    // m^every (m the one-step multiplier), so the null law, its scale included, comes from
+    // the reference: a wrong variance cannot pass by inflating its own error (issue #30).
+    let rho = m.lag_correlation;
+    let (o, mean, se) = stats::ar1_square_sum_test(&m.series, mr.variance_discrete, rho)?;
     m.me.variance = (mean, se);
     ctx.out.push(check(
         format!("{prefix}/mode-variance/n={}", mr.n),
-        kind,
+        QUADRATIC_FORM,
         (mean, mr.variance_discrete, se),
         &o,
         Some(mr.variance_continuum),
         format!(
-            "time average of q^2 over {how}; ratio to equipartition {:.4}",
+            "time average of q^2 over {} series ({} samples), against its exact null law \
+             (stationary Gaussian AR(1), lag correlation {rho:.4}; saddle-point tail), error \
+             from the reference; ratio to equipartition {:.4}",
+            m.series.len(),
+            m.series.iter().map(|s| s.len()).sum::<usize>(),
             mean / mr.variance_equipartition
         ),
     ));

@@ -35,6 +35,8 @@ pub const SEED_POWER: u64 = 0x90E_0007;
 pub const SEED_DECAY_POWER: u64 = 0x90E_0008;
 pub const SEED_HOLM: u64 = 0x4013_0009;
 pub const SEED_WELCH: u64 = 0x3E1C_000A;
+/// The exact-null variance test of AR(1) series: p-value uniformity, tails, power.
+pub const SEED_QUADFORM: u64 = 0x0AD_F00B;
 
 // tests/fem_model.rs
 /// Sample covariance of the noise generators.

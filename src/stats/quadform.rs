@@ -1,0 +1,419 @@
+//! The exact null law of a sum of squares of stationary Gaussian AR(1) series, and the test
+//! of a variance built on it (issue #30: a variance test whose scale comes from the
+//! reference, not from the data under test).
+//!
+//! A series `x_1 … x_T` of a stationary Gaussian AR(1) process with variance `v` and lag-one
+//! correlation `ρ` (`|ρ| < 1`) has covariance `v R`, `R_ij = ρ^|i−j|` (the
+//! Kac–Murdock–Szegő matrix). Its sum of squares `S = Σ x_t²` is a weighted sum of χ²₁
+//! variables, with cumulant generating function
+//!
+//! ```text
+//! K(u) = ln E e^{uS} = −½ ln det(I − 2uv R),      u < 1/(2v λ_max(R)).
+//! ```
+//!
+//! `R⁻¹ = M/(1 − ρ²)` with `M` tridiagonal (diagonal `1, 1 + ρ², …, 1 + ρ², 1`, off-diagonal
+//! `−ρ`, `det M = 1 − ρ²`), so `det(I − cR) = det(M − c(1 − ρ²) I)/(1 − ρ²)`: the
+//! determinant and its first two derivatives follow in O(T) from the three-term recurrence
+//! of the leading minors, written in ratios `r_k = D_k/D_{k−1}` so that nothing overflows
+//! (`r_k = d_k − ρ²/r_{k−1}`). The ratios converge geometrically to the fixed point of the
+//! recurrence, after which the remaining interior terms are equal and are added at once.
+//! Independent series add their cumulant generating functions.
+//!
+//! Tail probabilities come from the Lugannani–Rice saddle-point formula (Lugannani & Rice
+//! 1980; Butler 2007, §1.2), whose relative error is O(1/N) uniformly in the tail for a sum of
+//! N independent terms: `P(S ≥ s) ≈ 1 − Φ(w) + φ(w)(1/ũ − 1/w)` with `K′(û) = s`,
+//! `w = sgn(û)·sqrt(2(ûs − K(û)))`, `ũ = û·sqrt(K″(û))`. Unlike a t-test, whose error comes
+//! from the spread of the data under test, the test of [`ar1_square_sum_test`] takes the whole
+//! null law from the reference (variance and lag correlation): a variance 9× too large gives
+//! an astronomically small p-value instead of a t statistic bounded by the data.
+
+use super::hypothesis::TestOutcome;
+use crate::error::{Error, Result};
+use statrs::distribution::{Continuous, ContinuousCDF, Normal};
+
+/// Relative change of the recurrence's ratio (and its derivatives) below which it is
+/// treated as converged to its fixed point.
+const FIXED_POINT_TOLERANCE: f64 = 1e-15;
+/// Below this |w| the saddle point is at the mean, where the Lugannani–Rice formula
+/// cancels; the normal approximation `Φ(−w)` is used there (the two-sided p-value is then
+/// within about 1e-4 of 1).
+const CENTRE_W: f64 = 1e-4;
+
+/// The law of `S = Σ_series Σ_t x_t²` for independent stationary Gaussian AR(1) series
+/// with a common variance and lag-one correlation (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ar1SquareSum {
+    /// Stationary variance `v` of each sample.
+    variance: f64,
+    /// Lag-one correlation `ρ` between successive samples.
+    rho: f64,
+    /// `(T, count)`: `count` series of length `T`.
+    lengths: Vec<(usize, usize)>,
+}
+
+/// `K(u)`, `K′(u)`, `K″(u)` at one argument; `None` outside the domain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cumulants {
+    /// `K(u)`.
+    pub k: f64,
+    /// `K′(u)`.
+    pub k1: f64,
+    /// `K″(u)`.
+    pub k2: f64,
+}
+
+impl Ar1SquareSum {
+    /// The law for series of the given lengths (series of length 0 are ignored).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a variance that is not finite and positive, `|ρ| ≥ 1`
+    /// or not finite, or no samples at all.
+    pub fn new(variance: f64, rho: f64, lengths: &[usize]) -> Result<Self> {
+        crate::error::require_positive("variance", variance)?;
+        if !(rho.is_finite() && rho.abs() < 1.0) {
+            return Err(Error::invalid("rho", rho, "finite, in (-1, 1)"));
+        }
+        let mut grouped: Vec<(usize, usize)> = Vec::new();
+        for &t in lengths.iter().filter(|&&t| t > 0) {
+            match grouped.iter_mut().find(|(len, _)| *len == t) {
+                Some((_, count)) => *count += 1,
+                None => grouped.push((t, 1)),
+            }
+        }
+        if grouped.is_empty() {
+            return Err(Error::invalid("series", 0, "at least one sample"));
+        }
+        grouped.sort_unstable();
+        Ok(Ar1SquareSum {
+            variance,
+            rho,
+            lengths: grouped,
+        })
+    }
+
+    /// Number of samples in all series.
+    pub fn samples(&self) -> usize {
+        self.lengths.iter().map(|(t, c)| t * c).sum()
+    }
+
+    /// `E S = N v`.
+    pub fn mean(&self) -> f64 {
+        self.samples() as f64 * self.variance
+    }
+
+    /// `Var S = 2v² Σ tr(R²)`, `tr(R²) = Σ_{i,j} ρ^{2|i−j|} = T(1 + r)/(1 − r) −
+    /// 2r(1 − r^T)/(1 − r)²`, `r = ρ²`.
+    pub fn variance(&self) -> f64 {
+        let r = self.rho * self.rho;
+        let tr: f64 = self
+            .lengths
+            .iter()
+            .map(|&(t, c)| {
+                let t = t as f64;
+                c as f64
+                    * (t * (1.0 + r) / (1.0 - r) - 2.0 * r * (1.0 - r.powf(t)) / (1.0 - r).powi(2))
+            })
+            .sum();
+        2.0 * self.variance * self.variance * tr
+    }
+
+    /// `K(u)` and its first two derivatives (module docs), or `None` where `I − 2uvR` is not
+    /// positive definite (`u` beyond the first singularity).
+    pub fn cumulants(&self, u: f64) -> Option<Cumulants> {
+        let r2 = self.rho * self.rho;
+        let q = 1.0 - r2;
+        // c' = 2uv(1 − ρ²): det(I − 2uvR) = det(M − c'I)/(1 − ρ²).
+        let dc = 2.0 * self.variance * q;
+        let c = u * dc;
+        let mut out = Cumulants {
+            k: 0.0,
+            k1: 0.0,
+            k2: 0.0,
+        };
+        for &(t, count) in &self.lengths {
+            let (l, l1, l2) = tridiagonal_log_det(t, r2, c)?;
+            let n = count as f64;
+            out.k += n * -0.5 * (l - q.ln());
+            out.k1 += n * -0.5 * l1 * dc;
+            out.k2 += n * -0.5 * l2 * dc * dc;
+        }
+        Some(out)
+    }
+
+    /// The saddle point `û` with `K′(û) = s` (`s > 0`), by safeguarded Newton iteration on a
+    /// bracket ([`Self::cumulants`] is `None` past the first singularity, `K′` increases).
+    fn saddle_point(&self, s: f64) -> Option<(f64, Cumulants)> {
+        let at = |u: f64| self.cumulants(u);
+        let mean = self.mean();
+        // A bracket [lo, hi] with K'(lo) <= s <= K'(hi) (hi may be outside the domain).
+        let scale = 1.0 / (2.0 * self.variance);
+        let (mut lo, mut hi);
+        if s >= mean {
+            lo = 0.0;
+            hi = scale;
+            // Within the domain and below s: move lo up; the domain ends below 1/(2v λ_max),
+            // λ_max <= (1 + |ρ|)/(1 − |ρ|).
+            while let Some(cu) = at(hi) {
+                if cu.k1 >= s {
+                    break;
+                }
+                lo = hi;
+                hi *= 2.0;
+            }
+        } else {
+            hi = 0.0;
+            lo = -scale;
+            while at(lo)?.k1 > s {
+                hi = lo;
+                lo *= 2.0;
+                if !lo.is_finite() {
+                    return None;
+                }
+            }
+        }
+        let mut u = 0.5 * (lo + hi);
+        for _ in 0..200 {
+            let Some(cu) = at(u) else {
+                hi = u;
+                u = 0.5 * (lo + hi);
+                continue;
+            };
+            let f = cu.k1 - s;
+            if f > 0.0 {
+                hi = u;
+            } else {
+                lo = u;
+            }
+            if f.abs() <= 1e-14 * s || (hi - lo).abs() <= 1e-16 * u.abs().max(f64::MIN_POSITIVE) {
+                return Some((u, cu));
+            }
+            let newton = u - f / cu.k2;
+            u = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+        }
+        at(u).map(|cu| (u, cu))
+    }
+
+    /// `P(S ≥ s)` by the Lugannani–Rice formula (module docs); `None` if the saddle point
+    /// cannot be found (e.g. a non-finite `s`).
+    pub fn upper_tail(&self, s: f64) -> Option<f64> {
+        if !s.is_finite() {
+            return None;
+        }
+        if s <= 0.0 {
+            return Some(1.0);
+        }
+        let (u, cu) = self.saddle_point(s)?;
+        let normal = Normal::standard();
+        let w2 = 2.0 * (u * s - cu.k);
+        let w = u.signum() * w2.max(0.0).sqrt();
+        if w.abs() < CENTRE_W {
+            return Some(normal.sf(w));
+        }
+        let ut = u * cu.k2.sqrt();
+        let p = normal.sf(w) + normal.pdf(w) * (1.0 / ut - 1.0 / w);
+        Some(p.clamp(0.0, 1.0))
+    }
+}
+
+/// `ln det(M − cI)` and its first two derivatives in `c`, for the `t × t` tridiagonal `M`
+/// of the module docs (`r2 = ρ²`), or `None` unless `M − cI` is positive definite.
+fn tridiagonal_log_det(t: usize, r2: f64, c: f64) -> Option<(f64, f64, f64)> {
+    // Diagonal entry k (0-based) of M − cI.
+    let d = |k: usize| {
+        if k == 0 || k + 1 == t {
+            1.0 - c
+        } else {
+            1.0 + r2 - c
+        }
+    };
+    if t == 1 {
+        // M = [1 − ρ²]: the 1 × 1 KMS inverse is 1, i.e. M = 1 − ρ² (det M = 1 − ρ²).
+        let a = 1.0 - r2 - c;
+        return (a > 0.0).then(|| (a.ln(), -1.0 / a, -1.0 / (a * a)));
+    }
+    // r_k, r'_k, r''_k (derivatives in c) of the ratios of leading minors.
+    let (mut r, mut r1, mut r2d) = (d(0), -1.0, 0.0);
+    if r <= 0.0 {
+        return None;
+    }
+    let (mut l, mut l1, mut l2) = (r.ln(), r1 / r, r2d / r - (r1 / r).powi(2));
+    let mut k = 1;
+    while k < t {
+        let (rp, rp1, rp2) = (r, r1, r2d);
+        r = d(k) - r2 / rp;
+        r1 = -1.0 + r2 * rp1 / (rp * rp);
+        r2d = r2 * (rp2 / (rp * rp) - 2.0 * rp1 * rp1 / (rp * rp * rp));
+        if r <= 0.0 || !r.is_finite() {
+            return None;
+        }
+        let (term, term1, term2) = (r.ln(), r1 / r, r2d / r - (r1 / r).powi(2));
+        l += term;
+        l1 += term1;
+        l2 += term2;
+        k += 1;
+        // At the fixed point every further interior entry adds the same terms: add them at
+        // once and go on with the last entry.
+        let converged =
+            |a: f64, b: f64| (a - b).abs() <= FIXED_POINT_TOLERANCE * a.abs().max(1e-300);
+        if k + 1 < t && converged(r, rp) && converged(r1, rp1) && converged(r2d, rp2) {
+            let rest = (t - 1 - k) as f64;
+            l += rest * term;
+            l1 += rest * term1;
+            l2 += rest * term2;
+            k = t - 1;
+        }
+    }
+    Some((l, l1, l2))
+}
+
+/// The two-sided test that independent stationary Gaussian AR(1) series (lag-one
+/// correlation `rho` between successive samples) have variance `variance` about mean zero:
+/// `S = Σ x²` against its exact null law ([`Ar1SquareSum`]), two-sided
+/// `p = 2 min(P(S ≥ s), P(S ≤ s))`. Returns the outcome (statistic: the normal score of
+/// `s` under the null's exact mean and variance, no degrees of freedom), the estimate
+/// `S/N`, and the null standard deviation of `S/N` (from the reference, not the data).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for invalid parameters, no samples, a non-finite sample; a
+/// [`Error::Numerical`] if the saddle point is not found.
+pub fn ar1_square_sum_test(
+    series: &[&[f64]],
+    variance: f64,
+    rho: f64,
+) -> Result<(TestOutcome, f64, f64)> {
+    for (i, s) in series.iter().enumerate() {
+        if let Some(j) = s.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(format!("series[{i}][{j}]"), s[j], "finite"));
+        }
+    }
+    let lengths: Vec<usize> = series.iter().map(|s| s.len()).collect();
+    let law = Ar1SquareSum::new(variance, rho, &lengths)?;
+    let s: f64 = series.iter().flat_map(|x| x.iter()).map(|x| x * x).sum();
+    let n = law.samples() as f64;
+    let sd = law.variance().sqrt();
+    let upper = law.upper_tail(s).ok_or_else(|| Error::Numerical {
+        routine: "ar1_square_sum_test".into(),
+        detail: format!("no saddle point for the sum of squares {s:e}"),
+    })?;
+    let p_value = (2.0 * upper.min(1.0 - upper)).clamp(0.0, 1.0);
+    Ok((
+        TestOutcome {
+            statistic: (s - law.mean()) / sd,
+            p_value,
+            dof: None,
+        },
+        s / n,
+        sd / n,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+    use statrs::distribution::ChiSquared;
+
+    /// `K, K', K''` from the eigenvalues of `vR` (dense), for a few series.
+    fn dense(v: f64, rho: f64, lengths: &[usize], u: f64) -> (f64, f64, f64) {
+        let mut out = (0.0, 0.0, 0.0);
+        for &t in lengths {
+            let r = DMatrix::from_fn(t, t, |i, j| rho.powi((i as i32 - j as i32).abs()));
+            for lam in r.symmetric_eigenvalues().iter() {
+                let a = v * lam;
+                let x = 1.0 - 2.0 * u * a;
+                out.0 += -0.5 * x.ln();
+                out.1 += a / x;
+                out.2 += 2.0 * a * a / (x * x);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn cumulants_match_the_dense_eigenvalues() {
+        for &(rho, ref lengths) in &[
+            (0.6, vec![7, 7, 3]),
+            (-0.85, vec![12]),
+            (0.0, vec![5, 1]),
+            (0.97, vec![40, 2]),
+        ] {
+            let law = Ar1SquareSum::new(1.7, rho, lengths).unwrap();
+            // Up to 90 % of the way to the first singularity 1/(2v λ_max).
+            let t = *lengths.iter().max().unwrap();
+            let r = DMatrix::from_fn(t, t, |i, j| rho.powi((i as i32 - j as i32).abs()));
+            let u_max = 1.0 / (2.0 * 1.7 * r.symmetric_eigenvalues().max());
+            for &u in &[-3.0, -0.2, 0.0, 0.3 * u_max, 0.9 * u_max] {
+                let cu = law.cumulants(u).unwrap();
+                let (k, k1, k2) = dense(1.7, rho, lengths, u);
+                for (a, b) in [(cu.k, k), (cu.k1, k1), (cu.k2, k2)] {
+                    assert!(
+                        (a - b).abs() <= 1e-10 * b.abs().max(1.0),
+                        "{rho} {u}: {a} vs {b}"
+                    );
+                }
+            }
+            // Mean and variance are K'(0) and K''(0).
+            let c0 = law.cumulants(0.0).unwrap();
+            assert!((c0.k1 - law.mean()).abs() <= 1e-12 * law.mean());
+            assert!((c0.k2 - law.variance()).abs() <= 1e-10 * law.variance());
+        }
+    }
+
+    #[test]
+    fn the_fixed_point_shortcut_is_exact() {
+        // Long series (the shortcut taken) against the same sum without it: a series of
+        // length T is the long recurrence; compare with the dense result at moderate T.
+        let law = Ar1SquareSum::new(0.3, -0.5, &[300]).unwrap();
+        let (k, k1, k2) = dense(0.3, -0.5, &[300], 0.4);
+        let cu = law.cumulants(0.4).unwrap();
+        assert!((cu.k - k).abs() <= 1e-10 * k.abs());
+        assert!((cu.k1 - k1).abs() <= 1e-10 * k1.abs());
+        assert!((cu.k2 - k2).abs() <= 1e-10 * k2.abs());
+    }
+
+    #[test]
+    fn the_domain_ends_at_the_first_singularity() {
+        // 1/(2 v λ_max): beyond it no cumulants.
+        let (v, rho, t) = (1.0_f64, 0.5_f64, 20);
+        let r = DMatrix::from_fn(t, t, |i, j| rho.powi((i as i32 - j as i32).abs()));
+        let lmax = r.symmetric_eigenvalues().max();
+        let law = Ar1SquareSum::new(v, rho, &[t]).unwrap();
+        assert!(law.cumulants(0.999 / (2.0 * v * lmax)).is_some());
+        assert!(law.cumulants(1.001 / (2.0 * v * lmax)).is_none());
+    }
+
+    #[test]
+    fn white_noise_tails_are_chi_squared() {
+        // ρ = 0: S/v is exactly χ²(N); Lugannani–Rice is within 2 % in both tails from
+        // N = 10 (its error is O(1/N)), within 0.1 % from N = 200.
+        for &n in &[10usize, 200, 5000] {
+            let law = Ar1SquareSum::new(2.0, 0.0, &[n]).unwrap();
+            let chi = ChiSquared::new(n as f64).unwrap();
+            for &p in &[1e-12, 1e-6, 1e-3, 0.05, 0.3, 0.7, 0.95, 0.999, 1.0 - 1e-6] {
+                let q = chi.inverse_cdf(p);
+                let exact = chi.sf(q);
+                let approx = law.upper_tail(2.0 * q).unwrap();
+                let (e, a) = if exact < 0.5 {
+                    (exact, approx)
+                } else {
+                    (1.0 - exact, 1.0 - approx)
+                };
+                let tol = if n < 100 { 0.02 } else { 1e-3 };
+                assert!((a / e - 1.0).abs() < tol, "n {n}, p {p}: {a:e} vs {e:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_parameters_are_refused() {
+        assert!(Ar1SquareSum::new(0.0, 0.1, &[3]).is_err());
+        assert!(Ar1SquareSum::new(1.0, 1.0, &[3]).is_err());
+        assert!(Ar1SquareSum::new(1.0, f64::NAN, &[3]).is_err());
+        assert!(Ar1SquareSum::new(1.0, 0.1, &[0]).is_err());
+        assert!(ar1_square_sum_test(&[&[1.0, f64::NAN]], 1.0, 0.0).is_err());
+    }
+}
