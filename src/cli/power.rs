@@ -42,6 +42,10 @@ pub struct PowerArgs {
     /// Output directory for power.csv, power.json and power.md.
     #[arg(short, long, default_value = "reports/power")]
     pub(super) out: PathBuf,
+    /// Measure each fault at its stated size only instead of the size ladder, e.g. to
+    /// compare budgets by the checks failed per seed.
+    #[arg(long)]
+    stated_size: bool,
 }
 
 /// Runs the power study; exit code 0 once the tables are written (a measurement: the
@@ -89,6 +93,7 @@ pub fn run(args: PowerArgs, verbosity: Verbosity) -> Result<i32> {
         alpha: args.alpha,
         out: args.out.clone(),
         progress: verbosity.shows_progress(),
+        stated_only: args.stated_size,
     })?;
     for m in &report.smallest_detected {
         println!(

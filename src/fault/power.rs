@@ -118,6 +118,9 @@ pub struct PowerOptions {
     /// Print progress on stderr: a line per row, and within a row at most one every
     /// [`crate::progress::LINE_INTERVAL`] (off with `--quiet`).
     pub progress: bool,
+    /// Measure each fault at its stated size only, not the ladder (to compare budgets: the
+    /// checks failed per seed at the size a careless bug has).
+    pub stated_only: bool,
 }
 
 /// One fault, scene and size over the seeds.
@@ -137,6 +140,9 @@ pub struct PowerRow {
     pub seeds: u64,
     /// Seeds whose verification failed its checks (exit-1 class).
     pub failed_checks: u64,
+    /// Failed checks per seed, on average over the seeds (a run failure counts none): how
+    /// strongly the budget detects the fault, comparable between budgets.
+    pub mean_failed_checks: f64,
     /// Seeds whose run failed (exit 3).
     pub run_failures: u64,
     /// Seeds refused as bad input (exit 2): a fault should never cause one.
@@ -291,6 +297,7 @@ fn measure(
     let start = Instant::now();
     let (mut failed, mut crashed, mut refused) = (0u64, 0u64, 0u64);
     let mut names: BTreeMap<String, u64> = BTreeMap::new();
+    let mut total_failed = 0u64;
     let mut first_error = None;
     let mut last_line = Instant::now();
     for (k, &seed) in seeds.iter().enumerate() {
@@ -310,6 +317,7 @@ fn measure(
             Outcome::Passed => {}
             Outcome::FailedChecks(checks) => {
                 failed += 1;
+                total_failed += checks.len() as u64;
                 for c in checks {
                     *names.entry(c).or_default() += 1;
                 }
@@ -336,6 +344,7 @@ fn measure(
         stated: fault.size == fault.kind.stated_size(),
         seeds: n,
         failed_checks: failed,
+        mean_failed_checks: total_failed as f64 / n as f64,
         run_failures: crashed,
         input_errors: refused,
         detection_rate: detected as f64 / n as f64,
@@ -421,7 +430,12 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
             .into_iter()
             .filter(|t| opts.scenes.is_empty() || opts.scenes.iter().any(|s| s == t.scene));
         for target in chosen {
-            for size in kind.ladder() {
+            let sizes = if opts.stated_only {
+                vec![kind.stated_size()]
+            } else {
+                kind.ladder()
+            };
+            for size in sizes {
                 // Detection grows with the size: once a size is detected in every seed,
                 // the larger ones are not run (saves most of the study's time).
                 if rows.last().is_some_and(|r: &PowerRow| {
@@ -438,13 +452,14 @@ pub fn run_power(opts: &PowerOptions) -> Result<PowerReport> {
                 let fault = Fault::new(kind, size)?;
                 let row = measure(&target, fault, &seeds, opts, &scratch)?;
                 say(format!(
-                    "{:<24} {:<20} s = {:<8} detected {:>3}/{} (checks {}, run failures {}, input errors {}) [{:.2}, {:.2}]  {:.1} s/seed",
+                    "{:<24} {:<20} s = {:<8} detected {:>3}/{} (checks {}, {:.1} failed checks per seed, run failures {}, input errors {}) [{:.2}, {:.2}]  {:.1} s/seed",
                     kind.name(),
                     target.scene,
                     size,
                     row.failed_checks + row.run_failures + row.input_errors,
                     row.seeds,
                     row.failed_checks,
+                    row.mean_failed_checks,
                     row.run_failures,
                     row.input_errors,
                     row.interval[0],
@@ -488,6 +503,7 @@ fn csv_text(report: &PowerReport) -> Result<String> {
             "stated",
             "seeds",
             "failed_checks",
+            "mean_failed_checks",
             "run_failures",
             "input_errors",
             "detection_rate",
@@ -509,6 +525,7 @@ fn csv_text(report: &PowerReport) -> Result<String> {
             r.stated.to_string(),
             r.seeds.to_string(),
             r.failed_checks.to_string(),
+            r.mean_failed_checks.to_string(),
             r.run_failures.to_string(),
             r.input_errors.to_string(),
             r.detection_rate.to_string(),
@@ -534,8 +551,8 @@ fn markdown(report: &PowerReport) -> String {
         report.seeds.last().copied().unwrap_or(0),
         report.wall_seconds
     );
-    s.push_str("| fault | scene (runs) | size | detected | checks / run failed / refused | 95 % interval |\n");
-    s.push_str("|---|---|---|---|---|---|\n");
+    s.push_str("| fault | scene (runs) | size | detected | checks / run failed / refused | failed checks per seed | 95 % interval |\n");
+    s.push_str("|---|---|---|---|---|---|---|\n");
     for r in &report.rows {
         let runs = if r.runs.is_empty() {
             String::new()
@@ -543,7 +560,7 @@ fn markdown(report: &PowerReport) -> String {
             format!(" ({})", r.runs.join(", "))
         };
         s.push_str(&format!(
-            "| {} | {}{} | {}{} | {}/{} | {} / {} / {} | [{:.2}, {:.2}] |\n",
+            "| {} | {}{} | {}{} | {}/{} | {} / {} / {} | {:.1} | [{:.2}, {:.2}] |\n",
             r.fault,
             r.scene,
             runs,
@@ -554,6 +571,7 @@ fn markdown(report: &PowerReport) -> String {
             r.failed_checks,
             r.run_failures,
             r.input_errors,
+            r.mean_failed_checks,
             r.interval[0],
             r.interval[1]
         ));
@@ -633,6 +651,7 @@ mod tests {
             stated: size == FaultKind::NoiseVariance.stated_size(),
             seeds: 20,
             failed_checks: 0,
+            mean_failed_checks: 0.0,
             run_failures: 0,
             input_errors: 0,
             detection_rate: rate,
