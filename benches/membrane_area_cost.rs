@@ -32,7 +32,9 @@
 //! ```
 //!
 //! Further arguments: `soft` or `stiff` (one set-up), a proposal's name (`crank-nicolson`,
-//! `newton`, `ornstein-uhlenbeck`: those only), `verbose` (each strain on stderr).
+//! `newton`, `newton-slow`, `ornstein-uhlenbeck`: those only), `verbose` (each strain on
+//! stderr). `newton-slow` is [`Proposal::Newton`] with the rank-one term on the slowest
+//! groups only ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1).
 
 use langevin_fem::dynamics::{ModalMetropolis, Proposal, Trajectory};
 use langevin_fem::fem::area::AreaMembrane;
@@ -49,6 +51,9 @@ const SEED: u64 = 20_261_210;
 const ELEMENTS: usize = 16;
 /// Area modulus K_A (units a = kT = 1).
 const AREA_MODULUS: f64 = 1e6;
+/// `newton-slow`: the rank-one term on the groups with rates ≤ this × λ_1
+/// ([`ModalMetropolis::with_rank_one_limit`]): the buckling modes only.
+const SLOW_RATES: f64 = 5.0;
 /// Number of strains of the curve.
 const STRAINS: usize = 24;
 /// Target standard error of ⟨σ⟩/σ_c0.
@@ -166,10 +171,12 @@ struct Point {
 }
 
 /// Runs one point (see the module docs).
+#[allow(clippy::too_many_arguments)]
 fn run_point(
     model: &AreaMembrane,
     modes: &PlateModes,
     kind: Proposal,
+    rank_one_limit: Option<f64>,
     dt_tau1: f64,
     tau1: f64,
     exact: f64,
@@ -182,6 +189,9 @@ fn run_point(
         .expect("chain")
         .with_proposal(kind)
         .expect("proposal");
+    if let Some(limit) = rank_one_limit {
+        chain = chain.with_rank_one_limit(limit / tau1);
+    }
     for _ in 0..SCENE_BURN_IN_STEPS {
         chain.step(&mut rng);
     }
@@ -242,10 +252,12 @@ fn main() {
     } else {
         &[0.02, 0.08, 0.32, 1.0]
     };
+    // (name, proposal, rank-one term on the groups with rates ≤ this × λ_1 only)
     let proposals = [
-        ("crank-nicolson", Proposal::CrankNicolson),
-        ("newton", Proposal::Newton),
-        ("ornstein-uhlenbeck", Proposal::OrnsteinUhlenbeck),
+        ("crank-nicolson", Proposal::CrankNicolson, None),
+        ("newton", Proposal::Newton, None),
+        ("newton-slow", Proposal::Newton, Some(SLOW_RATES)),
+        ("ornstein-uhlenbeck", Proposal::OrnsteinUhlenbeck, None),
     ];
     println!(
         "membrane under imposed area, {ELEMENTS} x {ELEMENTS} elements, {STRAINS} strains, se <= {TARGET} sigma_c0{}",
@@ -298,7 +310,7 @@ fn main() {
                 (i, r, m, theory.tension_ratio(r).expect("exact tension"))
             })
             .collect();
-        for (label, kind) in proposals {
+        for (label, kind, limit) in proposals {
             if !chosen(label, &proposals.map(|p| p.0)) {
                 continue;
             }
@@ -309,7 +321,7 @@ fn main() {
                 let points: Vec<Point> = models
                     .iter()
                     .map(|(i, _, m, exact)| {
-                        run_point(m, &modes, kind, dt_tau1, tau1, *exact, *i as u64)
+                        run_point(m, &modes, kind, limit, dt_tau1, tau1, *exact, *i as u64)
                     })
                     .collect();
                 let total: f64 = points.iter().map(|p| p.cpu_needed).sum::<f64>() * scale;
