@@ -47,7 +47,7 @@ pub use discrete::DiscreteLaw;
 pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
-pub use modal_metropolis::ModalMetropolis;
+pub use modal_metropolis::{ModalMetropolis, Proposal};
 pub use modal_step::ModalStep;
 pub use nonlinear::{NonlinearIntegrator, NonlinearStep};
 

@@ -1,0 +1,364 @@
+//! Cost of the membrane's tension–strain curve under imposed projected area (issue #28,
+//! point 4 "Speed"): the CPU-seconds for ⟨σ⟩ at 24 strains with standard error
+//! ≤ 0.01 σ_c0 each, on a 16 × 16 mesh, for both set-ups of the scenes
+//! (`verification/membrane-area-soft.toml`: κ = 20 kT, periodic;
+//! `verification/membrane-area-stiff.toml`: κ = 200 kT, simply supported; K_A = 10⁶,
+//! a = b = kT = ξ = 1), and for each proposal of [`ModalMetropolis`] ([`Proposal`]).
+//!
+//! A **budget by target precision** as for Fig. 2 (docs/src/reference/performance.md): at
+//! each strain and candidate step, one trajectory (the start of the scenes: exact free
+//! bending equilibrium, moved onto the buckled branch; burn-in of 5 τ1 at the scenes'
+//! 0.02 τ1 with the proposal under test, then [`OWN_BURN_IN`] steps at the candidate step,
+//! neither timed) records σ/σ_c0 at every step for a timed run of at least
+//! [`MIN_CPU`] CPU-s and [`MIN_TAU`] integrated autocorrelation times (at most
+//! [`MAX_CPU`]). Its standard error (Sokal's windowed τ_int, [`mean_with_error`]) scales
+//! as T^−½, so the sampling needs `cpu_run · (se/0.01)²` CPU-s for 0.01 σ_c0; the
+//! burn-in adds the 250 steps of the scenes plus 20 τ_int steps at the chosen step. The
+//! curve's cost is the sum over the strains, each at its cheapest candidate step (an
+//! ideal step search; the per-step rows give each step's own sum). One trajectory per
+//! strain: splitting it over cores adds one burn-in per trajectory.
+//!
+//! The 24 strains are spread like the scenes' 12 `strain_ratios` (piecewise linear in
+//! the index, [`curve_ratios`]). Every mean is also compared with the exact discrete
+//! theory of the same mesh ([`AreaTheory::discrete`]): the `max |z|` column, which should
+//! stay below ~3.5 for an exact chain.
+//!
+//! CPU time is the thread's own (`CLOCK_THREAD_CPUTIME_ID`). Fixed seeds; the figures vary
+//! with the timing noise of a shared machine (±20 %) and the statistical error of τ_int.
+//!
+//! ```sh
+//! cargo bench --bench membrane_area_cost             # 24 strains, 4 steps (~10 min)
+//! cargo bench --bench membrane_area_cost -- quick    # 6 of the 24 strains, 3 steps (~2 min)
+//! ```
+//!
+//! Further arguments: `soft` or `stiff` (one set-up), a proposal's name (`crank-nicolson`,
+//! `newton`, `newton-slow`, `ornstein-uhlenbeck`: those only), `verbose` (each strain on
+//! stderr). `newton-slow` is [`Proposal::Newton`] with the rank-one term on the slowest
+//! groups only ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1).
+
+use langevin_fem::dynamics::{ModalMetropolis, Proposal, Trajectory};
+use langevin_fem::fem::area::AreaMembrane;
+use langevin_fem::fem::plate_area::{AreaParams, AreaTheory};
+use langevin_fem::fem::plate_modes::PlateModes;
+use langevin_fem::rng::trajectory_rng;
+use langevin_fem::spectral::membrane::{MembraneBoundary, MembraneParams};
+use langevin_fem::stats::mean_with_error;
+use std::time::Duration;
+
+/// Master seed.
+const SEED: u64 = 20_261_210;
+/// Mesh: elements per side.
+const ELEMENTS: usize = 16;
+/// Area modulus K_A (units a = kT = 1).
+const AREA_MODULUS: f64 = 1e6;
+/// `newton-slow`: the rank-one term on the groups with rates ≤ this × λ_1
+/// ([`ModalMetropolis::with_rank_one_limit`]): the buckling modes only.
+const SLOW_RATES: f64 = 5.0;
+/// Number of strains of the curve.
+const STRAINS: usize = 24;
+/// Target standard error of ⟨σ⟩/σ_c0.
+const TARGET: f64 = 0.01;
+/// The scenes' burn-in: 5 τ1 at 0.02 τ1.
+const SCENE_BURN_IN_STEPS: u64 = 250;
+const SCENE_BURN_IN_DT_TAU1: f64 = 0.02;
+/// Untimed steps at the candidate step before the timed run.
+const OWN_BURN_IN: u64 = 500;
+/// Timed run per point: at least this CPU time and this many τ_int, at most `MAX_CPU`.
+const MIN_CPU: f64 = 0.25;
+const MIN_TAU: f64 = 200.0;
+const MAX_CPU: f64 = 2.0;
+
+/// CPU time of the calling thread (wall time where no thread clock is available).
+#[cfg(target_os = "linux")]
+fn cpu_now() -> Duration {
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: i64,
+        tv_nsec: i64,
+    }
+    unsafe extern "C" {
+        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+    }
+    /// `CLOCK_THREAD_CPUTIME_ID` of Linux.
+    const THREAD_CPUTIME: i32 = 3;
+    let mut t = Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid, writable timespec (two i64 on 64-bit Linux, the layout of
+    // `struct timespec`), and the clock id is a constant Linux defines.
+    let rc = unsafe { clock_gettime(THREAD_CPUTIME, &mut t) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
+    Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
+}
+
+/// CPU time of the calling thread (wall time where no thread clock is available).
+#[cfg(not(target_os = "linux"))]
+fn cpu_now() -> Duration {
+    use std::sync::OnceLock;
+    use std::time::Instant;
+    static START: OnceLock<Instant> = OnceLock::new();
+    START.get_or_init(Instant::now).elapsed()
+}
+
+/// One set-up: a scene's membrane on the bench's mesh.
+struct SetUp {
+    name: &'static str,
+    membrane: MembraneParams,
+    /// The scene's `strain_ratios`.
+    scene_ratios: &'static [f64],
+}
+
+fn set_ups() -> [SetUp; 2] {
+    let base = MembraneParams {
+        tension: 0.0,
+        drag: 1.0,
+        kt: 1.0,
+        width: 1.0,
+        height: 1.0,
+        ..MembraneParams::default()
+    };
+    [
+        SetUp {
+            name: "soft (kappa 20, periodic)",
+            membrane: MembraneParams {
+                bending_rigidity: 20.0,
+                boundary: MembraneBoundary::Periodic,
+                ..base
+            },
+            scene_ratios: &[
+                -5.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 20.0, 30.0,
+            ],
+        },
+        SetUp {
+            name: "stiff (kappa 200, simply supported)",
+            membrane: MembraneParams {
+                bending_rigidity: 200.0,
+                boundary: MembraneBoundary::SimplySupported,
+                ..base
+            },
+            scene_ratios: &[
+                -2.0, -1.0, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 10.0,
+            ],
+        },
+    ]
+}
+
+/// `STRAINS` ratios spread like `scene`: `scene` piecewise linear in its index, sampled
+/// at `STRAINS` equally spaced positions from the first to the last.
+fn curve_ratios(scene: &[f64]) -> Vec<f64> {
+    let last = (scene.len() - 1) as f64;
+    (0..STRAINS)
+        .map(|i| {
+            let x = i as f64 * last / (STRAINS - 1) as f64;
+            let j = (x.floor() as usize).min(scene.len() - 2);
+            let t = x - j as f64;
+            scene[j] + t * (scene[j + 1] - scene[j])
+        })
+        .collect()
+}
+
+/// What one timed run gives.
+struct Point {
+    acceptance: f64,
+    /// τ_int of σ in steps (½-convention).
+    tau_int: f64,
+    ns_per_step: f64,
+    /// CPU-s for se = `TARGET`, burn-in included.
+    cpu_needed: f64,
+    /// (⟨σ⟩ − exact)/se.
+    z: f64,
+}
+
+/// Runs one point (see the module docs).
+#[allow(clippy::too_many_arguments)]
+fn run_point(
+    model: &AreaMembrane,
+    modes: &PlateModes,
+    kind: Proposal,
+    rank_one_limit: Option<f64>,
+    dt_tau1: f64,
+    tau1: f64,
+    exact: f64,
+    stream: u64,
+) -> Point {
+    let unit = model.buckling_stress();
+    let mut rng = trajectory_rng(SEED, stream);
+    let burn_dt = SCENE_BURN_IN_DT_TAU1 * tau1;
+    let mut chain = ModalMetropolis::for_membrane(model, modes, burn_dt, &mut rng)
+        .expect("chain")
+        .with_proposal(kind)
+        .expect("proposal");
+    if let Some(limit) = rank_one_limit {
+        chain = chain.with_rank_one_limit(limit / tau1);
+    }
+    for _ in 0..SCENE_BURN_IN_STEPS {
+        chain.step(&mut rng);
+    }
+    chain.set_dt(dt_tau1 * tau1).expect("dt");
+    for _ in 0..OWN_BURN_IN {
+        chain.step(&mut rng);
+    }
+    assert!(chain.is_finite(), "diverged");
+    let (p0, a0) = (chain.proposed, chain.accepted);
+    let mut sigma: Vec<f64> = Vec::new();
+    let mut cpu = 0.0;
+    let mut chunk = 1000_usize;
+    let estimate = loop {
+        let start = cpu_now();
+        for _ in 0..chunk {
+            chain.step(&mut rng);
+            sigma.push(-chain.force() / unit);
+        }
+        cpu += (cpu_now() - start).as_secs_f64();
+        chunk = sigma.len();
+        if cpu < MIN_CPU {
+            continue;
+        }
+        match mean_with_error(&sigma) {
+            Ok(e) if e.tau_int * MIN_TAU <= sigma.len() as f64 || cpu >= MAX_CPU => break Some(e),
+            // a chain that (nearly) never moves has no τ_int: its cost is infinite
+            Err(_) if cpu >= MAX_CPU => break None,
+            _ => {}
+        }
+    };
+    let acceptance = (chain.accepted - a0) as f64 / (chain.proposed - p0) as f64;
+    let steps = sigma.len() as f64;
+    let ns_per_step = cpu * 1e9 / steps;
+    let Some(estimate) = estimate else {
+        return Point {
+            acceptance,
+            tau_int: f64::INFINITY,
+            ns_per_step,
+            cpu_needed: f64::INFINITY,
+            z: f64::NAN,
+        };
+    };
+    let sampling = cpu * (estimate.std_error / TARGET).powi(2);
+    let burn_in = (SCENE_BURN_IN_STEPS as f64 + 20.0 * estimate.tau_int) * ns_per_step * 1e-9;
+    Point {
+        acceptance,
+        tau_int: estimate.tau_int,
+        ns_per_step,
+        cpu_needed: sampling + burn_in,
+        z: (estimate.mean - exact) / estimate.std_error,
+    }
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let steps: &[f64] = if quick {
+        &[0.08, 0.32, 1.0]
+    } else {
+        &[0.02, 0.08, 0.32, 1.0]
+    };
+    // (name, proposal, rank-one term on the groups with rates ≤ this × λ_1 only)
+    let proposals = [
+        ("crank-nicolson", Proposal::CrankNicolson, None),
+        ("newton", Proposal::Newton, None),
+        ("newton-slow", Proposal::Newton, Some(SLOW_RATES)),
+        ("ornstein-uhlenbeck", Proposal::OrnsteinUhlenbeck, None),
+    ];
+    println!(
+        "membrane under imposed area, {ELEMENTS} x {ELEMENTS} elements, {STRAINS} strains, se <= {TARGET} sigma_c0{}",
+        if quick {
+            " (quick: every 4th strain, sums scaled by 4)"
+        } else {
+            ""
+        }
+    );
+    println!(
+        "| set-up | proposal | dt/tau1 | acceptance | tau_int of sigma (steps, min-max) | CPU ns/step | max abs z | **CPU-s for the curve** |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
+    let args: Vec<String> = std::env::args().collect();
+    let chosen = |name: &str, all: &[&str]| {
+        !all.iter().any(|n| args.iter().any(|a| a == n)) || args.iter().any(|a| a == name)
+    };
+    for set_up in set_ups() {
+        if !chosen(
+            set_up.name.split(' ').next().unwrap_or(""),
+            &["soft", "stiff"],
+        ) {
+            continue;
+        }
+        let k_a = AREA_MODULUS;
+        let base = AreaMembrane::new(set_up.membrane, ELEMENTS, ELEMENTS, k_a, 0.0).expect("model");
+        let modes = PlateModes::new(base.plate()).expect("plate modes");
+        let sigma_c0 = base.buckling_stress();
+        let tau1 = set_up.membrane.tau1();
+        let theory = AreaTheory::discrete(
+            &AreaParams::from_membrane(&set_up.membrane, k_a),
+            ELEMENTS,
+            ELEMENTS,
+        )
+        .expect("theory");
+        let all = curve_ratios(set_up.scene_ratios);
+        let ratios: Vec<(usize, f64)> = all
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|(i, _)| !quick || i % 4 == 1)
+            .collect();
+        let scale = STRAINS as f64 / ratios.len() as f64;
+        let models: Vec<(usize, f64, AreaMembrane, f64)> = ratios
+            .iter()
+            .map(|&(i, r)| {
+                let m =
+                    AreaMembrane::new(set_up.membrane, ELEMENTS, ELEMENTS, k_a, r * sigma_c0 / k_a)
+                        .expect("model");
+                (i, r, m, theory.tension_ratio(r).expect("exact tension"))
+            })
+            .collect();
+        for (label, kind, limit) in proposals {
+            if !chosen(label, &proposals.map(|p| p.0)) {
+                continue;
+            }
+            // best[strain] = the cheapest step's CPU-s
+            let mut best = vec![f64::INFINITY; models.len()];
+            let mut best_dt = vec![0.0; models.len()];
+            for &dt_tau1 in steps {
+                let points: Vec<Point> = models
+                    .iter()
+                    .map(|(i, _, m, exact)| {
+                        run_point(m, &modes, kind, limit, dt_tau1, tau1, *exact, *i as u64)
+                    })
+                    .collect();
+                let total: f64 = points.iter().map(|p| p.cpu_needed).sum::<f64>() * scale;
+                for (j, p) in points.iter().enumerate() {
+                    if p.cpu_needed < best[j] {
+                        best[j] = p.cpu_needed;
+                        best_dt[j] = dt_tau1;
+                    }
+                }
+                let acc = points.iter().map(|p| p.acceptance).sum::<f64>() / points.len() as f64;
+                let tmin = points
+                    .iter()
+                    .map(|p| p.tau_int)
+                    .fold(f64::INFINITY, f64::min);
+                let tmax = points.iter().map(|p| p.tau_int).fold(0.0, f64::max);
+                let ns = points.iter().map(|p| p.ns_per_step).sum::<f64>() / points.len() as f64;
+                let zmax = points.iter().map(|p| p.z.abs()).fold(0.0, f64::max); // NaN (stuck) ignored
+                println!(
+                    "| {} | {label} | {dt_tau1} | {acc:.3} | {tmin:.1}-{tmax:.0} | {ns:.0} | {zmax:.1} | {total:.1} |",
+                    set_up.name
+                );
+                if std::env::args().any(|a| a == "verbose") {
+                    for ((_, r, _, _), p) in models.iter().zip(&points) {
+                        eprintln!(
+                            "    eps/eps_c0 {r:6.2}: acc {:.3} tau {:.1} ns {:.0} cpu {:.3} z {:+.2}",
+                            p.acceptance, p.tau_int, p.ns_per_step, p.cpu_needed, p.z
+                        );
+                    }
+                }
+            }
+            let total: f64 = best.iter().sum::<f64>() * scale;
+            let chosen: Vec<String> = best_dt.iter().map(|d| format!("{d}")).collect();
+            println!(
+                "| {} | {label} | best per strain ({}) | | | | | **{total:.1}** |",
+                set_up.name,
+                chosen.join(" ")
+            );
+        }
+    }
+}
