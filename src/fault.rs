@@ -95,6 +95,12 @@ pub enum FaultKind {
     /// stretch rigidity. Compression scenes. Stated size 0.5 (⟨F⟩ depends on EA only in
     /// tension and near the Euler strain; above it F ≈ F_c0 whatever EA).
     AxialStretchRigidity,
+    /// Proposal force error: the Metropolis chain's proposal kernel uses the constraint
+    /// force × (1 + s) (a θ-scheme its explicit force), the energy and the acceptance the
+    /// true one. The chain stays exact, so the stationary law is right and only the
+    /// dynamics are wrong (issue #30: it passed every check at 5 %). Compression scenes'
+    /// modal chains (uniform meshes, membranes under imposed area). Stated size 0.05.
+    ProposalForce,
     /// Shared-model fault: the element stiffness matrix × (1 + s) in the shared
     /// [`BeamModel`], used by the integrator **and** the exact discrete references (so the
     /// generalized rates scale by 1 + s). Linear finite-element scenes. Stated size 0.02.
@@ -116,7 +122,7 @@ pub struct Fault {
 
 impl FaultKind {
     /// Every fault, in catalogue order.
-    pub const ALL: [FaultKind; 11] = [
+    pub const ALL: [FaultKind; 12] = [
         FaultKind::NoiseVariance,
         FaultKind::NoiseTimeScaling,
         FaultKind::IntegratorStiffness,
@@ -126,6 +132,7 @@ impl FaultKind {
         FaultKind::ComponentNoiseSharing,
         FaultKind::VonKarmanStrain,
         FaultKind::AxialStretchRigidity,
+        FaultKind::ProposalForce,
         FaultKind::SharedStiffness,
         FaultKind::SharedHinge,
     ];
@@ -142,6 +149,7 @@ impl FaultKind {
             FaultKind::ComponentNoiseSharing => "component-noise-sharing",
             FaultKind::VonKarmanStrain => "von-karman-strain",
             FaultKind::AxialStretchRigidity => "axial-stretch-rigidity",
+            FaultKind::ProposalForce => "proposal-force",
             FaultKind::SharedStiffness => "shared-stiffness",
             FaultKind::SharedHinge => "shared-hinge",
         }
@@ -177,6 +185,9 @@ impl FaultKind {
             FaultKind::AxialStretchRigidity => {
                 "axial solve with EA x (1+s): the chain's force and stretching energy"
             }
+            FaultKind::ProposalForce => {
+                "Metropolis proposal's constraint force x (1+s), energy and acceptance true"
+            }
             FaultKind::SharedStiffness => {
                 "shared element stiffness x (1+s): integrator and exact discrete references"
             }
@@ -195,7 +206,9 @@ impl FaultKind {
             | FaultKind::IntegratorDrag
             | FaultKind::CorrelatedNoise => 0.1,
             FaultKind::AxialStretchRigidity => 0.5,
-            FaultKind::IntegratorStiffness | FaultKind::VonKarmanStrain => 0.05,
+            FaultKind::IntegratorStiffness
+            | FaultKind::VonKarmanStrain
+            | FaultKind::ProposalForce => 0.05,
             FaultKind::SharedStiffness => 0.02,
             FaultKind::IntegratorHinge
             | FaultKind::ComponentNoiseSharing
@@ -247,9 +260,9 @@ impl FaultKind {
             | FaultKind::SharedStiffness
             | FaultKind::SharedHinge => model == ModelKind::Fem,
             FaultKind::ComponentNoiseSharing => model == ModelKind::Fem && dims == 3,
-            FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
-                model == ModelKind::Compression
-            }
+            FaultKind::VonKarmanStrain
+            | FaultKind::AxialStretchRigidity
+            | FaultKind::ProposalForce => model == ModelKind::Compression,
         }
     }
 
@@ -266,6 +279,7 @@ impl FaultKind {
             | FaultKind::ComponentNoiseSharing => true,
             FaultKind::VonKarmanStrain
             | FaultKind::AxialStretchRigidity
+            | FaultKind::ProposalForce
             | FaultKind::SharedStiffness
             | FaultKind::SharedHinge => false,
         }
@@ -586,6 +600,18 @@ pub(crate) fn compression_model(fault: Option<Fault>, beam: BeamModel) -> Result
         FaultKind::IntegratorStiffness => beam.with_scaled_matrices(1.0 + s, 1.0, 1.0),
         FaultKind::VonKarmanStrain => beam.with_scaled_matrices(1.0, 1.0, 1.0 + 2.0 * s),
         _ => Ok(beam),
+    }
+}
+
+/// Hook of the compression scenes' modal chains: the factor on the force their proposal
+/// kernel uses ([`FaultKind::ProposalForce`]: 1 + s; 1 otherwise).
+pub(crate) fn proposal_force_factor(fault: Option<Fault>) -> f64 {
+    match fault {
+        Some(Fault {
+            kind: FaultKind::ProposalForce,
+            size,
+        }) => 1.0 + size,
+        _ => 1.0,
     }
 }
 
@@ -1325,32 +1351,52 @@ mod tests {
     /// that fails; without the fault it passes. Deterministic (fixed seed).
     #[test]
     fn axial_residual_check_finds_a_tiny_von_karman_strain_error() {
-        let scene = builtin::find("compression-2d").unwrap().load().unwrap();
-        let summary = |scene: Scene, tag: &str| {
-            let summary = quick_verify(scene, &format!("axial-{tag}")).unwrap();
+        let fault = Fault::new(FaultKind::VonKarmanStrain, 5e-5).unwrap();
+        only_the_residual_fails("compression-2d", fault, "/axial-equilibrium");
+    }
+
+    /// Quick verification of built-in scene `name` without and with `fault`: the checks
+    /// named `…suffix` (one per run) pass without it and fail with it, and nothing else
+    /// fails with it.
+    fn only_the_residual_fails(name: &str, fault: Fault, suffix: &str) {
+        let scene = builtin::find(name).unwrap().load().unwrap();
+        let checks = |scene: Scene, tag: &str| {
+            let summary = quick_verify(scene, &format!("{suffix}-{name}-{tag}")).unwrap();
             summary.scenes.into_iter().next().unwrap().checks
         };
-        let axial = |checks: &[CheckResult]| -> Vec<bool> {
+        let flags = |checks: &[CheckResult]| -> Vec<bool> {
             checks
                 .iter()
-                .filter(|c| c.name.ends_with("/axial-equilibrium"))
+                .filter(|c| c.name.ends_with(suffix))
                 .map(|c| c.passed)
                 .collect()
         };
-        let clean = summary(scene.clone(), "clean");
-        assert_eq!(axial(&clean), vec![true; scene.runs.len()]);
-        let fault = Fault::new(FaultKind::VonKarmanStrain, 5e-5).unwrap();
-        let faulty = summary(scene.clone().with_fault(fault), "vk");
-        assert_eq!(axial(&faulty), vec![false; scene.runs.len()]);
+        let clean = checks(scene.clone(), "clean");
+        assert_eq!(flags(&clean), vec![true; scene.runs.len()], "{name}");
+        let faulty = checks(scene.clone().with_fault(fault), "faulty");
+        assert_eq!(flags(&faulty), vec![false; scene.runs.len()], "{name}");
         let failed: Vec<_> = faulty
             .iter()
             .filter(|c| !c.passed)
             .map(|c| &c.name)
             .collect();
         assert!(
-            failed.iter().all(|n| n.ends_with("/axial-equilibrium")),
-            "{failed:?}"
+            failed.iter().all(|n| n.ends_with(suffix)),
+            "{name}: {failed:?}"
         );
+    }
+
+    /// **A wrong force in the Metropolis proposal fails at quick** (issue #30). At 5 % it
+    /// passed every statistical check (the chain stays exact); every run's
+    /// `proposal-drift` residual fails, in both filament compression scenes, and it is the
+    /// only check that fails there (the stationary law is right); without the fault it
+    /// passes. Deterministic (fixed seed).
+    #[test]
+    fn proposal_drift_check_finds_a_five_percent_proposal_force_error() {
+        let fault = Fault::new(FaultKind::ProposalForce, 0.05).unwrap();
+        for name in ["compression-2d", "compression-3d"] {
+            only_the_residual_fails(name, fault, "/proposal-drift");
+        }
     }
 
     /// **A bug in the shared model fails `verify` (exit 1) at the quick budget.** A 2 %

@@ -2293,7 +2293,7 @@ fn manifest_cases() -> Vec<Case> {
             M,
             VerifySet,
             "record-undecodable-magic",
-            &["shards/2", "metropolis.frc", "LFEMFRC1|magic"],
+            &["shards/2", "metropolis.frc", "LFEMFRC2|magic"],
             |_, r| {
                 replace_record(r, "shards/2", FRC_REC, |mut b| {
                     b[..8].copy_from_slice(b"LFEMXXX9");

@@ -23,7 +23,7 @@ pub struct PowerArgs {
     /// Fault to measure (repeatable; default: the whole catalogue): noise-variance,
     /// noise-time-scaling, integrator-stiffness, integrator-drag, correlated-noise,
     /// integrator-hinge, component-noise-sharing, von-karman-strain,
-    /// axial-stretch-rigidity, shared-stiffness or shared-hinge.
+    /// axial-stretch-rigidity, proposal-force, shared-stiffness or shared-hinge.
     #[arg(long = "fault", value_name = "NAME")]
     faults: Vec<String>,
     /// Target scene to measure (repeatable; default: every target scene of each fault):

@@ -24,6 +24,8 @@
 //! the acceptance of the nodal scheme and the chain is exact at any Δt. Proposals from or
 //! into a state whose `A_a` is not positive definite are rejected.
 
+mod drift;
+
 use super::driver::Trajectory;
 use crate::error::{Error, Result};
 use crate::fem::area::AreaMembrane;
@@ -50,6 +52,9 @@ struct Evaluation {
     g: Vec<f64>,
     energy: f64,
     force: f64,
+    /// The force the proposal kernel uses: `force` (× the injected fault's factor,
+    /// [`ModalMetropolis::with_proposal_force_factor`]).
+    kernel_force: f64,
     /// `[inv00, inv01, inv11]` of each 2×2 block of `A_a`, then `[1/a, 0, 0]` per 1×1 block.
     inverse: Vec<[f64; 3]>,
     /// The inverse of each general block of `A_a` (row-major, stride 4).
@@ -145,6 +150,9 @@ pub struct ModalMetropolis<'m> {
     /// `Some(θ)`: the θ-scheme with the constraint force explicit instead of the
     /// Metropolis chain ([`Self::with_theta`]).
     theta: Option<f64>,
+    /// The factor on the force the proposal kernel uses (1; an injected fault otherwise,
+    /// [`Self::with_proposal_force_factor`]).
+    proposal_force_factor: f64,
     /// Proposals made.
     pub proposed: u64,
     /// Accepted proposals.
@@ -287,6 +295,7 @@ impl<'m> ModalMetropolis<'m> {
             g: vec![0.0; nc * n],
             energy: 0.0,
             force: 0.0,
+            kernel_force: 0.0,
             inverse: vec![[0.0; 3]; blocks],
             group_inverse: vec![[0.0; 16]; groups.len()],
             log_det: None,
@@ -311,6 +320,7 @@ impl<'m> ModalMetropolis<'m> {
             proposal: empty,
             z: vec![0.0; nc * n],
             theta: None,
+            proposal_force_factor: 1.0,
             proposed: 0,
             accepted: 0,
             kind: Proposal::CrankNicolson,
@@ -382,6 +392,19 @@ impl<'m> ModalMetropolis<'m> {
         self.evaluate(&mut cur);
         self.current = cur;
         Ok(())
+    }
+
+    /// An injected fault ([`crate::fault`]): the proposal kernel (and a θ-scheme's explicit
+    /// force) uses the constraint force × `factor`, the energy and the acceptance the true
+    /// one. The Metropolis chain stays exact (the Hastings ratio uses the same kernel), so
+    /// only its dynamics are wrong: what [`Self::drift_residual`] sees (issue #30).
+    #[cfg(any(test, feature = "faults"))]
+    pub fn with_proposal_force_factor(mut self, factor: f64) -> Self {
+        self.proposal_force_factor = factor;
+        let mut cur = std::mem::take(&mut self.current);
+        self.evaluate(&mut cur);
+        self.current = cur;
+        self
     }
 
     /// The same state stepped by the θ-scheme with the constraint force explicit,
@@ -469,7 +492,7 @@ impl<'m> ModalMetropolis<'m> {
     fn theta_step(&mut self, theta: f64) {
         let dt = 2.0 * self.half_dt;
         let cur = &self.current;
-        let f = cur.force;
+        let f = cur.kernel_force;
         let n = self.n();
         let next = &mut self.proposal.a;
         for (c, out) in next.chunks_exact_mut(n).enumerate() {
@@ -552,13 +575,14 @@ impl<'m> ModalMetropolis<'m> {
         let s = p.excess(two_l_s);
         let f = p.force(s);
         e.force = f;
+        e.kernel_force = f * self.proposal_force_factor;
         e.energy = 0.5 * bend + p.energy(s);
     }
 
     /// The inverse blocks of `A_a = I + ½Δt(Λ − F B)` and `d · ln det A_a` into `e`
     /// (`log_det` `None` unless positive definite).
     fn factor_crank_nicolson(&self, e: &mut Evaluation) {
-        let f = e.force;
+        let f = e.kernel_force;
         let h = self.half_dt;
         let (mut ok, mut log_det, mut prod) = (true, 0.0, 1.0);
         let (ip, is) = e.inverse.split_at_mut(self.pairs.len());
@@ -636,7 +660,7 @@ impl<'m> ModalMetropolis<'m> {
             self.n(),
             2 * self.pairs.len(),
             self.half_dt,
-            cur.force,
+            cur.kernel_force,
             self.scale,
         );
         let chunks = cur
@@ -694,7 +718,7 @@ impl<'m> ModalMetropolis<'m> {
         let (Some(ld), Some(ld_p)) = (cur.log_det, prop.log_det) else {
             return f64::NEG_INFINITY;
         };
-        let (n, h, fp) = (self.n(), self.half_dt, prop.force);
+        let (n, h, fp) = (self.n(), self.half_dt, prop.kernel_force);
         let forward: f64 = self.z.iter().map(|z| z * z).sum();
         let mut backward = 0.0;
         let states = cur
@@ -844,7 +868,7 @@ impl ModalMetropolis<'_> {
     /// positive definite iff `D_a` is (then `w ≥ 1`), or `D_a` has exactly one negative
     /// eigenvalue (no zero one) and `det A_a > 0`, i.e. `w < 0`.
     fn factor_newton(&self, e: &mut Evaluation) {
-        let (f, h) = (e.force, self.half_dt);
+        let (f, h) = (e.kernel_force, self.half_dt);
         let c = self.rank_one_weight();
         let (mut ok, mut log_det, mut prod, mut negatives) = (true, 0.0, 1.0_f64, 0_usize);
         let mut at = 0;
@@ -895,7 +919,7 @@ impl ModalMetropolis<'_> {
         if cur.log_det.is_none() {
             return false;
         }
-        let (h, f, sc) = (self.half_dt, cur.force, self.scale);
+        let (h, f, sc) = (self.half_dt, cur.kernel_force, self.scale);
         let c = self.rank_one_weight();
         let out = &mut self.proposal.a;
         let (mut at, mut g_dinv_u) = (0, 0.0);
@@ -932,7 +956,7 @@ impl ModalMetropolis<'_> {
         let (Some(ld), Some(ld_p)) = (cur.log_det, prop.log_det) else {
             return f64::NEG_INFINITY;
         };
-        let (h, fp) = (self.half_dt, prop.force);
+        let (h, fp) = (self.half_dt, prop.kernel_force);
         let c = self.rank_one_weight();
         let forward: f64 = self.z.iter().map(|z| z * z).sum();
         let gd: f64 = cur
@@ -969,7 +993,7 @@ impl ModalMetropolis<'_> {
     /// `sqrt(kT (1 − e^{−2Δt h_j})/h_j)` (`sqrt(2kTΔt)` at `h_j = 0`) and
     /// `log_det = −Σ_j ln sd_j = −½ ln det Σ_a`.
     fn factor_ornstein_uhlenbeck(&self, e: &mut Evaluation) {
-        let (f, dt, kt) = (e.force, 2.0 * self.half_dt, self.kt);
+        let (f, dt, kt) = (e.kernel_force, 2.0 * self.half_dt, self.kt);
         let (mut log_var, mut prod, mut at) = (0.0, 1.0_f64, 0);
         for (vectors, grp) in e.vectors.iter_mut().zip(&self.groups) {
             let k = grp.k;
@@ -1100,6 +1124,7 @@ impl Default for Evaluation {
             g: Vec::new(),
             energy: 0.0,
             force: 0.0,
+            kernel_force: 0.0,
             inverse: Vec::new(),
             group_inverse: Vec::new(),
             log_det: None,

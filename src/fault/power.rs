@@ -87,6 +87,14 @@ pub fn targets(kind: FaultKind) -> Vec<Target> {
         FaultKind::CorrelatedNoise | FaultKind::ComponentNoiseSharing => {
             vec![t("hinged-linear-3d", CN)]
         }
+        // The modal chains' proposal force: every compression scene.
+        FaultKind::ProposalForce => vec![
+            t("compression-2d", ALL),
+            t("compression-3d", ALL),
+            t("tension-2d", ALL),
+            t("membrane-area-soft", ALL),
+            t("membrane-area-stiff", ALL),
+        ],
         // The stretch rigidity matters most in tension (F ≈ EA·ε there): tension-2d.
         FaultKind::VonKarmanStrain | FaultKind::AxialStretchRigidity => {
             vec![

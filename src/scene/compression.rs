@@ -165,6 +165,21 @@ fn note_axial_residual(rec: &mut ForceRecord, residual: f64) {
     rec.axial_states += 1;
 }
 
+/// Samples between two probes of the proposal's drift ([`ModalMetropolis::drift_residual`],
+/// about ten steps' work): the first sample of a trajectory and every 100th after it.
+pub const DRIFT_PROBE_EVERY: usize = 100;
+
+/// Probes the proposal's drift of `chain` at its current state into `rec` (the largest
+/// residual and the number of states probed; a state where no proposal can be made is not
+/// counted, NaN is kept and fails the check).
+fn note_drift(rec: &mut ForceRecord, chain: &ModalMetropolis<'_>) {
+    if let Some(r) = chain.drift_residual() {
+        let worst = rec.drift_residual.unwrap_or(0.0);
+        rec.drift_residual = Some(if r.is_nan() || r > worst { r } else { worst });
+        rec.drift_states += 1;
+    }
+}
+
 /// The observer of [`CompressionRun::simulate`]: F/F_c0 and the nodal slopes at every
 /// sample, the axial equilibrium residual every [`AXIAL_RESIDUAL_EVERY`] samples, the
 /// Metropolis counts at the end.
@@ -214,18 +229,26 @@ impl Observer<ModalMetropolis<'_>> for ModalForceRecorder<'_> {
                 .axial_residual(&chain.nodal_state(), chain.force());
             note_axial_residual(&mut self.rec, r);
         }
+        if self.rec.slope_samples.is_multiple_of(DRIFT_PROBE_EVERY) {
+            note_drift(&mut self.rec, chain);
+        }
         self.rec.slope_samples += 1;
     }
 }
 
-/// The observer of a membrane's chain: `F/σ_c0 = −σ/σ_c0` at every sample.
+/// The observer of a membrane's chain: `F/σ_c0 = −σ/σ_c0` at every sample, the proposal's
+/// drift every [`DRIFT_PROBE_EVERY`] samples (in `drift`, whose force series stays empty).
 struct StressRecorder {
     unit: f64,
     force_ratio: Vec<f64>,
+    drift: ForceRecord,
 }
 
 impl Observer<ModalMetropolis<'_>> for StressRecorder {
     fn on_sample(&mut self, _: usize, _: u64, chain: &ModalMetropolis<'_>) {
+        if self.force_ratio.len().is_multiple_of(DRIFT_PROBE_EVERY) {
+            note_drift(&mut self.drift, chain);
+        }
         self.force_ratio.push(chain.force() / self.unit);
     }
 }
@@ -298,6 +321,10 @@ pub struct CompressionRun {
     /// Euler buckling load F_c0 (the unit of the recorded forces); a membrane's buckling
     /// stress σ_c0.
     pub euler_load: f64,
+    /// The injected fault's factor on the modal chain's proposal force
+    /// ([`crate::fault::FaultKind::ProposalForce`]).
+    #[cfg(any(test, feature = "faults"))]
+    proposal_force_factor: f64,
 }
 
 /// The object of a compression run at each strain.
@@ -339,6 +366,13 @@ pub struct ForceRecord {
     pub axial_residual: Option<f64>,
     /// Number of states the residual was evaluated at.
     pub axial_states: u64,
+    /// The largest relative difference between the Metropolis proposal's drift and the
+    /// gradient of the chain's energy over the states probed
+    /// ([`ModalMetropolis::drift_residual`]); `None` if none was (the banded chain, data
+    /// from another program).
+    pub drift_residual: Option<f64>,
+    /// Number of states the drift was probed at.
+    pub drift_states: u64,
 }
 
 impl CompressionRun {
@@ -383,6 +417,8 @@ impl CompressionRun {
                 models,
             },
             euler_load: p.euler_load(),
+            #[cfg(any(test, feature = "faults"))]
+            proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
     }
 
@@ -441,6 +477,8 @@ impl CompressionRun {
             sample_interval,
             object: Strained::Membrane { models, modes },
             euler_load: sigma_c0,
+            #[cfg(any(test, feature = "faults"))]
+            proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
     }
 
@@ -617,6 +655,10 @@ impl CompressionRun {
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
         let mut chain = ModalMetropolis::new(model, modes, plan.burn_in_dt, rng)?;
+        #[cfg(any(test, feature = "faults"))]
+        {
+            chain = chain.with_proposal_force_factor(self.proposal_force_factor);
+        }
         self.burn_in(&mut chain, plan, model.strain(), rng)?;
         let mut recorder = ModalForceRecorder {
             model,
@@ -657,6 +699,10 @@ impl CompressionRun {
         sampled_steps: u64,
     ) -> Result<ForceRecord> {
         let mut chain = ModalMetropolis::for_membrane(model, modes, plan.burn_in_dt, rng)?;
+        #[cfg(any(test, feature = "faults"))]
+        {
+            chain = chain.with_proposal_force_factor(self.proposal_force_factor);
+        }
         if let Family::Theta(theta) = self.spec.integrator.family() {
             chain = chain.with_theta(theta)?;
         }
@@ -664,6 +710,7 @@ impl CompressionRun {
         let mut recorder = StressRecorder {
             unit: self.euler_load,
             force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
+            drift: ForceRecord::default(),
         };
         self.sample(
             &mut chain,
@@ -677,6 +724,8 @@ impl CompressionRun {
             force_ratio: recorder.force_ratio,
             proposed: chain.proposed,
             accepted: chain.accepted,
+            drift_residual: recorder.drift.drift_residual,
+            drift_states: recorder.drift.drift_states,
             ..Default::default()
         })
     }

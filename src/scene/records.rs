@@ -26,7 +26,8 @@ use crate::scene::linear::TrajectoryRecord;
 /// Version 2 (issue #29) adds the rigid-mode series after the profile.
 pub const LINEAR_MAGIC: &[u8; 8] = b"LFEMLIN2";
 /// The magic of compression-run records.
-pub const FORCE_MAGIC: &[u8; 8] = b"LFEMFRC1";
+/// Version 2 (issue #30) adds the proposal-drift residual after the axial residual.
+pub const FORCE_MAGIC: &[u8; 8] = b"LFEMFRC2";
 
 /// Appends values to a byte buffer.
 struct Encoder(Vec<u8>);
@@ -240,6 +241,8 @@ pub fn encode_force(records: &[Vec<ForceRecord>]) -> Vec<u8> {
             e.count(r.slope_samples);
             e.optional(r.axial_residual);
             e.u64(r.axial_states);
+            e.optional(r.drift_residual);
+            e.u64(r.drift_states);
         }
     }
     e.0
@@ -265,6 +268,8 @@ pub fn decode_force(bytes: &[u8], source: &str) -> Result<Vec<Vec<ForceRecord>>>
                 slope_samples: d.u64()? as usize,
                 axial_residual: d.optional()?,
                 axial_states: d.u64()?,
+                drift_residual: d.optional()?,
+                drift_states: d.u64()?,
             });
         }
         out.push(point);
@@ -343,6 +348,8 @@ mod tests {
                         slope_samples: 20,
                         axial_residual: (j != 1).then_some(2.5e-15 * j as f64),
                         axial_states: 40 * j,
+                        drift_residual: (j != 2).then_some(3.5e-9 * j as f64),
+                        drift_states: j,
                     })
                     .collect()
             })
@@ -377,7 +384,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("shard-2/run.records") && e.contains("LFEMFRC1"),
+            e.contains("shard-2/run.records") && e.contains("LFEMFRC2"),
             "{e}"
         );
         for cut in (0..bytes.len()).step_by(7) {
@@ -400,7 +407,8 @@ mod tests {
             ..ForceRecord::default()
         }]];
         let mut bad = encode_force(&force);
-        let flag = bad.len() - 8 - 8 - 1;
+        // The axial flag: before its value and states, the drift flag (none) and states.
+        let flag = bad.len() - 8 - 1 - 8 - 8 - 1;
         assert_eq!(bad[flag], 1);
         bad[flag] = 7;
         let e = decode_force(&bad, "flag").unwrap_err().to_string();
