@@ -45,6 +45,10 @@
 //! Run: `cargo bench --bench effective_samples` (≈ 1.5 min); `-- nonlinear` or `-- linear`
 //! runs one part.
 
+#[path = "common/cpu.rs"]
+mod cpu;
+
+use cpu::cpu_now;
 use langevin_fem::FilamentParams;
 use langevin_fem::dynamics::{
     Components, Driver, IntegratorKind, ModalMetropolis, NonlinearIntegrator, NonlinearState,
@@ -79,38 +83,6 @@ const PRE_EQUILIBRATION_DT_TAU1: f64 = 0.02;
 /// Burn-in of the integrator under test after the pre-equilibration (τ₁): its own law,
 /// biased for the θ-schemes, relaxes from the exact one within about τ₁.
 const OWN_BURN_IN_TAU1: f64 = 1.0;
-
-/// CPU time of the calling thread (wall time where no thread clock is available).
-#[cfg(target_os = "linux")]
-fn cpu_now() -> Duration {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    unsafe extern "C" {
-        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-    }
-    /// `CLOCK_THREAD_CPUTIME_ID` of Linux.
-    const THREAD_CPUTIME: i32 = 3;
-    let mut t = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `t` is a valid, writable timespec (two i64 on 64-bit Linux, the layout of
-    // `struct timespec`), and the clock id is a constant Linux defines.
-    let rc = unsafe { clock_gettime(THREAD_CPUTIME, &mut t) };
-    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
-    Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
-}
-
-/// CPU time of the calling thread (wall time where no thread clock is available).
-#[cfg(not(target_os = "linux"))]
-fn cpu_now() -> Duration {
-    use std::sync::OnceLock;
-    static START: OnceLock<Instant> = OnceLock::new();
-    START.get_or_init(Instant::now).elapsed()
-}
 
 /// Records `F/F_c0` at every sample of a nonlinear trajectory.
 struct ForceRecorder<'m> {

@@ -36,6 +36,10 @@
 //! stderr). `newton-slow` is [`Proposal::Newton`] with the rank-one term on the slowest
 //! groups only ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1).
 
+#[path = "common/cpu.rs"]
+mod cpu;
+
+use cpu::cpu_now;
 use langevin_fem::dynamics::{ModalMetropolis, Proposal, Trajectory};
 use langevin_fem::fem::area::AreaMembrane;
 use langevin_fem::fem::plate_area::{AreaParams, AreaTheory};
@@ -43,7 +47,6 @@ use langevin_fem::fem::plate_modes::PlateModes;
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::spectral::membrane::{MembraneBoundary, MembraneParams};
 use langevin_fem::stats::mean_with_error;
-use std::time::Duration;
 
 /// Master seed.
 const SEED: u64 = 20_261_210;
@@ -67,39 +70,6 @@ const OWN_BURN_IN: u64 = 500;
 const MIN_CPU: f64 = 0.25;
 const MIN_TAU: f64 = 200.0;
 const MAX_CPU: f64 = 2.0;
-
-/// CPU time of the calling thread (wall time where no thread clock is available).
-#[cfg(target_os = "linux")]
-fn cpu_now() -> Duration {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    unsafe extern "C" {
-        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-    }
-    /// `CLOCK_THREAD_CPUTIME_ID` of Linux.
-    const THREAD_CPUTIME: i32 = 3;
-    let mut t = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `t` is a valid, writable timespec (two i64 on 64-bit Linux, the layout of
-    // `struct timespec`), and the clock id is a constant Linux defines.
-    let rc = unsafe { clock_gettime(THREAD_CPUTIME, &mut t) };
-    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
-    Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
-}
-
-/// CPU time of the calling thread (wall time where no thread clock is available).
-#[cfg(not(target_os = "linux"))]
-fn cpu_now() -> Duration {
-    use std::sync::OnceLock;
-    use std::time::Instant;
-    static START: OnceLock<Instant> = OnceLock::new();
-    START.get_or_init(Instant::now).elapsed()
-}
 
 /// One set-up: a scene's membrane on the bench's mesh.
 struct SetUp {
