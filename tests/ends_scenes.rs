@@ -96,3 +96,98 @@ fn rigid_diffusion_check_accepts_the_truth_and_rejects_a_wrong_law() {
     let p = p_of(&run);
     assert!(p < 1e-4, "a 10 % wrong law passes: p = {p}");
 }
+
+/// The tangent-angle cosine functional of Gittes et al. (1993) on a shape the Hermite
+/// cubics hold exactly: w = x² on a free–free beam (θ = 2x) has
+/// a_n = √(2/L)∫2x cos(nπx/L) dx = √(2/L)·2(L/nπ)²((−1)ⁿ − 1).
+#[test]
+fn tangent_cosine_functional_is_exact_on_a_quadratic() {
+    use langevin_fem::fem::beam::BeamModel;
+    use langevin_fem::fem::mesh::Mesh;
+    use langevin_fem::params::{Ends, FilamentParams};
+    let length = 2.0;
+    let p = FilamentParams {
+        length,
+        ..FilamentParams::default()
+    };
+    let ends: Ends = "free-free".parse().expect("ends");
+    let beam =
+        BeamModel::with_ends(p, Mesh::uniform(length, 7).expect("mesh"), ends).expect("beam");
+    let mut w = vec![0.0; beam.n_dofs()];
+    for (node, &x) in beam.mesh().nodes().iter().enumerate() {
+        w[beam.node_deflection_index(node).expect("free")] = x * x;
+        w[beam.node_rotation_index(node).expect("free")] = 2.0 * x;
+    }
+    for n in 1..=12 {
+        let f = beam.tangent_cosine_functional(n);
+        let got: f64 = f.iter().zip(&w).map(|(a, b)| a * b).sum();
+        let k = n as f64 * std::f64::consts::PI / length;
+        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+        let exact = (2.0 / length).sqrt() * 2.0 / (k * k) * (sign - 1.0);
+        assert!(
+            (got - exact).abs() <= 1e-12 * (1.0 + exact.abs()),
+            "n = {n}: {got} vs {exact}"
+        );
+    }
+}
+
+/// The tangent-angle references: the exact discrete variance of the free–free beam under
+/// Crank–Nicolson with consistent noise (its stationary law is the discrete Gibbs law)
+/// converges to the continuum kT L²/(EI n²π²) as the mesh is refined (rigid modes do not
+/// enter), and the pinned–free filament's likewise; a coarse mesh lies off by more than
+/// a fine one.
+#[test]
+fn tangent_angle_references_converge_to_the_continuum() {
+    for name in ["microtubule-free-free", "pinned-free-2d"] {
+        let mut s = scene(name);
+        let mut errors = Vec::new();
+        for elements in [4, 8, 32] {
+            s.mesh.elements = elements;
+            let run = LinearRun::prepare(&s, &s.runs[0]).expect("prepares");
+            let t = &run.reference.tangent;
+            assert_eq!(t.len(), s.sampling.modes, "{name}");
+            let worst = t
+                .iter()
+                .map(|r| (r.variance_discrete / r.variance_continuum - 1.0).abs())
+                .fold(0.0, f64::max);
+            errors.push(worst);
+            for r in t {
+                assert!((r.correlation(0) - 1.0).abs() < 1e-12, "{r:?}");
+            }
+        }
+        assert!(errors[2] < 2e-4, "{name}: {errors:?}");
+        assert!(errors[0] > errors[2], "{name}: {errors:?}");
+    }
+}
+
+/// `tangent-angle` on a simulated free–free microtubule passes against the exact
+/// discrete variances and fails when they are 10 % too small (as if the bending rigidity
+/// were 10 % too large in the references).
+#[test]
+fn tangent_angle_check_accepts_the_truth_and_rejects_a_wrong_rigidity() {
+    let s = scene("microtubule-free-free");
+    let spec = &s.runs[0];
+    let mut run = LinearRun::prepare(&s, spec).expect("prepares");
+    let e = spec.quick;
+    let steps = run.sampled_steps(e.duration_tau1 * s.tau1());
+    let records = run
+        .simulate_ensemble(s.seed, 0, e.trajectories as u64, steps, |_| {})
+        .expect("ensemble");
+    let kinds = [langevin_fem::scene::CheckKind::TangentAngle];
+    let smallest_p = |run: &LinearRun| {
+        let (out, est) = linear_checks(run, &kinds, &records, &[]).expect("checks");
+        assert!(est.skipped.is_empty(), "{:?}", est.skipped);
+        assert_eq!(out.len(), 2 * s.sampling.modes);
+        out.iter()
+            .filter(|c| c.name.contains("tangent-variance"))
+            .map(|c| c.p_value.expect("p-value"))
+            .fold(1.0, f64::min)
+    };
+    let p = smallest_p(&run);
+    assert!(p > 0.01 / 8.0, "the truth rejected: p = {p}");
+    for t in &mut run.reference.tangent {
+        t.variance_discrete /= 1.1;
+    }
+    let p = smallest_p(&run);
+    assert!(p < 1e-4, "a 10 % wrong variance passes: p = {p}");
+}

@@ -140,6 +140,17 @@ fn snapshot_of(scene: &Scene) -> String {
             )
             .unwrap();
         }
+        // The tangent-angle cosines of Gittes et al. (issue #29), where checked.
+        for t in &r.tangent {
+            writeln!(
+                s,
+                "tangent-angle n={}: discrete {} continuum {}",
+                t.n,
+                g(t.variance_discrete),
+                g(t.variance_continuum)
+            )
+            .unwrap();
+        }
         let mut rng = trajectory_rng(derive_seed(GOLDEN_SEED, &spec.name), 0);
         let trace = run.trace(&mut rng, 200, 25).expect("trace runs");
         for (k, row) in trace.iter().enumerate() {

@@ -579,3 +579,93 @@ fn membrane_under_imposed_area_is_refused_where_not_supported() {
         assert!(!Path::new(out).join("manifest.json").exists());
     }
 }
+
+/// A free–free microtubule's trajectories (issue #29): after the modal amplitudes the
+/// rigid coordinates (w_mean, w_angle) and the tangent-angle cosine amplitudes of Gittes
+/// et al. (gw_n); its own output passes the rigid-diffusion and tangent-angle checks
+/// against its discretization's exact references (none skipped); the tangent-angle
+/// amplitudes scaled by 1.1 fail the tangent variances, the rigid coordinates scaled by
+/// 1.1 the rigid diffusion; `rigid` on a scene without rigid modes is refused naming the
+/// key.
+#[test]
+fn free_filament_data_carry_rigid_and_tangent_angle_columns() {
+    let dir = TempDir::new("run-check-free");
+    let data = dir.join_str("data");
+    let args = [
+        "run",
+        "--scene",
+        "microtubule-free-free",
+        "--run",
+        "crank-nicolson",
+        "--format",
+        "csv",
+        "--out",
+        &data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let side = json(&Path::new(&data).join("data.json"));
+    assert_eq!(side["runs"][0]["rigid"], true);
+    assert_eq!(side["runs"][0]["tangent_modes"], 4);
+    let first = Path::new(&data).join(side["runs"][0]["files"][0].as_str().unwrap());
+    let text = std::fs::read_to_string(&first).unwrap();
+    assert!(
+        text.lines()
+            .next()
+            .unwrap()
+            .ends_with("aw_4,w_mean,w_angle,gw_1,gw_2,gw_3,gw_4"),
+        "{}",
+        text.lines().next().unwrap()
+    );
+    let report = dir.join_str("report");
+    let (o, args) = check_scene("microtubule-free-free", &data, &report);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr_of(&o));
+    let s = json(&Path::new(&report).join("summary.json"));
+    let names: Vec<String> = s["scenes"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap().to_string())
+        .collect();
+    for want in [
+        "crank-nicolson/rigid-diffusion/mode=0",
+        "crank-nicolson/rigid-diffusion/mode=1",
+        "crank-nicolson/tangent-variance/n=1",
+        "crank-nicolson/tangent-ks/n=4",
+    ] {
+        assert!(names.iter().any(|n| n == want), "{want} not in {names:?}");
+    }
+    let failed_of = |report: &str| -> Vec<String> {
+        checks(Path::new(report))
+            .into_iter()
+            .filter(|c| !c.1)
+            .map(|c| c.0)
+            .collect()
+    };
+    scale_columns(&data, &side, |h| h.starts_with("gw_"), 1.1);
+    let report2 = dir.join_str("report-tangent");
+    let (o, args) = check_scene("microtubule-free-free", &data, &report2);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr_of(&o));
+    let failed = failed_of(&report2);
+    assert!(
+        failed.iter().any(|f| f.contains("tangent-variance")),
+        "{failed:?}"
+    );
+    assert!(failed.iter().all(|f| f.contains("tangent")), "{failed:?}");
+    scale_columns(&data, &side, |h| h.starts_with("gw_"), 1.0 / 1.1);
+    scale_columns(&data, &side, |h| h == "w_mean" || h == "w_angle", 1.1);
+    let report3 = dir.join_str("report-rigid");
+    let (o, args) = check_scene("microtubule-free-free", &data, &report3);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr_of(&o));
+    let failed = failed_of(&report3);
+    assert!(
+        failed.iter().any(|f| f.contains("rigid-diffusion")),
+        "{failed:?}"
+    );
+    assert!(failed.iter().all(|f| f.contains("rigid")), "{failed:?}");
+    // The same data against a hinged scene: `rigid` names the key.
+    let (o, args) = check_scene("hinged-linear-2d", &data, &dir.join_str("report-hinged"));
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr_of(&o));
+    let err = stderr_of(&o);
+    assert!(err.contains("runs[0].rigid"), "{err}");
+}

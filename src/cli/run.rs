@@ -575,6 +575,8 @@ fn linear_data_run(
         discretization: Some(job.discretization(k, dt)),
         files,
         strain_ratio: None,
+        rigid: !run.reference.rigid.is_empty(),
+        tangent_modes: run.reference.tangent.len(),
     }
 }
 
@@ -786,6 +788,8 @@ fn compression_data_runs(job: &Job, k: usize, run: &CompressionRun, n: u64) -> V
                 .map(|j| compression_file(name, i, j, job.ext()))
                 .collect(),
             strain_ratio: Some(ratio),
+            rigid: false,
+            tangent_modes: 0,
         })
         .collect()
 }

@@ -384,6 +384,41 @@ pub struct DataRun {
     /// per strain, sharing the run name); their columns are [`COMPRESSION_COLUMNS`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub strain_ratio: Option<f64>,
+    /// Filament data whose ends allow rigid motion (a free end and no clamp, issue #29):
+    /// whether the files carry the rigid coordinates after the modal amplitudes
+    /// ([`filament_extra_columns`]: `w_mean` = (1/L)∫w dx, `w_angle` = the rigid
+    /// rotation's angle ∫(x − x_p)w dx / ∫(x − x_p)² dx about its pivot x_p).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub rigid: bool,
+    /// Filament data with no clamped end: the number of tangent-angle cosine amplitudes
+    /// per component the files carry after the rigid coordinates (Gittes et al. 1993:
+    /// `gw_n` = √(2/L)∫θ cos(nπs/L) ds, θ the tangent angle, n = 1 …).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tangent_modes: usize,
+}
+
+/// Whether a count is 0 (left out of a written sidecar).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// The largest `tangent_modes` of a data run.
+pub const MAX_TANGENT_MODES: usize = 1000;
+
+/// The columns a filament's run adds after the modal amplitudes: per component the rigid
+/// coordinates `{w,v}_{suffix}` for `rigid` (suffix `mean` for a translation, `angle` for
+/// a rotation), then per component the tangent-angle cosine amplitudes `g{w,v}_n`,
+/// n = 1 … `tangent_modes`.
+pub fn filament_extra_columns(dims: usize, rigid: &[&str], tangent_modes: usize) -> Vec<String> {
+    let comps: &[&str] = if dims == 3 { &["w", "v"] } else { &["w"] };
+    let mut c = Vec::new();
+    for k in comps {
+        c.extend(rigid.iter().map(|s| format!("{k}_{s}")));
+    }
+    for k in comps {
+        c.extend((1..=tangent_modes).map(|n| format!("g{k}_{n}")));
+    }
+    c
 }
 
 /// The columns of a compression run's files: time, the compressive force F (force
@@ -727,6 +762,28 @@ impl DataRun {
         mut earlier: impl Iterator<Item = &'a DataRun>,
     ) -> std::result::Result<(), (String, String)> {
         let key = |s: &str| format!("runs[{k}].{s}");
+        let membrane = matches!(object, DataObject::Membrane(_));
+        if self.tangent_modes > MAX_TANGENT_MODES || (membrane && self.tangent_modes > 0) {
+            return Err((
+                key("tangent_modes"),
+                format!(
+                    "must be in [0, {MAX_TANGENT_MODES}] for filament data (the tangent-angle cosine amplitudes per component) and 0 (left out) for membrane data, got {}",
+                    self.tangent_modes
+                ),
+            ));
+        }
+        if membrane && self.rigid {
+            return Err((
+                key("rigid"),
+                "must be false (left out) for membrane data: rigid coordinates belong to a filament with a free end".into(),
+            ));
+        }
+        if self.strain_ratio.is_some() && (self.rigid || self.tangent_modes > 0) {
+            return Err((
+                key(if self.rigid { "rigid" } else { "tangent_modes" }),
+                "must be left out for compression data (columns t, force, stored_length)".into(),
+            ));
+        }
         if !crate::scene::validate::is_path_name(&self.name) {
             return Err((
                 key("name"),

@@ -170,7 +170,7 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "checks",
         "-",
-        "a non-empty list of: profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance, xy-symmetry (membrane on a square patch) (fem, spectral); force-strain, force-distribution, dt-halving (compression)",
+        "a non-empty list of: profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance, xy-symmetry (membrane on a square patch), rigid-diffusion (filament with a free end and no clamp), tangent-angle (fem filament without a clamped end) (fem, spectral); force-strain, force-distribution, dt-halving (compression)",
         "required",
         None,
         "The statistical checks of every run that does not list its own.",

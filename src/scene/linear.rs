@@ -22,7 +22,7 @@ use crate::fem::modal::GeneralizedModes;
 use crate::fem::noise::NoiseModel;
 use crate::params::End;
 use crate::rng::{TrajectoryRng, trajectory_rng};
-use crate::scene::{ModelKind, RunSpec, Scene};
+use crate::scene::{CheckKind, ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode, MembraneSimulator};
 use crate::spectral::simulator::ModalSimulator;
@@ -103,6 +103,49 @@ pub struct LinearReference {
     pub max_rate: f64,
     /// Per rigid mode of the ends (issue #29; empty without), its exact diffusion law.
     pub rigid: Vec<RigidReference>,
+    /// Per tangent-angle cosine amplitude n = 1 … (check `tangent-angle`; empty
+    /// without), its exact law.
+    pub tangent: Vec<TangentReference>,
+}
+
+/// The exact stationary law of one tangent-angle cosine amplitude
+/// `a_n = √(2/L)∫θ cos(nπs/L) ds` (Gittes et al. 1993,
+/// [`BeamModel::tangent_cosine_functional`]): a zero-mean Gaussian whose autocorrelation
+/// after `k` steps is `Σ_i u_i m_i^k / Σ_i u_i` (not one exponential: the cosines are not
+/// the modes of the beam).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TangentReference {
+    /// The cosine's index n ≥ 1.
+    pub n: usize,
+    /// The exact variance of the discretized system under its integrator (`aᵀSa`, `a`
+    /// the functional's modal image and `S` the discrete stationary covariance), or the
+    /// continuum's for data of an unknown discretization.
+    pub variance_discrete: f64,
+    /// The continuum's `kT L²/(EI n²π²)`.
+    pub variance_continuum: f64,
+    /// The autocorrelation's terms `(u_i, m_i)`: `u_i = a_i (S a)_i` and the one-step
+    /// multiplier `m_i` of mode i (for data of an unknown discretization, the bound
+    /// `(1, e^{−λ₁Δt})`: in the continuum the weights are positive and the slowest
+    /// elastic rate λ₁ bounds every decay).
+    pub terms: Vec<(f64, f64)>,
+}
+
+impl TangentReference {
+    /// The autocorrelation after `steps` steps (`|·|` bounded by 1).
+    pub fn correlation(&self, steps: u64) -> f64 {
+        let total: f64 = self.terms.iter().map(|(u, _)| u).sum();
+        let k = steps.min(i32::MAX as u64) as i32;
+        let sum: f64 = self.terms.iter().map(|(u, m)| u * m.powi(k)).sum();
+        if total > 0.0 { sum / total } else { 0.0 }
+    }
+
+    /// The smallest stride (in samples `every` steps apart) at which the correlation of
+    /// kept samples is at most `limit` in magnitude, capped at `cap`.
+    pub fn stride(&self, every: u64, limit: f64, cap: usize) -> usize {
+        (1..cap)
+            .find(|&k| self.correlation(every.saturating_mul(k as u64)).abs() <= limit)
+            .unwrap_or(cap)
+    }
 }
 
 /// The exact law of one rigid mode's amplitude `r = ψᵀCw` (C-normalized `ψ`, a free
@@ -122,6 +165,40 @@ pub struct RigidReference {
     /// Whether the integrator steps the rigid motion (the exact-modal integrator steps
     /// the elastic modes only: its rigid amplitudes stay 0).
     pub simulated: bool,
+    /// The physical coordinate of the mode in trajectory files (column suffix): `mean`,
+    /// the centre-of-mass deflection (1/L)∫w dx, or `angle`, the rigid rotation's angle
+    /// ∫(x − x_p)w dx / I about its pivot x_p (I = ∫(x − x_p)² dx).
+    pub coordinate: &'static str,
+    /// `r` per unit of the physical coordinate: √(ξL) for `mean`, √(ξI) for `angle`
+    /// (`r = ψᵀCw` with `ψᵀCψ = 1`, the elastic modes C-orthogonal to ψ).
+    pub coordinate_scale: f64,
+}
+
+/// The rigid modes of a filament of parameters `p` with ends `ends`, as
+/// `(name, coordinate, coordinate_scale)` of [`RigidReference`], in the order of
+/// [`BeamModel::rigid_modes`]: free–free the translation and the rotation about the
+/// centre (I = L³/12), hinged–free the rotation about the hinge (I = L³/3).
+pub fn rigid_coordinates(
+    p: &crate::params::FilamentParams,
+    ends: crate::params::Ends,
+) -> Vec<(&'static str, &'static str, f64)> {
+    let (l, xi) = (p.length, p.drag);
+    match (ends.left, ends.right) {
+        (End::Free, End::Free) => vec![
+            ("translation", "mean", (xi * l).sqrt()),
+            (
+                "rotation about the centre",
+                "angle",
+                (xi * l.powi(3) / 12.0).sqrt(),
+            ),
+        ],
+        (End::Hinged, End::Free) | (End::Free, End::Hinged) => vec![(
+            "rotation about the hinge",
+            "angle",
+            (xi * l.powi(3) / 3.0).sqrt(),
+        )],
+        _ => Vec::new(),
+    }
 }
 
 /// The probe vector `a_x = Φᵀ p_x` of the deflection at `x`, where `w(x) = p_xᵀ w`
@@ -203,6 +280,9 @@ trait Observables {
     /// The rigid-mode amplitudes `r_k = ψ_kᵀCw` ([`BeamModel::rigid_amplitudes`]),
     /// component-major `out[c * n_rigid + k]`; nothing for an object without rigid modes.
     fn rigid(&self, _out: &mut [f64]) {}
+    /// The values `pᵀw` of the rows `p` of `functionals` (one per column of the state),
+    /// component-major `out[c * rows + i]`; nothing for a model without nodal states.
+    fn functionals(&self, _functionals: &DMatrix<f64>, _out: &mut [f64]) {}
 }
 
 /// A filament being simulated ([`Trajectory`]: advances all its transverse components by
@@ -276,6 +356,12 @@ impl Observables for LaneOf<'_, FemBatch<'_>> {
             });
         }
     }
+    fn functionals(&self, functionals: &DMatrix<f64>, out: &mut [f64]) {
+        let m = functionals.nrows();
+        self.batch.each_component(self.lane, |c, s| {
+            project_modes(functionals, s, &mut out[c * m..(c + 1) * m]);
+        });
+    }
 }
 
 struct FemSampler<'a> {
@@ -320,6 +406,12 @@ impl Observables for FemSampler<'_> {
             for (c, s) in self.filament.states.iter().enumerate() {
                 beam.rigid_amplitudes(s, &mut out[c * r..(c + 1) * r]);
             }
+        }
+    }
+    fn functionals(&self, functionals: &DMatrix<f64>, out: &mut [f64]) {
+        let m = functionals.nrows();
+        for (c, s) in self.filament.states.iter().enumerate() {
+            project_modes(functionals, s, &mut out[c * m..(c + 1) * m]);
         }
     }
 }
@@ -452,6 +544,7 @@ struct Recorder<'r> {
     buf_m: Vec<f64>,
     buf_p: Vec<f64>,
     buf_r: Vec<f64>,
+    buf_g: Vec<f64>,
     one: Vec<f64>,
 }
 
@@ -476,6 +569,10 @@ impl<'r> Recorder<'r> {
                     Vec::with_capacity(cap(run.profile_every));
                     c * run.reference.rigid.len()
                 ],
+                tangent: vec![
+                    Vec::with_capacity(cap(run.profile_every));
+                    c * run.reference.tangent.len()
+                ],
                 two_time: vec![0.0; c * ntt],
                 slope_squares: vec![0.0; run.n_nodes()],
                 slope_samples: 0,
@@ -484,6 +581,7 @@ impl<'r> Recorder<'r> {
             buf_m: vec![0.0; c * nm],
             buf_p: vec![0.0; c * np],
             buf_r: vec![0.0; c * run.reference.rigid.len()],
+            buf_g: vec![0.0; c * run.reference.tangent.len()],
             one: vec![0.0; c],
         }
     }
@@ -535,6 +633,12 @@ impl<S: Observables + ?Sized> Observer<S> for Recorder<'_> {
                     s.push(*v);
                 }
             }
+            if let Some(g) = run.tangent_functionals() {
+                sampler.functionals(g, &mut self.buf_g);
+                for (s, v) in rec.tangent.iter_mut().zip(&self.buf_g) {
+                    s.push(*v);
+                }
+            }
         }
     }
 }
@@ -554,24 +658,60 @@ fn rigid_references(
         return Ok(Vec::new());
     }
     let sigma = crate::fem::NoiseGenerator::new(noise, beam)?.covariance();
-    let names: &[&str] = match (beam.ends().left, beam.ends().right) {
-        (End::Free, End::Free) => &["translation", "rotation about the centre"],
-        _ => &["rotation about the hinge"],
-    };
+    let names = rigid_coordinates(beam.params(), beam.ends());
     let kt = beam.kt();
     Ok(rigid
         .iter()
         .zip(names)
-        .map(|(psi, name)| {
+        .map(|(psi, (name, coordinate, coordinate_scale))| {
             let v = DVector::from_column_slice(psi);
             RigidReference {
-                name: (*name).to_string(),
+                coordinate,
+                coordinate_scale,
+                name: name.to_string(),
                 diffusion_discrete: 2.0 * kt * v.dot(&(&sigma * &v)),
                 diffusion_continuum: 2.0 * kt,
                 simulated: !integrator.needs_modes(),
             }
         })
         .collect())
+}
+
+/// The exact laws of the tangent-angle cosine amplitudes n = 1 … `count` of `beam`
+/// ([`TangentReference`]) under the discrete law `law` of its generalized modes `gm`, and
+/// the functionals' rows that sample them.
+fn tangent_references(
+    beam: &BeamModel,
+    gm: &GeneralizedModes,
+    law: &DiscreteLaw,
+    count: usize,
+) -> (Vec<TangentReference>, Option<DMatrix<f64>>) {
+    let p = beam.params();
+    let n_dofs = beam.n_dofs();
+    let mut rows = DMatrix::zeros(count, n_dofs);
+    let mut refs = Vec::with_capacity(count);
+    for n in 1..=count {
+        let f = beam.tangent_cosine_functional(n);
+        rows.row_mut(n - 1).copy_from_slice(&f);
+        let a = probe_of(n_dofs, &gm.vectors, |e| {
+            f.iter().zip(e).map(|(x, y)| x * y).sum()
+        });
+        let sa = &law.stationary * &a;
+        let terms = a
+            .iter()
+            .zip(sa.iter())
+            .zip(&law.multipliers)
+            .map(|((ai, si), &m)| (ai * si, m))
+            .collect();
+        let q = n as f64 * std::f64::consts::PI / p.length;
+        refs.push(TangentReference {
+            n,
+            variance_discrete: a.dot(&sa),
+            variance_continuum: p.kt / (p.bending_rigidity * q * q),
+            terms,
+        });
+    }
+    (refs, Some(rows))
 }
 
 /// `rates` × `factor` (the rates themselves, bit for bit, at factor 1).
@@ -606,6 +746,9 @@ pub struct TrajectoryRecord {
     /// Rigid-mode amplitude series `rigid[c * n_rigid + k]` (issue #29: free ends),
     /// sampled with the profile (every `profile_every` steps); empty without rigid modes.
     pub rigid: Vec<Vec<f64>>,
+    /// Tangent-angle cosine amplitude series `tangent[c * n_tangent + i]` (cosine
+    /// n = i + 1, [`TangentReference`]), sampled with the profile; empty unless checked.
+    pub tangent: Vec<Vec<f64>>,
     /// Two-time products w(x,t)·w(y,η), `two_time[c * n_points + j]`.
     pub two_time: Vec<f64>,
     /// Per node, the sum of θ² = w'² over the profile samples and components (empty for
@@ -651,6 +794,9 @@ enum Model {
         /// The O(n) path in modal coordinates, where the object's modes come without a
         /// dense transform and the noise is consistent (the plate).
         modal: Option<ModalPath>,
+        /// The rows `p_n` of the tangent-angle cosine amplitudes `p_nᵀw`
+        /// ([`BeamModel::tangent_cosine_functional`]), when checked.
+        tangent: Option<Box<DMatrix<f64>>>,
     },
     Spectral {
         beam: HingedBeam,
@@ -691,6 +837,7 @@ struct Prepared {
     two_time: Vec<TwoTimeReference>,
     max_rate: f64,
     rigid: Vec<RigidReference>,
+    tangent: Vec<TangentReference>,
 }
 
 /// The quantities shared by the preparation steps of a run.
@@ -763,6 +910,7 @@ impl Setup<'_> {
         }
         Ok(Prepared {
             rigid: Vec::new(),
+            tangent: Vec::new(),
             amplitude_scale: vec![1.0; self.scene.sampling.modes],
             model: Model::Spectral {
                 beam: *continuum,
@@ -846,6 +994,7 @@ impl Setup<'_> {
             .fold(0.0, f64::max);
         Ok(Prepared {
             rigid: Vec::new(),
+            tangent: Vec::new(),
             amplitude_scale: vec![1.0; checked.len()],
             model: Model::SpectralMembrane {
                 simulator: Box::new(simulator),
@@ -906,6 +1055,12 @@ impl Setup<'_> {
             FemObject::Beam(beam) => rigid_references(beam, spec.noise, spec.integrator)?,
             FemObject::Plate { .. } => Vec::new(),
         };
+        let (tangent, tangent_rows) = match object.beam() {
+            Some(beam) if spec.checks(self.scene).contains(&CheckKind::TangentAngle) => {
+                tangent_references(beam, &gm, &law, self.scene.sampling.modes)
+            }
+            _ => (Vec::new(), None),
+        };
         let amplitude_scale = match &object {
             // Other ends: the modes are signed by their continuum mode already
             // (generalized_modes), whose normalization ∫φ² = L/2 is the sine's.
@@ -929,6 +1084,7 @@ impl Setup<'_> {
         };
         Ok(Prepared {
             rigid,
+            tangent,
             amplitude_scale,
             model: Model::Fem {
                 object,
@@ -937,6 +1093,7 @@ impl Setup<'_> {
                 noise: spec.noise,
                 integrator: spec.integrator,
                 modal,
+                tangent: tangent_rows.map(Box::new),
             },
             modes: refs,
             profile_discrete,
@@ -1115,6 +1272,7 @@ impl LinearRun {
                 dt,
                 max_rate: prepared.max_rate,
                 rigid: prepared.rigid,
+                tangent: prepared.tangent,
             },
             mode_every,
             profile_every,
@@ -1179,6 +1337,14 @@ impl LinearRun {
         }
     }
 
+    /// The rows of the tangent-angle cosine functionals, when the run checks them.
+    fn tangent_functionals(&self) -> Option<&DMatrix<f64>> {
+        match &self.model {
+            Model::Fem { tangent, .. } => tangent.as_deref(),
+            _ => None,
+        }
+    }
+
     fn n_nodes(&self) -> usize {
         match &self.model {
             Model::Fem { object, .. } => object.beam().map_or(0, |b| b.mesh().n_nodes()),
@@ -1188,8 +1354,8 @@ impl LinearRun {
 
     /// What is wrong with the shapes of `records` and `extra` (the two-time products of
     /// the extra trajectories) read from elsewhere (a shard), against what this run gives
-    /// its records: the numbers of mode, profile and two-time series, the nodal slope
-    /// sums, at most [`MAX_SAMPLES`] samples a series, and the same series lengths in
+    /// its records: the numbers of mode, profile, rigid and tangent-angle series, two-time
+    /// products and nodal slope sums, at most [`MAX_SAMPLES`] samples a series, and the same series lengths in
     /// every trajectory; `None` if they are this run's shapes. The checks index the
     /// records by this run's counts: records of other shapes are refused before them.
     pub fn records_shape_error(
@@ -1202,23 +1368,33 @@ impl LinearRun {
         let want = (
             c * r.modes.len(),
             c * r.profile_x.len(),
+            c * r.rigid.len(),
+            c * r.tangent.len(),
             c * r.two_time.len(),
             self.n_nodes(),
         );
         let lengths = |rec: &TrajectoryRecord| -> Vec<usize> {
-            rec.modes.iter().chain(&rec.profile).map(Vec::len).collect()
+            rec.modes
+                .iter()
+                .chain(&rec.profile)
+                .chain(&rec.rigid)
+                .chain(&rec.tangent)
+                .map(Vec::len)
+                .collect()
         };
         let first = records.first().map(lengths);
         for (j, rec) in records.iter().enumerate() {
             let got = (
                 rec.modes.len(),
                 rec.profile.len(),
+                rec.rigid.len(),
+                rec.tangent.len(),
                 rec.two_time.len(),
                 rec.slope_squares.len(),
             );
             if got != want {
                 return Some(format!(
-                    "trajectory {j} holds (mode series, profile series, two-time products, nodal slope sums) = {got:?}, run {} gives {want:?}",
+                    "trajectory {j} holds (mode series, profile series, rigid series, tangent-angle series, two-time products, nodal slope sums) = {got:?}, run {} gives {want:?}",
                     self.spec.name
                 ));
             }
@@ -1230,12 +1406,12 @@ impl LinearRun {
                 ));
             }
         }
-        extra.iter().position(|x| x.len() != want.2).map(|j| {
+        extra.iter().position(|x| x.len() != want.4).map(|j| {
             format!(
                 "two-time trajectory {j} holds {} products, run {} gives {}",
                 extra[j].len(),
                 self.spec.name,
-                want.2
+                want.4
             )
         })
     }

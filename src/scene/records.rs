@@ -9,7 +9,7 @@
 //! an optional number is a byte (0 absent, 1 present) then the number if present.
 //!
 //! - linear: the number of full trajectories, each [`TrajectoryRecord`] (modes, profile,
-//!   two-time products, slope squares and their count), then the two-time products of the
+//!   rigid and tangent-angle series, two-time products, slope squares and their count), then the two-time products of the
 //!   extra from-rest trajectories (a count, then one sequence each);
 //! - compression: the number of strains, then per strain the number of trajectories and
 //!   each [`ForceRecord`] (F/F_c0, proposals, acceptances, slope squares and their count,
@@ -23,8 +23,9 @@ use crate::scene::compression::ForceRecord;
 use crate::scene::linear::TrajectoryRecord;
 
 /// The magic of linear-run records.
-/// Version 2 (issue #29) adds the rigid-mode series after the profile.
-pub const LINEAR_MAGIC: &[u8; 8] = b"LFEMLIN2";
+/// Version 2 (issue #29) adds the rigid-mode series after the profile, version 3 the
+/// tangent-angle cosine series after them.
+pub const LINEAR_MAGIC: &[u8; 8] = b"LFEMLIN3";
 /// The magic of compression-run records.
 /// Version 2 (issue #30) adds the proposal-drift residual after the axial residual.
 pub const FORCE_MAGIC: &[u8; 8] = b"LFEMFRC2";
@@ -195,6 +196,7 @@ pub fn encode_linear(records: &[TrajectoryRecord], extra: &[Vec<f64>]) -> Vec<u8
         e.series(&r.modes);
         e.series(&r.profile);
         e.series(&r.rigid);
+        e.series(&r.tangent);
         e.numbers(&r.two_time);
         e.numbers(&r.slope_squares);
         e.count(r.slope_samples);
@@ -217,6 +219,7 @@ pub fn decode_linear(bytes: &[u8], source: &str) -> Result<(Vec<TrajectoryRecord
             modes: d.series()?,
             profile: d.series()?,
             rigid: d.series()?,
+            tangent: d.series()?,
             two_time: d.numbers()?,
             slope_squares: d.numbers()?,
             slope_samples: d.u64()? as usize,
@@ -309,6 +312,7 @@ mod tests {
                 modes: vec![awkward(j, 10), awkward(j + 10, 3), vec![]],
                 profile: vec![awkward(j + 20, 7)],
                 rigid: vec![awkward(j + 60, 5)],
+                tangent: vec![awkward(j + 70, 4)],
                 two_time: awkward(j + 30, 2),
                 slope_squares: awkward(j + 40, 4),
                 slope_samples: 17 + j as usize,

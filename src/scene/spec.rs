@@ -307,6 +307,13 @@ pub enum CheckKind {
     /// random-walk law, a χ² variance test of the increments (independent by the
     /// Markov property of a zero mode).
     RigidDiffusion,
+    /// A filament with no clamped end (issue #29): the tangent-angle cosine amplitudes
+    /// `a_n = √(2/L)∫θ cos(nπs/L) ds` of Gittes et al. (1993), the standard analysis of
+    /// imaged microtubules and actin, for n = 1 … `modes`: their variance against the exact
+    /// discrete value (continuum `kT L²/(EI n²π²)` beside it) by a χ² test, and their
+    /// normal law by KS, on samples thinned to a lag correlation ≤ 0.01 by the exact
+    /// autocorrelation.
+    TangentAngle,
     /// Compression: ⟨F⟩ at every strain against the exact discrete equilibrium theory
     /// (per-point z-tests and a χ² over all points).
     ForceStrain,

@@ -36,7 +36,7 @@ use super::spec::{
 use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
-use crate::params::physical;
+use crate::params::{End, physical};
 use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
 use crate::work::{Origin, Part, RunWork};
 use std::fmt::Display;
@@ -96,7 +96,7 @@ impl Display for Num {
 }
 
 /// The allowed checks of a linear scene, for messages.
-const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance; xy-symmetry for a membrane; rigid-diffusion for a filament with a free end) for model \"fem\" or \"spectral\"";
+const LINEAR_CHECKS: &str = "a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance; xy-symmetry for a membrane; rigid-diffusion for a filament with a free end; tangent-angle for a finite-element filament without a clamped end) for model \"fem\" or \"spectral\"";
 /// The allowed positions x/L of the profile and two-time checks, for messages: the
 /// hinges x/L = 0 and 1 have w = 0 exactly, so nothing fluctuates there to check.
 const INTERIOR: &str = "in (0, 1) (inside the filament: w = 0 at the hinges x/L = 0 and 1)";
@@ -580,12 +580,20 @@ impl Scene {
             LINEAR_CHECKS
         };
         let rigid = self.membrane.is_none() && self.ends.rigid_modes() > 0;
+        // The cosines diagonalize the bending energy of θ only where every end leaves θ
+        // free (no clamp); the angle needs the finite-element slope.
+        let tangent = self.membrane.is_none()
+            && self.model == ModelKind::Fem
+            && ![self.ends.left, self.ends.right].contains(&End::Clamped);
         let misplaced = |k: &CheckKind| {
             k.is_compression() != compression
                 || (*k == CheckKind::XySymmetry && !self.is_square_membrane())
                 || (*k == CheckKind::RigidDiffusion && !rigid)
+                || (*k == CheckKind::TangentAngle && !tangent)
         };
-        let allowed = if kinds.contains(&CheckKind::RigidDiffusion) && !rigid {
+        let allowed = if kinds.contains(&CheckKind::TangentAngle) && !tangent {
+            "tangent-angle only for a finite-element filament (model = \"fem\") with no clamped end (the cosines of Gittes et al. diagonalize the bending energy only where theta is free at both ends); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"
+        } else if kinds.contains(&CheckKind::RigidDiffusion) && !rigid {
             "rigid-diffusion only for a filament with rigid modes (filament.ends free-free, hinged-free or free-hinged); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"
         } else if kinds.contains(&CheckKind::XySymmetry) && !self.is_square_membrane() {
             "xy-symmetry only for a membrane on a square patch (width = height, elements_y = elements); otherwise a linear check (profile, mode-variance, mode-distribution, decay-rate, spectrum, two-time, pooled-variance)"

@@ -227,6 +227,7 @@ fn linear_step(run: &LinearRun, kind: CheckKind) -> Result<Step> {
         CheckKind::PooledVariance => Step::AfterModes(pooled_variance_check),
         CheckKind::XySymmetry => Step::AfterModes(xy_symmetry_check),
         CheckKind::RigidDiffusion => Step::AfterModes(rigid_diffusion_check),
+        CheckKind::TangentAngle => Step::AfterModes(tangent_angle_check),
         CheckKind::ForceStrain | CheckKind::ForceDistribution | CheckKind::DtHalving => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
@@ -309,6 +310,7 @@ fn kind_name(kind: CheckKind) -> &'static str {
         CheckKind::PooledVariance => "pooled-variance",
         CheckKind::XySymmetry => "xy-symmetry",
         CheckKind::RigidDiffusion => "rigid-diffusion",
+        CheckKind::TangentAngle => "tangent-angle",
         CheckKind::ForceStrain => "force-strain",
         CheckKind::ForceDistribution => "force-distribution",
         CheckKind::DtHalving => "dt-halving",
@@ -831,8 +833,88 @@ fn rigid_diffusion_check(ctx: &mut LinearContext<'_>) -> Result<()> {
     if nr == 0 {
         ctx.est.skipped.push(SkippedCheck {
             name: format!("{prefix}/rigid-diffusion"),
-            reason: "no rigid-mode amplitudes: the ends allow no rigid motion, or the run's data carry none (trajectory files record the elastic shape and the elastic modes)".into(),
+            reason: "no rigid-mode amplitudes: the ends allow no rigid motion, or the data carry none (sidecar key rigid: the rigid coordinates w_mean, w_angle after the modal amplitudes)".into(),
         });
+    }
+    Ok(())
+}
+
+/// Largest thinning stride of a tangent-angle series (samples); a series that needs more
+/// is too short to give independent samples and its checks are skipped (noted).
+const MAX_TANGENT_STRIDE: usize = 10_000;
+
+/// Fewest thinned samples a tangent-angle check runs on.
+const MIN_TANGENT_SAMPLES: usize = 20;
+
+/// [`CheckKind::TangentAngle`]: per cosine n, the tangent-angle amplitudes of Gittes et
+/// al. (1993) over every trajectory and component, thinned by their exact
+/// autocorrelation ([`TangentReference::correlation`](crate::scene::linear::TangentReference))
+/// to a lag correlation ≤ [`MAX_THINNED_CORRELATION`]: the variance against the exact
+/// discrete value by a χ² test about the known mean 0 (continuum kT L²/(EI n²π²) beside
+/// it), and the law against N(0, that variance) by KS.
+fn tangent_angle_check(ctx: &mut LinearContext<'_>) -> Result<()> {
+    let run = ctx.run;
+    let prefix = &run.spec.name;
+    let nt = run.reference.tangent.len();
+    if nt == 0 {
+        ctx.est.skipped.push(SkippedCheck {
+            name: format!("{prefix}/tangent-angle"),
+            reason: "no tangent-angle amplitudes: the data carry none (sidecar key tangent_modes)"
+                .into(),
+        });
+    }
+    for (i, tr) in run.reference.tangent.iter().enumerate() {
+        let stride = tr.stride(
+            run.profile_every,
+            MAX_THINNED_CORRELATION,
+            MAX_TANGENT_STRIDE,
+        );
+        let series: Vec<&[f64]> = ctx
+            .records
+            .iter()
+            .flat_map(|t| (0..run.components).map(move |c| t.tangent[c * nt + i].as_slice()))
+            .collect();
+        let thinned = thin(&series, stride);
+        let name = |what: &str| format!("{prefix}/{what}/n={}", tr.n);
+        if stride >= MAX_TANGENT_STRIDE || thinned.len() < MIN_TANGENT_SAMPLES {
+            for what in ["tangent-variance", "tangent-ks"] {
+                ctx.est.skipped.push(SkippedCheck {
+                    name: name(what),
+                    reason: format!(
+                        "{} samples {stride} apart (lag correlation <= {MAX_THINNED_CORRELATION}); at least {MIN_TANGENT_SAMPLES} needed",
+                        thinned.len()
+                    ),
+                });
+            }
+            continue;
+        }
+        let v = tr.variance_discrete;
+        let o = stats::chi2_variance_test(&thinned, v, Some(0.0))?;
+        let s2 = thinned.iter().map(|q| q * q).sum::<f64>() / thinned.len() as f64;
+        ctx.out.push(check(
+            name("tangent-variance"),
+            "chi2-variance",
+            (s2, v, v * (2.0 / thinned.len() as f64).sqrt()),
+            &o,
+            Some(tr.variance_continuum),
+            format!(
+                "a_n = sqrt(2/L) int theta cos(n pi s/L) ds (Gittes et al. 1993): {} samples spaced {stride} profile samples apart (exact lag correlation <= {MAX_THINNED_CORRELATION}); ratio to the continuum kT L^2/(EI n^2 pi^2) {:.4}",
+                thinned.len(),
+                s2 / tr.variance_continuum
+            ),
+        ));
+        let o = stats::ks_normal(&thinned, 0.0, v.sqrt())?;
+        ctx.out.push(check(
+            name("tangent-ks"),
+            "ks",
+            (f64::NAN, f64::NAN, f64::NAN),
+            &o,
+            None,
+            format!(
+                "KS distance of the tangent-angle amplitude to N(0, {v:.4e}) over {} thinned samples",
+                thinned.len()
+            ),
+        ));
     }
     Ok(())
 }

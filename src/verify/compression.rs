@@ -53,7 +53,8 @@ fn compression_step(
         | CheckKind::TwoTime
         | CheckKind::PooledVariance
         | CheckKind::XySymmetry
-        | CheckKind::RigidDiffusion => {
+        | CheckKind::RigidDiffusion
+        | CheckKind::TangentAngle => {
             return Err(Error::invalid(
                 format!("checks of run {}", run.spec.name),
                 format!("{kind:?}"),

@@ -18,16 +18,20 @@
 //! simulates, and judged by the same checks ([`crate::verify::checks::linear_checks`]),
 //! family-wise correction and report.
 
-use crate::data::{DataObject, DataRun, DataSidecar, MAX_STEPS_PER_ROW, Start, Table, read_table};
+use crate::data::{
+    DataObject, DataRun, DataSidecar, MAX_STEPS_PER_ROW, Start, Table, filament_extra_columns,
+    read_table,
+};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::input::{human_bytes, open_regular, refused};
 use crate::params::FilamentParams;
 use crate::scene::compression::{CompressionRun, CompressionTheoryTable, ForceRecord};
 use crate::scene::linear::{
-    Continuum, LinearReference, LinearRun, ModeReference, TrajectoryRecord, TwoTimeReference,
+    Continuum, LinearReference, LinearRun, ModeReference, RigidReference, TangentReference,
+    TrajectoryRecord, TwoTimeReference, rigid_coordinates,
 };
-use crate::scene::{CompressionSpec, ModelKind, RunSpec, Scene};
+use crate::scene::{CheckKind, CompressionSpec, ModelKind, RunSpec, Scene};
 use crate::stats::moments::MIN_SERIES_LEN;
 use std::path::Path;
 
@@ -78,14 +82,18 @@ pub fn prepare_data_check(
         DataObject::Membrane(m) => data_scene.membrane = Some(m.params()),
     }
     let continuum = Continuum::of(&data_scene)?;
+    // The scene's τ₁ with the data's parameters: the unit of the scene's times (dt_tau1,
+    // two-time points), that of the ends' slowest elastic mode for other ends than hinges.
+    let tau1 = data_scene.tau1();
     let mut notes = Vec::new();
-    let discrete = discrete_run(&data_scene, object.tau1(), (dir, k), data, &mut notes)?;
+    let discrete = discrete_run(&data_scene, tau1, (dir, k), data, &mut notes)?;
     let spec = data_spec(scene, data);
     let (modes, scale, discrete) = mode_references(scene, data, &continuum, discrete, &mut notes);
     let d = discrete.as_ref();
     let profile = profile_references(scene, data, &continuum, d, &mut notes)?;
-    let (two_time, tt_cols) =
-        two_time_references(scene, data, object.tau1(), &continuum, d, &mut notes)?;
+    let (two_time, tt_cols) = two_time_references(scene, data, tau1, &continuum, d, &mut notes)?;
+    let rigid = rigid_data_references(&data_scene, data, d);
+    let tangent = tangent_data_references(&data_scene, (data, &spec), &continuum, d, &mut notes);
     let dts = data.dt_sample;
     let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
     let mode_every: Vec<u64> = modes
@@ -104,7 +112,8 @@ pub fn prepare_data_check(
         two_time,
         dt: dts,
         max_rate,
-        rigid: Vec::new(),
+        rigid,
+        tangent,
     };
     let run = LinearRun::for_data(
         spec,
@@ -114,13 +123,28 @@ pub fn prepare_data_check(
         profile_every,
         scale,
     );
+    let rigid_suffixes: Vec<&str> = if data.rigid {
+        rigid_coordinates(&data_scene.filament, data_scene.ends)
+            .iter()
+            .map(|r| r.1)
+            .collect()
+    } else {
+        Vec::new()
+    };
     let layout = Layout {
         n_positions: data.positions.len(),
         n_modes_data: data.modes,
+        n_rigid_data: rigid_suffixes.len(),
+        n_tangent_data: data.tangent_modes,
         profile_cols: profile.3,
         tt_cols,
     };
-    let columns = object.columns(sidecar.dims, data.positions.len(), data.modes)?;
+    let mut columns = object.columns(sidecar.dims, data.positions.len(), data.modes)?;
+    columns.extend(filament_extra_columns(
+        sidecar.dims,
+        &rigid_suffixes,
+        data.tangent_modes,
+    ));
     let (records, products) = read_records(&run, (data, &columns), dir, k, &layout, max_bytes)?;
     Ok(DataCheck {
         run,
@@ -295,6 +319,32 @@ fn check_linear_data(scene: &Scene, sidecar: &DataSidecar, dir: &Path, k: usize)
             ),
         ));
     }
+    let filament = !scene.is_membrane();
+    if data.rigid && !(filament && scene.ends.rigid_modes() > 0) {
+        return Err(key_err(
+            "rigid",
+            format!(
+                "is true, but scene {} has no rigid modes (its ends are {}): give rigid coordinates only for a filament with a free end and no clamp",
+                scene.name,
+                if filament {
+                    scene.ends.to_string()
+                } else {
+                    "a membrane's".into()
+                }
+            ),
+        ));
+    }
+    if data.tangent_modes > 0
+        && [scene.ends.left, scene.ends.right].contains(&crate::params::End::Clamped)
+    {
+        return Err(key_err(
+            "tangent_modes",
+            format!(
+                "is {}, but scene {} has a clamped end ({}): the tangent-angle cosines diagonalize the bending energy only where both ends leave the angle free; give 0 (leave the key out)",
+                data.tangent_modes, scene.name, scene.ends
+            ),
+        ));
+    }
     Ok(())
 }
 
@@ -376,6 +426,92 @@ fn mode_references(
         ));
     }
     (modes, scale, discrete)
+}
+
+/// The rigid modes' laws of data run `data` (none unless its files carry the rigid
+/// coordinates, sidecar `rigid`), in `r = ψᵀCw` units: the producer's discretization's
+/// (`discrete`) or the continuum's (a random walk of diffusivity 2kT, the centre of mass
+/// `2kT/(ξL)` and the angle `2kT/(ξI)` in physical units).
+fn rigid_data_references(
+    scene: &Scene,
+    data: &DataRun,
+    discrete: Option<&LinearRun>,
+) -> Vec<RigidReference> {
+    if !data.rigid {
+        return Vec::new();
+    }
+    let kt = scene.filament.kt;
+    rigid_coordinates(&scene.filament, scene.ends)
+        .into_iter()
+        .enumerate()
+        .map(|(k, (name, coordinate, coordinate_scale))| {
+            match discrete.and_then(|d| d.reference.rigid.get(k)) {
+                Some(r) => r.clone(),
+                None => RigidReference {
+                    name: name.to_string(),
+                    diffusion_discrete: 2.0 * kt,
+                    diffusion_continuum: 2.0 * kt,
+                    simulated: true,
+                    coordinate,
+                    coordinate_scale,
+                },
+            }
+        })
+        .collect()
+}
+
+/// The tangent-angle laws of data run `data` (run `spec` of the scene) when the run
+/// checks `tangent-angle`: for its first `min(tangent_modes, sampling.modes)` cosines, the
+/// producer's discretization's (`discrete`, its autocorrelation per row of the data) or
+/// the continuum's variance kT L²/(EI n²π²) with the bound e^{−λ₁t} on the
+/// autocorrelation; notes for cosines the data do not carry.
+fn tangent_data_references(
+    scene: &Scene,
+    (data, spec): (&DataRun, &RunSpec),
+    continuum: &Continuum,
+    discrete: Option<&LinearRun>,
+    notes: &mut Vec<String>,
+) -> Vec<TangentReference> {
+    if !spec.checks(scene).contains(&CheckKind::TangentAngle) {
+        return Vec::new();
+    }
+    let wanted = scene.sampling.modes;
+    let count = wanted.min(data.tangent_modes);
+    if count < wanted {
+        notes.push(format!(
+            "run {}: the data carry {} tangent-angle amplitudes per component (sidecar tangent_modes); cosines {}..{wanted} of the scene are not checked",
+            data.name,
+            data.tangent_modes,
+            count + 1
+        ));
+    }
+    let dts = data.dt_sample;
+    let per_row = discrete.map(|d| (dts / d.reference.dt).round());
+    match (discrete, per_row) {
+        (Some(d), Some(r)) if d.reference.tangent.len() >= count => d.reference.tangent[..count]
+            .iter()
+            .map(|t| TangentReference {
+                terms: t.terms.iter().map(|&(u, m)| (u, m.powf(r))).collect(),
+                ..t.clone()
+            })
+            .collect(),
+        _ => {
+            let p = &scene.filament;
+            let decay = (-continuum.mode_rate(1) * dts).exp();
+            (1..=count)
+                .map(|n| {
+                    let q = n as f64 * std::f64::consts::PI / p.length;
+                    let v = p.kt / (p.bending_rigidity * q * q);
+                    TangentReference {
+                        n,
+                        variance_discrete: v,
+                        variance_continuum: v,
+                        terms: vec![(1.0, decay)],
+                    }
+                })
+                .collect()
+        }
+    }
 }
 
 /// The column of the data's position `x`, if any.
@@ -624,6 +760,10 @@ fn read_records(
 struct Layout {
     n_positions: usize,
     n_modes_data: usize,
+    /// Rigid coordinates per component in the files.
+    n_rigid_data: usize,
+    /// Tangent-angle amplitudes per component in the files.
+    n_tangent_data: usize,
     profile_cols: Vec<usize>,
     tt_cols: Vec<(usize, usize)>,
 }
@@ -672,6 +812,36 @@ fn read_record(
             );
         }
     }
+    // After the modal amplitudes: the rigid coordinates, then the tangent-angle
+    // amplitudes, each component by component.
+    let extra = 1 + c * np + c * layout.n_modes_data;
+    let rigid_col = |k: usize, r: usize| extra + k * layout.n_rigid_data + r;
+    let tangent_col =
+        |k: usize, i: usize| extra + c * layout.n_rigid_data + k * layout.n_tangent_data + i;
+    let rigid_refs = &run.reference.rigid;
+    let mut rigid = Vec::with_capacity(c * rigid_refs.len());
+    for k in 0..c {
+        for (r, law) in rigid_refs.iter().enumerate() {
+            require_magnitude(table, (path, key), rigid_col(k, r), law.coordinate_scale)?;
+            rigid.push(
+                rows_from(run.profile_every)
+                    .map(|row| table.get(row, rigid_col(k, r)) * law.coordinate_scale)
+                    .collect(),
+            );
+        }
+    }
+    let nt = run.reference.tangent.len();
+    let mut tangent = Vec::with_capacity(c * nt);
+    for k in 0..c {
+        for i in 0..nt {
+            require_magnitude(table, (path, key), tangent_col(k, i), 1.0)?;
+            tangent.push(
+                rows_from(run.profile_every)
+                    .map(|row| table.get(row, tangent_col(k, i)))
+                    .collect(),
+            );
+        }
+    }
     let mut profile = Vec::with_capacity(c * layout.profile_cols.len());
     for k in 0..c {
         for &j in &layout.profile_cols {
@@ -708,7 +878,8 @@ fn read_record(
     let record = TrajectoryRecord {
         modes,
         profile,
-        rigid: Vec::new(),
+        rigid,
+        tangent,
         two_time: two_time.clone(),
         slope_squares: Vec::new(),
         slope_samples: 0,
@@ -1131,6 +1302,8 @@ mod tests {
                 .map(|j| format!("{name}-{}/t{j}.csv", strain_ratio.unwrap_or(0.0)))
                 .collect(),
             strain_ratio,
+            rigid: false,
+            tangent_modes: 0,
         }
     }
 

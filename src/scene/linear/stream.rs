@@ -75,7 +75,15 @@ impl LinearRun {
                 let labels: Vec<_> = r.modes.iter().filter_map(|m| m.label).collect();
                 crate::data::membrane_columns(positions.len(), &labels)
             } else {
-                crate::data::columns(self.components + 1, positions.len(), r.modes.len())
+                let dims = self.components + 1;
+                let rigid: Vec<&str> = r.rigid.iter().map(|m| m.coordinate).collect();
+                let mut c = crate::data::columns(dims, positions.len(), r.modes.len());
+                c.extend(crate::data::filament_extra_columns(
+                    dims,
+                    &rigid,
+                    r.tangent.len(),
+                ));
+                c
             },
             positions,
             every,
@@ -125,6 +133,8 @@ struct RowWriter<'r> {
     row: Vec<f64>,
     deflections: Vec<f64>,
     modes: Vec<f64>,
+    rigid: Vec<f64>,
+    tangent: Vec<f64>,
 }
 
 impl<'r> RowWriter<'r> {
@@ -137,6 +147,8 @@ impl<'r> RowWriter<'r> {
             row: Vec::with_capacity(plan.columns.len()),
             deflections: vec![0.0; c * plan.positions.len()],
             modes: vec![0.0; c * run.reference.modes.len()],
+            rigid: vec![0.0; c * run.reference.rigid.len()],
+            tangent: vec![0.0; c * run.reference.tangent.len()],
         }
     }
 
@@ -156,6 +168,22 @@ impl<'r> RowWriter<'r> {
                 .enumerate()
                 .map(|(k, q)| q * self.run.amplitude_scale[k % nm]),
         );
+        // The rigid coordinates in physical units (centre of mass, angle), then the
+        // tangent-angle amplitudes (the data format's order).
+        let rigid = &self.run.reference.rigid;
+        if !rigid.is_empty() {
+            sampler.rigid(&mut self.rigid);
+            self.row.extend(
+                self.rigid
+                    .iter()
+                    .enumerate()
+                    .map(|(k, r)| r / rigid[k % rigid.len()].coordinate_scale),
+            );
+        }
+        if let Some(g) = self.run.tangent_functionals() {
+            sampler.functionals(g, &mut self.tangent);
+            self.row.extend(&self.tangent);
+        }
         if let Err(e) = file.push_row(&self.row) {
             self.file = Err(e);
         }
