@@ -32,9 +32,12 @@
 //! ```
 //!
 //! Further arguments: `soft` or `stiff` (one set-up), a proposal's name (`crank-nicolson`,
-//! `newton`, `newton-slow`, `ornstein-uhlenbeck`: those only), `verbose` (each strain on
-//! stderr). `newton-slow` is [`Proposal::Newton`] with the rank-one term on the slowest
-//! groups only ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1).
+//! `newton`, `newton-slow`, `ornstein-uhlenbeck`, `crank-nicolson+radial`,
+//! `newton-slow+radial`: those only), `verbose` (each strain on stderr). `newton-slow` is
+//! [`Proposal::Newton`] with the rank-one term on the slowest groups only
+//! ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1); `+radial` adds a radial move
+//! after every step from the end of the scenes' burn-in on
+//! ([`ModalMetropolis::with_radial_moves`]).
 
 #[path = "common/cpu.rs"]
 mod cpu;
@@ -145,8 +148,7 @@ struct Point {
 fn run_point(
     model: &AreaMembrane,
     modes: &PlateModes,
-    kind: Proposal,
-    rank_one_limit: Option<f64>,
+    (kind, rank_one_limit, radial): (Proposal, Option<f64>, bool),
     dt_tau1: f64,
     tau1: f64,
     exact: f64,
@@ -164,6 +166,12 @@ fn run_point(
     }
     for _ in 0..SCENE_BURN_IN_STEPS {
         chain.step(&mut rng);
+    }
+    // Radial moves from equilibrium on: from the buckled start, far from it (aᵀΛa ≈ 5N kT
+    // at 20 ε_c0), the first one shrinks the state into a compressed saddle region that
+    // the Crank–Nicolson proposal, with its frozen force, cannot leave.
+    if radial {
+        chain = chain.with_radial_moves();
     }
     chain.set_dt(dt_tau1 * tau1).expect("dt");
     for _ in 0..OWN_BURN_IN {
@@ -222,12 +230,25 @@ fn main() {
     } else {
         &[0.02, 0.08, 0.32, 1.0]
     };
-    // (name, proposal, rank-one term on the groups with rates ≤ this × λ_1 only)
+    // (name, proposal, rank-one term on the groups with rates ≤ this × λ_1 only, radial
+    // moves)
     let proposals = [
-        ("crank-nicolson", Proposal::CrankNicolson, None),
-        ("newton", Proposal::Newton, None),
-        ("newton-slow", Proposal::Newton, Some(SLOW_RATES)),
-        ("ornstein-uhlenbeck", Proposal::OrnsteinUhlenbeck, None),
+        ("crank-nicolson", Proposal::CrankNicolson, None, false),
+        ("newton", Proposal::Newton, None, false),
+        ("newton-slow", Proposal::Newton, Some(SLOW_RATES), false),
+        (
+            "ornstein-uhlenbeck",
+            Proposal::OrnsteinUhlenbeck,
+            None,
+            false,
+        ),
+        ("crank-nicolson+radial", Proposal::CrankNicolson, None, true),
+        (
+            "newton-slow+radial",
+            Proposal::Newton,
+            Some(SLOW_RATES),
+            true,
+        ),
     ];
     println!(
         "membrane under imposed area, {ELEMENTS} x {ELEMENTS} elements, {STRAINS} strains, se <= {TARGET} sigma_c0{}",
@@ -280,7 +301,7 @@ fn main() {
                 (i, r, m, theory.tension_ratio(r).expect("exact tension"))
             })
             .collect();
-        for (label, kind, limit) in proposals {
+        for (label, kind, limit, radial) in proposals {
             if !chosen(label, &proposals.map(|p| p.0)) {
                 continue;
             }
@@ -291,7 +312,15 @@ fn main() {
                 let points: Vec<Point> = models
                     .iter()
                     .map(|(i, _, m, exact)| {
-                        run_point(m, &modes, kind, limit, dt_tau1, tau1, *exact, *i as u64)
+                        run_point(
+                            m,
+                            &modes,
+                            (kind, limit, radial),
+                            dt_tau1,
+                            tau1,
+                            *exact,
+                            *i as u64,
+                        )
                     })
                     .collect();
                 let total: f64 = points.iter().map(|p| p.cpu_needed).sum::<f64>() * scale;
