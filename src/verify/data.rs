@@ -1359,6 +1359,31 @@ mod tests {
         1.0 / std::f64::consts::PI.powi(4)
     }
 
+    fn builtin(name: &str) -> Scene {
+        crate::scene::builtin::find(name).unwrap().load().unwrap()
+    }
+
+    /// Rigid coordinates (`rigid`) against a scene whose ends allow no rigid motion, and
+    /// tangent-angle amplitudes (`tangent_modes`) against one with a clamped end, are
+    /// refused naming the key.
+    #[test]
+    fn rigid_and_tangent_columns_are_refused_where_the_ends_have_none() {
+        let dir = temp("ends-keys");
+        let mut r = run("cn", tau1() / 100.0, None);
+        r.rigid = true;
+        let side = write(&dir, &linear(vec![r]), 600);
+        for name in ["hinged-linear-2d", "grafted-clamped-free"] {
+            let r = prepare_data_check(&builtin(name), &side, &dir, 0, CAP);
+            refusal(r, &["key `runs[0].rigid`", "has no rigid modes", name]);
+        }
+        let mut r = run("cn", tau1() / 100.0, None);
+        r.tangent_modes = 3;
+        let side = write(&dir, &linear(vec![r]), 600);
+        let r = prepare_data_check(&builtin("grafted-clamped-free"), &side, &dir, 0, CAP);
+        refusal(r, &["key `runs[0].tangent_modes`", "clamped end", "is 3"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     /// Valid data are read; too few rows after the burn-in are still refused naming
     /// `runs[k].files`; a two-time point beyond the rows names the file.
     /// Data of the other object are refused before their files are read, naming the
