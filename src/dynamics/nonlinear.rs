@@ -33,7 +33,7 @@ use super::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::banded::{BandedCholesky, SymBanded};
 use crate::fem::noise::{NoiseGenerator, NoiseModel};
-use crate::fem::vonkarman::CompressedFilament;
+use crate::fem::vonkarman::{AxialScratch, CompressedFilament};
 use crate::rng::TrajectoryRng;
 use rand::RngExt;
 
@@ -136,6 +136,8 @@ pub struct NonlinearIntegrator<'m> {
     /// Metropolis: the chain's work space (`None` for the θ-schemes).
     mh: Option<MhBuffers>,
     scratch: [Vec<f64>; 3],
+    /// Step (i) of the paper's explicit scheme: the axial solve's work space.
+    axial: AxialScratch,
     /// Proposals made (Metropolis only).
     pub proposed: u64,
     /// Accepted proposals (Metropolis only).
@@ -222,6 +224,7 @@ impl<'m> NonlinearIntegrator<'m> {
             mh_base,
             mh,
             scratch: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
+            axial: AxialScratch::default(),
             proposed: 0,
             accepted: 0,
         })
@@ -266,7 +269,8 @@ impl<'m> NonlinearIntegrator<'m> {
         }
         let s = two_l_s / (2.0 * p.length);
         let f = if self.kind == IntegratorKind::EulerMaruyama {
-            -model.axial_equilibrium(w).element_force[0]
+            model.axial_equilibrium_into(w, &mut self.axial);
+            -self.axial.element_force[0]
         } else {
             model.compressive_force(s)
         };
@@ -690,7 +694,8 @@ pub(crate) mod tests {
     }
 
     /// After construction (and the first step, which evaluates the initial state), a
-    /// Metropolis or Crank–Nicolson step allocates nothing, with proposals both accepted
+    /// Metropolis, Crank–Nicolson or explicit (paper's, with its axial solve) step
+    /// allocates nothing, with proposals both accepted
     /// and rejected; 2D and 3D, in tension and buckled.
     #[test]
     fn steps_do_not_allocate() {
@@ -700,11 +705,17 @@ pub(crate) mod tests {
         for kind in [
             IntegratorKind::MetropolisCrankNicolson,
             IntegratorKind::CrankNicolson,
+            IntegratorKind::EulerMaruyama,
         ] {
             for dims in [2, 3] {
                 for ratio in [0.0, 6.0] {
                     let m = model(dims, ratio);
-                    let dt = 0.05 * m.beam().params().tau1();
+                    // The explicit scheme at half its stability limit 2/λ_max.
+                    let dt = if kind == IntegratorKind::EulerMaruyama {
+                        1.0 / m.beam().max_rate().unwrap()
+                    } else {
+                        0.05 * m.beam().params().tau1()
+                    };
                     let mut integ =
                         NonlinearIntegrator::new(&m, kind, NoiseModel::Consistent, dt).unwrap();
                     let mut w = random_state(&m, 0.01, 40 + dims as u64);

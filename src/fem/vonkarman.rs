@@ -74,6 +74,20 @@ pub struct CompressedFilament {
     strain: f64,
 }
 
+/// Work space of [`CompressedFilament::axial_equilibrium_into`]: the element-mean half
+/// squared slopes, the tridiagonal system and its solution.
+#[derive(Debug, Clone, Default)]
+pub struct AxialScratch {
+    s: Vec<f64>,
+    /// Nodal axial displacements u_0 = 0, …, u_N = −Δ (after a solve).
+    pub u: Vec<f64>,
+    k: Vec<f64>,
+    diag: Vec<f64>,
+    rhs: Vec<f64>,
+    /// Axial force N per element (tension positive; after a solve).
+    pub element_force: Vec<f64>,
+}
+
 /// Result of the axial equilibrium solve (step i).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AxialSolution {
@@ -172,36 +186,59 @@ impl CompressedFilament {
     /// `(EA/h_{e−1})(u_e − u_{e−1}) − (EA/h_e)(u_{e+1} − u_e) = EA(s_e − s_{e−1})` (node e), solved
     /// by the Thomas algorithm in O(N).
     pub fn axial_equilibrium(&self, w: &[Vec<f64>]) -> AxialSolution {
+        let mut scratch = AxialScratch::default();
+        self.axial_equilibrium_into(w, &mut scratch);
+        AxialSolution {
+            u: scratch.u,
+            element_force: scratch.element_force,
+        }
+    }
+
+    /// [`Self::axial_equilibrium`] into the buffers of `scratch` (the same arithmetic, so
+    /// the same bits; allocation-free once the buffers have their size): the paper's
+    /// explicit scheme solves step (i) at every step.
+    pub fn axial_equilibrium_into(&self, w: &[Vec<f64>], scratch: &mut AxialScratch) {
         let mesh = self.beam.mesh();
         let ne = mesh.n_elements();
         let ea = self.beam.params().stretch_rigidity;
         let delta = self.strain * mesh.length();
+        let AxialScratch {
+            s,
+            u,
+            k,
+            diag,
+            rhs,
+            element_force,
+        } = scratch;
         // Element-mean half squared slope s_e.
-        let s: Vec<f64> = (0..ne)
-            .map(|e| {
-                let h = mesh.element_length(e);
-                let g = geometric_matrix(h);
-                let dofs = self.beam.element_dofs(e);
-                let mut acc = 0.0;
-                for c in w {
-                    let loc: Vec<f64> = dofs.iter().map(|d| d.map_or(0.0, |i| c[i])).collect();
-                    for a in 0..4 {
-                        for b in 0..4 {
-                            acc += loc[a] * g[a][b] * loc[b];
-                        }
+        s.clear();
+        s.extend((0..ne).map(|e| {
+            let h = mesh.element_length(e);
+            let g = geometric_matrix(h);
+            let dofs = self.beam.element_dofs(e);
+            let mut acc = 0.0;
+            for c in w {
+                let loc = dofs.map(|d| d.map_or(0.0, |i| c[i]));
+                for a in 0..4 {
+                    for b in 0..4 {
+                        acc += loc[a] * g[a][b] * loc[b];
                     }
                 }
-                acc / (2.0 * h)
-            })
-            .collect();
-        let mut u = vec![0.0; ne + 1];
+            }
+            acc / (2.0 * h)
+        }));
+        u.clear();
+        u.resize(ne + 1, 0.0);
         u[ne] = -delta;
         let m = ne - 1; // interior unknowns u_1..u_{N-1}
         if m > 0 {
-            let k: Vec<f64> = (0..ne).map(|e| ea / mesh.element_length(e)).collect();
+            k.clear();
+            k.extend((0..ne).map(|e| ea / mesh.element_length(e)));
             // Row i (node i+1): −k_i u_i + (k_i + k_{i+1}) u_{i+1} − k_{i+1} u_{i+2} = EA(s_{i+1} − s_i).
-            let mut diag: Vec<f64> = (0..m).map(|i| k[i] + k[i + 1]).collect();
-            let mut rhs: Vec<f64> = (0..m).map(|i| ea * (s[i + 1] - s[i])).collect();
+            diag.clear();
+            diag.extend((0..m).map(|i| k[i] + k[i + 1]));
+            rhs.clear();
+            rhs.extend((0..m).map(|i| ea * (s[i + 1] - s[i])));
             rhs[m - 1] += k[ne - 1] * u[ne];
             for i in 1..m {
                 let f = -k[i] / diag[i - 1];
@@ -213,10 +250,9 @@ impl CompressedFilament {
                 u[i] = (rhs[i - 1] + k[i] * u[i + 1]) / diag[i - 1];
             }
         }
-        let element_force = (0..ne)
-            .map(|e| ea * ((u[e + 1] - u[e]) / mesh.element_length(e) + s[e]))
-            .collect();
-        AxialSolution { u, element_force }
+        element_force.clear();
+        element_force
+            .extend((0..ne).map(|e| ea * ((u[e + 1] - u[e]) / mesh.element_length(e) + s[e])));
     }
 
     /// The axial equilibrium residual of state `w` against the compressive force `force`

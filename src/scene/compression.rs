@@ -5,15 +5,17 @@
 //! projected area ([`AreaMembrane`], issue #28), whose compressive stress `F = −σ` is
 //! recorded in units of `σ_c0 = κq²_min` exactly as the filament's force in units of F_c0.
 
-use crate::dynamics::{Driver, Family, ModalMetropolis, NonlinearState, Observer};
+use crate::dynamics::{Driver, Family, IntegratorKind, ModalMetropolis, NonlinearState, Observer};
 use crate::error::{Error, Result};
 use crate::fem::area::AreaMembrane;
 use crate::fem::banded::BandedCholesky;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
+use crate::fem::noise::NoiseModel;
 use crate::fem::paired::PairedModes;
 use crate::fem::plate_area::{AreaCutoff, AreaParams, AreaTheory};
 use crate::fem::plate_modes::PlateModes;
+use crate::params::FilamentParams;
 use crate::rng::{TrajectoryRng, trajectory_rng};
 use crate::scene::linear::{add_slope_squares, largest_rms_slope};
 use crate::scene::{CompressionSpec, RunSpec, Scene, StepSearch};
@@ -321,6 +323,9 @@ pub struct CompressionRun {
     /// Euler buckling load F_c0 (the unit of the recorded forces); a membrane's buckling
     /// stress σ_c0.
     pub euler_load: f64,
+    /// The scene's filament, its dims and element count (a membrane: `None`): the true
+    /// parameters, whatever fault the chain's model carries, for [`Self::scheme_band`].
+    filament: Option<(FilamentParams, Dims, usize)>,
     /// The injected fault's factor on the modal chain's proposal force
     /// ([`crate::fault::FaultKind::ProposalForce`]).
     #[cfg(any(test, feature = "faults"))]
@@ -417,6 +422,7 @@ impl CompressionRun {
                 models,
             },
             euler_load: p.euler_load(),
+            filament: Some((p, Dims::from_u32(scene.dims as u32)?, scene.mesh.elements)),
             #[cfg(any(test, feature = "faults"))]
             proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
@@ -477,9 +483,51 @@ impl CompressionRun {
             sample_interval,
             object: Strained::Membrane { models, modes },
             euler_load: sigma_c0,
+            filament: None,
             #[cfg(any(test, feature = "faults"))]
             proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
+    }
+
+    /// The tolerance band of ⟨F⟩/F_c0 at each of `strain_ratios` for a run whose linear
+    /// part is not fluctuation–dissipation exact at its step — the paper's explicit scheme
+    /// (`euler-maruyama`: its stiff modes' variance `1/(1 − λΔt/2)`) or the paper's
+    /// element-uniform noise (eq. 5: a per-mode deficit) — on a filament: around the
+    /// linear-response prediction `F_pred = F_exact + Δ` of that scheme
+    /// ([`crate::theory::scheme_law`]), half-width `|Δ|/2` (the allowance for the
+    /// prediction's neglect of the nonlinear coupling under such noise), as
+    /// `(F_exact + Δ − |Δ|/2, F_exact + Δ + |Δ|/2)`. `None` for every other run (its
+    /// reference is the exact discrete theory itself, with no tolerance).
+    ///
+    /// # Errors
+    /// As [`crate::theory::scheme_law::scheme_force_ratios`].
+    pub fn scheme_band(&self, strain_ratios: &[f64]) -> Result<Option<Vec<(f64, f64)>>> {
+        let Some((params, dims, elements)) = self.filament else {
+            return Ok(None);
+        };
+        if self.spec.integrator != IntegratorKind::EulerMaruyama
+            && self.spec.noise != NoiseModel::ElementUniform
+        {
+            return Ok(None);
+        }
+        let pairs = crate::theory::scheme_law::scheme_force_ratios(
+            &params,
+            dims,
+            elements,
+            self.spec.integrator,
+            self.spec.noise,
+            self.dt,
+            strain_ratios,
+        )?;
+        Ok(Some(
+            pairs
+                .into_iter()
+                .map(|(pred, exact)| {
+                    let half = 0.5 * (pred - exact).abs();
+                    (pred - half, pred + half)
+                })
+                .collect(),
+        ))
     }
 
     /// Number of steps for a sampled duration (physical time) at the scene's step `dt`.

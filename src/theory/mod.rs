@@ -6,8 +6,12 @@
 //!   Hermite-cubic discretization the simulator uses.
 //!   Its [`GlobalConstraint`] also serves the filament in tension and the membrane under
 //!   imposed projected area ([`crate::fem::plate_area`]).
+//! - [`scheme_law`]: the linear-response prediction of ⟨F⟩(ε) for a scheme that is not
+//!   fluctuation–dissipation exact (the paper's explicit scheme with its element-uniform
+//!   noise, eq. 5): how far it is expected to sit from the exact theory.
 
 pub mod compression;
+pub mod scheme_law;
 
 pub use compression::{
     CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, ForceDistribution, GlobalConstraint,

@@ -110,13 +110,19 @@ const MIN_TRAJECTORIES_FOR_T: usize = 4;
 /// compared with its correlation time, and an IAT error is then itself uncertain and
 /// correlated with the estimate: the z-tails were heavier than normal (the calibration
 /// found a false-alarm rate above α). Returns (estimate, error, outcome, kind, detail).
+///
+/// With a tolerance `band` (lo, hi) the estimate is tested against the nearest point of
+/// the band (the estimate itself inside it: statistic 0, p = 1), so each tail outside it
+/// is rejected at the level of the two-sided test against its edge.
 fn force_point_test(
     point: &[ForceRecord],
     iat: (f64, f64),
     reference: f64,
+    band: Option<(f64, f64)>,
 ) -> Result<(f64, f64, stats::TestOutcome, &'static str, String)> {
+    let nearest = |m: f64| band.map_or(reference, |(lo, hi)| m.clamp(lo, hi));
     if point.len() < MIN_TRAJECTORIES_FOR_T {
-        let o = stats::z_test(iat.0, reference, iat.1)?;
+        let o = stats::z_test(iat.0, nearest(iat.0), iat.1)?;
         return Ok((
             iat.0,
             iat.1,
@@ -130,7 +136,7 @@ fn force_point_test(
         .map(|r| r.force_ratio.iter().sum::<f64>() / r.force_ratio.len() as f64)
         .collect();
     let m = stats::ensemble_mean(&means)?;
-    let o = stats::t_test(m.mean, reference, m.std_error, means.len())?;
+    let o = stats::t_test(m.mean, nearest(m.mean), m.std_error, means.len())?;
     Ok((
         m.mean,
         m.std_error,
@@ -150,10 +156,12 @@ fn force_point_test(
 fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> Result<()> {
     let name = &x.run.spec.name;
     let theory = x.theory;
+    let bands = x.run.scheme_band(&theory.strain_ratios)?;
     let mut z = Vec::new();
     for (i, &(f, se)) in x.est.force.iter().enumerate() {
+        let band = bands.as_ref().map(|b| b[i]);
         let (mean, se, o, kind, how) =
-            force_point_test(&x.records[i], (f, se), theory.discrete[i])?;
+            force_point_test(&x.records[i], (f, se), theory.discrete[i], band)?;
         // The score with the same p-value, so that the χ² sum holds for t-tests too.
         z.push(stats::equivalent_z(o.statistic, o.p_value)?);
         out.push(CheckResult::statistical(
@@ -162,7 +170,10 @@ fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> 
             (mean, theory.discrete[i], se),
             Some(theory.continuum[i]),
             &o,
-            format!("<F>/F_c0 over {how}"),
+            match band {
+                None => format!("<F>/F_c0 over {how}"),
+                Some(b) => band_detail(&how, theory.discrete[i], b),
+            },
         ));
     }
     let o = stats::chi2_sum_test(&z)?;
@@ -178,10 +189,75 @@ fn force_strain_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult>) -> 
             z.len()
         ),
     ));
-    out.push(mean_bias_check(name, &x.est.force, &theory.discrete)?);
+    out.push(match &bands {
+        None => mean_bias_check(name, &x.est.force, &theory.discrete)?,
+        Some(b) => mean_bias_band_check(name, &x.est.force, &theory.discrete, b)?,
+    });
     out.extend(axial_residual_check(name, x.records, &theory.strain_ratios));
     out.extend(proposal_drift_check(name, x.records, &theory.strain_ratios));
     Ok(())
+}
+
+/// The detail of a point tested against a tolerance band: the deviation from the exact
+/// discrete theory (the check's reference column) and the band it must lie in.
+fn band_detail(how: &str, exact: f64, (lo, hi): (f64, f64)) -> String {
+    let centre = 0.5 * (lo + hi);
+    format!(
+        "<F>/F_c0 over {how}; tested against the tolerance band [{lo:.4}, {hi:.4}]: the \
+         linear-response prediction of this scheme's noise and step {centre:.4} (exact \
+         discrete theory {exact:.4} {:+.4}) +/- half its predicted shift (theory::scheme_law)",
+        centre - exact
+    )
+}
+
+/// [`mean_bias_check`] for a run with a tolerance band per strain (the paper's explicit
+/// scheme or its element-uniform noise, [`crate::scene::compression::CompressionRun::scheme_band`]):
+/// the mean over the strains of `⟨F⟩ − F_discrete` z-tested against the nearest point of
+/// the mean band (inside it: statistic 0, p = 1). A systematic error beyond the predicted
+/// deviation of the scheme and its allowance is found with √n times the power of a point.
+///
+/// # Errors
+/// No strains, or a non-finite standard error.
+pub fn mean_bias_band_check(
+    name: &str,
+    force: &[(f64, f64)],
+    discrete: &[f64],
+    bands: &[(f64, f64)],
+) -> Result<CheckResult> {
+    let n = force.len() as f64;
+    let mean = force
+        .iter()
+        .zip(discrete)
+        .map(|(f, d)| f.0 - d)
+        .sum::<f64>()
+        / n;
+    let se = force.iter().map(|f| f.1 * f.1).sum::<f64>().sqrt() / n;
+    let lo = bands
+        .iter()
+        .zip(discrete)
+        .map(|(b, d)| b.0 - d)
+        .sum::<f64>()
+        / n;
+    let hi = bands
+        .iter()
+        .zip(discrete)
+        .map(|(b, d)| b.1 - d)
+        .sum::<f64>()
+        / n;
+    let o = stats::z_test(mean, mean.clamp(lo, hi), se)?;
+    Ok(CheckResult::statistical(
+        format!("{name}/force-mean-bias"),
+        "z-test",
+        (mean, 0.0, se),
+        None,
+        &o,
+        format!(
+            "mean of <F>/F_c0 - exact discrete theory over {} strains, tested against the \
+             mean tolerance band [{lo:.4}, {hi:.4}] (the scheme's predicted deviation \
+             +/- half of it: its noise and step are not fluctuation-dissipation exact)",
+            force.len()
+        ),
+    ))
 }
 
 /// Round-off allowance of the axial equilibrium residual per degree of freedom squared,
@@ -448,7 +524,10 @@ pub fn halving_check(
 
 #[cfg(test)]
 mod tests {
-    use super::{ForceRecord, axial_residual_check, mean_bias_check, proposal_drift_check};
+    use super::{
+        ForceRecord, axial_residual_check, mean_bias_band_check, mean_bias_check,
+        proposal_drift_check,
+    };
     use crate::fem::noise::standard_normal;
     use crate::rng::trajectory_rng;
 
@@ -491,6 +570,73 @@ mod tests {
             "false rejections {rejected}/{reps}"
         );
         assert!(found as f64 / n > 0.8, "shift found in {found}/{reps}");
+    }
+
+    /// The band version of the mean-bias check: estimates whose true mean lies anywhere
+    /// in the band (here at its upper edge, the worst case; band [0.02, 0.04] above the
+    /// reference) are rejected at α = 0.01 in at most about α/2 of 2000 replicates (2 %
+    /// allowed), estimates at the band's centre never; estimates 0.006 beyond the band's
+    /// edge (3.7 s.e. of the mean) are rejected in more than 80 %, and so is the exact
+    /// discrete theory's own value when the band lies 0.03 away from it.
+    #[test]
+    fn mean_bias_band_check_accepts_the_band_and_rejects_beyond_it() {
+        let se: Vec<f64> = (0..12).map(|i| 0.002 + 0.006 * i as f64 / 11.0).collect();
+        let reference: Vec<f64> = (0..12).map(|i| 1.0 - 0.05 * i as f64).collect();
+        let bands: Vec<(f64, f64)> = reference.iter().map(|r| (r + 0.02, r + 0.04)).collect();
+        let mut rng = trajectory_rng(20261204, 0);
+        let (mut at_edge, mut at_centre, mut beyond, mut exact) = (0, 0, 0, 0);
+        let reps = 2000;
+        for _ in 0..reps {
+            let noise: Vec<f64> = se.iter().map(|s| s * standard_normal(&mut rng)).collect();
+            let draw = |offset: f64| -> Vec<(f64, f64)> {
+                reference
+                    .iter()
+                    .zip(&noise)
+                    .zip(&se)
+                    .map(|((r, e), s)| (r + offset + e, *s))
+                    .collect()
+            };
+            let rejects = |f: &[(f64, f64)]| {
+                let c = mean_bias_band_check("run", f, &reference, &bands).unwrap();
+                usize::from(c.p_value.unwrap() < 0.01)
+            };
+            at_edge += rejects(&draw(0.04));
+            at_centre += rejects(&draw(0.03));
+            beyond += rejects(&draw(0.046));
+            exact += rejects(&draw(-0.0));
+        }
+        let n = reps as f64;
+        assert!(at_edge as f64 / n <= 0.02, "at the edge {at_edge}/{reps}");
+        assert_eq!(at_centre, 0, "at the centre");
+        assert!(beyond as f64 / n > 0.8, "beyond {beyond}/{reps}");
+        assert!(exact as f64 / n > 0.8, "exact theory {exact}/{reps}");
+    }
+
+    /// A point inside its band passes with statistic 0 and p = 1 (t-test over the
+    /// trajectories); outside it is tested against the nearest edge, exactly as the
+    /// two-sided test against that edge.
+    #[test]
+    fn force_point_test_uses_the_nearest_edge_of_its_band() {
+        let point: Vec<ForceRecord> = [1.0, 1.2, 0.9, 1.1, 1.05]
+            .iter()
+            .map(|&f| ForceRecord {
+                force_ratio: vec![f, f],
+                ..Default::default()
+            })
+            .collect();
+        let (mean, se, o, kind, _) =
+            super::force_point_test(&point, (0.0, 1.0), 0.0, Some((0.9, 1.1))).unwrap();
+        assert_eq!(kind, "t-test");
+        assert_eq!((o.statistic, o.p_value), (0.0, 1.0));
+        let (_, _, below, _, _) =
+            super::force_point_test(&point, (0.0, 1.0), 0.0, Some((1.2, 1.3))).unwrap();
+        let edge = crate::stats::t_test(mean, 1.2, se, 5).unwrap();
+        assert_eq!(
+            (below.statistic, below.p_value),
+            (edge.statistic, edge.p_value)
+        );
+        let (_, _, plain, _, _) = super::force_point_test(&point, (0.0, 1.0), 1.2, None).unwrap();
+        assert_eq!(plain.p_value, edge.p_value);
     }
 
     /// The residual check: the worst record over strains and trajectories, passing at
