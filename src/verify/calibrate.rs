@@ -31,7 +31,8 @@
 //! Discrete p-values are handled: ties and p = 1 exactly are valid KS input (the test
 //! is then conservative); a check without a p-value (a deterministic check) or whose
 //! p-value is the same at every seed is not a random check and is listed as not tested
-//! ([`UniformityStatus`]); a check with fewer than two p-values (seeds whose run failed
+//! ([`UniformityStatus`]), as is an interval test against a tolerance band (kinds
+//! `band-…`, p = 1 inside the band: conservative, not uniform by design); a check with fewer than two p-values (seeds whose run failed
 //! have none) cannot be tested either.
 //!
 //! ## References
@@ -75,7 +76,7 @@ pub const HISTOGRAM_BINS: usize = 20;
 pub const FALSE_ALARM_RULE: &str = "a scene fails a seed if any check is rejected after the Holm correction at alpha, or if its run fails; the rate k/N of failed seeds is consistent with alpha unless the whole exact (Clopper-Pearson) 95 % interval lies above alpha; binomial_p is the one-sided exact test of rate <= alpha, P(X >= k | N, alpha)";
 
 /// The rule by which a check kind's p-values are judged, as stated in the outputs.
-pub const UNIFORMITY_RULE: &str = "per check (one scene, one name) a one-sample Kolmogorov-Smirnov test of its raw p-values over the seeds against U(0,1); per kind, Holm over the KS p-values of its checks in every calibrated scene; a kind is rejected if any Holm-adjusted KS p-value is below 0.01. Checks without a p-value, with the same p-value at every seed, or with fewer than 2 p-values are not tested";
+pub const UNIFORMITY_RULE: &str = "per check (one scene, one name) a one-sample Kolmogorov-Smirnov test of its raw p-values over the seeds against U(0,1); per kind, Holm over the KS p-values of its checks in every calibrated scene; a kind is rejected if any Holm-adjusted KS p-value is below 0.01. Checks without a p-value, with the same p-value at every seed, with fewer than 2 p-values, or interval tests against a tolerance band (kinds band-*, p = 1 inside the band: conservative, not uniform by design) are not tested";
 
 /// The exact (Clopper–Pearson) two-sided interval for a binomial proportion: `k`
 /// successes in `n` trials at `confidence` (e.g. 0.95). With a = 1 − confidence,
@@ -219,7 +220,14 @@ pub enum UniformityStatus {
     Constant,
     /// Fewer than two p-values (no p-value, or the runs failed).
     TooFew,
+    /// An interval test (kind `band-…`: a point tested against a tolerance band, p = 1
+    /// inside it): conservative by design, its p-values are not uniform under a correct
+    /// simulator; its false alarms still count in the scene's rate.
+    Interval,
 }
+
+/// The prefix of the kinds of interval tests ([`UniformityStatus::Interval`]).
+pub const INTERVAL_KIND_PREFIX: &str = "band-";
 
 /// The uniformity test of one check's p-values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -312,7 +320,9 @@ fn kind_uniformity(kind: &str, list: &[&CheckPValues]) -> Result<KindUniformity>
             .map(|p| p.clamp(0.0, 1.0))
             .collect();
         pooled.extend_from_slice(&p);
-        let status = if p.len() < 2 {
+        let status = if c.kind.starts_with(INTERVAL_KIND_PREFIX) {
+            UniformityStatus::Interval
+        } else if p.len() < 2 {
             UniformityStatus::TooFew
         } else if p.iter().all(|&x| x == p[0]) {
             UniformityStatus::Constant
@@ -791,10 +801,21 @@ mod tests {
                 kind: "other".into(),
                 p_values: vec![],
             },
+            CheckPValues {
+                scene: "s".into(),
+                name: "band".into(),
+                kind: "band-t-test".into(),
+                p_values: vec![1.0, 1.0, 0.4, 1.0, 0.2],
+            },
         ];
         let k = uniformity_by_kind(&list).unwrap();
-        // A kind without any p-value (deterministic checks) is left out.
-        assert_eq!(k.len(), 1);
+        // A kind without any p-value (deterministic checks) is left out; an interval
+        // test's kind is listed, untested.
+        assert_eq!(k.len(), 2);
+        assert_eq!(k[0].kind, "band-t-test");
+        assert_eq!(k[0].per_check[0].status, UniformityStatus::Interval);
+        assert!(!k[0].rejected && k[0].tested == 0);
+        let k = &k[1..];
         assert!(k.iter().all(|u| u.kind != "other"));
         let statuses: Vec<_> = k[0].per_check.iter().map(|c| c.status).collect();
         assert_eq!(

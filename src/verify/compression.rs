@@ -127,7 +127,11 @@ fn force_point_test(
             iat.0,
             iat.1,
             o,
-            "z-test",
+            if band.is_some() {
+                "band-z-test"
+            } else {
+                "z-test"
+            },
             format!("{} trajectories (IAT errors)", point.len()),
         ));
     }
@@ -141,7 +145,11 @@ fn force_point_test(
         m.mean,
         m.std_error,
         o,
-        "t-test",
+        if band.is_some() {
+            "band-t-test"
+        } else {
+            "t-test"
+        },
         format!(
             "{} independent trajectories, error from their spread (t, {} dof; IAT error {:.3e})",
             means.len(),
@@ -247,7 +255,7 @@ pub fn mean_bias_band_check(
     let o = stats::z_test(mean, mean.clamp(lo, hi), se)?;
     Ok(CheckResult::statistical(
         format!("{name}/force-mean-bias"),
-        "z-test",
+        "band-z-test",
         (mean, 0.0, se),
         None,
         &o,
@@ -626,7 +634,7 @@ mod tests {
             .collect();
         let (mean, se, o, kind, _) =
             super::force_point_test(&point, (0.0, 1.0), 0.0, Some((0.9, 1.1))).unwrap();
-        assert_eq!(kind, "t-test");
+        assert_eq!(kind, "band-t-test");
         assert_eq!((o.statistic, o.p_value), (0.0, 1.0));
         let (_, _, below, _, _) =
             super::force_point_test(&point, (0.0, 1.0), 0.0, Some((1.2, 1.3))).unwrap();
@@ -635,8 +643,10 @@ mod tests {
             (below.statistic, below.p_value),
             (edge.statistic, edge.p_value)
         );
-        let (_, _, plain, _, _) = super::force_point_test(&point, (0.0, 1.0), 1.2, None).unwrap();
+        let (_, _, plain, kind, _) =
+            super::force_point_test(&point, (0.0, 1.0), 1.2, None).unwrap();
         assert_eq!(plain.p_value, edge.p_value);
+        assert_eq!(kind, "t-test");
     }
 
     /// The residual check: the worst record over strains and trajectories, passing at
