@@ -33,7 +33,14 @@
 //!
 //! Further arguments: `soft` or `stiff` (one set-up), a proposal's name (`crank-nicolson`,
 //! `newton`, `newton-slow`, `ornstein-uhlenbeck`, `crank-nicolson+radial`,
-//! `newton-slow+radial`: those only), `verbose` (each strain on stderr). `newton-slow` is
+//! `newton-slow+radial`, `independence`, `independence+rb`, `independence-split+rb`:
+//! those only), `verbose` (each strain on stderr). The `independence` rows replace every
+//! step by an independence move ([`ModalMetropolis::with_independence_moves`]; no step
+//! size, one row): after the scenes' burn-in, the proposal's load is the best by
+//! acceptance (over [`TUNING_MOVES`] moves each) of the burn-in's mean force and three
+//! loads between it and the first buckling load; `+rb` records the Rao–Blackwellized
+//! `E[σ | direction]` ([`ModalMetropolis::conditional_force`]) instead of σ; `-split`
+//! gives the slowest shell its own radius. `newton-slow` is
 //! [`Proposal::Newton`] with the rank-one term on the slowest groups only
 //! ([`ModalMetropolis::with_rank_one_limit`], rates ≤ 5 λ_1); `+radial` adds a radial move
 //! after every step from the end of the scenes' burn-in on
@@ -131,6 +138,28 @@ fn curve_ratios(scene: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// How the chain moves and what it records.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Sampler {
+    /// The proposal's steps; σ recorded.
+    Chain,
+    /// Independence moves (`ModalMetropolis::with_independence_moves`); σ recorded.
+    Independence,
+    /// Independence moves; the Rao–Blackwellized `E[σ | direction]` recorded
+    /// (`ModalMetropolis::conditional_force`).
+    RaoBlackwell,
+    /// Independence moves with the slowest modes' own radius
+    /// (rates ≤ [`SPLIT_RATES`] λ_1); `E[σ | direction]` recorded.
+    SplitRaoBlackwell,
+}
+
+/// The split independence moves: the modes with rates ≤ this × λ_1 get their own radius
+/// (the slowest shell only).
+const SPLIT_RATES: f64 = 1.5;
+
+/// Independence moves per candidate load when the bench picks the load.
+const TUNING_MOVES: usize = 300;
+
 /// What one timed run gives.
 struct Point {
     acceptance: f64,
@@ -148,7 +177,7 @@ struct Point {
 fn run_point(
     model: &AreaMembrane,
     modes: &PlateModes,
-    (kind, rank_one_limit, radial): (Proposal, Option<f64>, bool),
+    (kind, rank_one_limit, radial, sampler): (Proposal, Option<f64>, bool, Sampler),
     dt_tau1: f64,
     tau1: f64,
     exact: f64,
@@ -174,6 +203,38 @@ fn run_point(
         chain = chain.with_radial_moves();
     }
     chain.set_dt(dt_tau1 * tau1).expect("dt");
+    if sampler != Sampler::Chain {
+        // the independence proposal's load: the mean force over the burn-in (below the
+        // first buckling load), then the best of a few loads up to that limit by acceptance
+        let mut mean = 0.0;
+        for _ in 0..OWN_BURN_IN {
+            chain.step(&mut rng);
+            mean += chain.force() / OWN_BURN_IN as f64;
+        }
+        let limit = chain.independence_force_limit();
+        let mean = mean.min(limit - 1e-3 * limit.abs());
+        let candidates = [
+            mean,
+            0.5 * (mean + limit),
+            0.9 * limit + 0.1 * mean,
+            0.99 * limit + 0.01 * mean,
+        ];
+        let mut best: Option<(f64, ModalMetropolis)> = None;
+        for load in candidates.into_iter().filter(|l| *l < limit) {
+            let slow = (sampler == Sampler::SplitRaoBlackwell).then_some(SPLIT_RATES / tau1);
+            let Ok(mut trial) = chain.clone().with_independence_moves(load, slow) else {
+                continue;
+            };
+            for _ in 0..TUNING_MOVES {
+                trial.step(&mut rng);
+            }
+            let acc = trial.acceptance();
+            if best.as_ref().is_none_or(|(b, _)| acc > *b) {
+                best = Some((acc, trial));
+            }
+        }
+        chain = best.expect("an independence load").1;
+    }
     for _ in 0..OWN_BURN_IN {
         chain.step(&mut rng);
     }
@@ -186,7 +247,12 @@ fn run_point(
         let start = cpu_now();
         for _ in 0..chunk {
             chain.step(&mut rng);
-            sigma.push(-chain.force() / unit);
+            let f = if matches!(sampler, Sampler::RaoBlackwell | Sampler::SplitRaoBlackwell) {
+                chain.conditional_force()
+            } else {
+                chain.force()
+            };
+            sigma.push(-f / unit);
         }
         cpu += (cpu_now() - start).as_secs_f64();
         chunk = sigma.len();
@@ -232,22 +298,64 @@ fn main() {
     };
     // (name, proposal, rank-one term on the groups with rates ≤ this × λ_1 only, radial
     // moves)
+    use Sampler::{Chain, Independence, RaoBlackwell, SplitRaoBlackwell};
     let proposals = [
-        ("crank-nicolson", Proposal::CrankNicolson, None, false),
-        ("newton", Proposal::Newton, None, false),
-        ("newton-slow", Proposal::Newton, Some(SLOW_RATES), false),
+        (
+            "crank-nicolson",
+            Proposal::CrankNicolson,
+            None,
+            false,
+            Chain,
+        ),
+        ("newton", Proposal::Newton, None, false, Chain),
+        (
+            "newton-slow",
+            Proposal::Newton,
+            Some(SLOW_RATES),
+            false,
+            Chain,
+        ),
         (
             "ornstein-uhlenbeck",
             Proposal::OrnsteinUhlenbeck,
             None,
             false,
+            Chain,
         ),
-        ("crank-nicolson+radial", Proposal::CrankNicolson, None, true),
+        (
+            "crank-nicolson+radial",
+            Proposal::CrankNicolson,
+            None,
+            true,
+            Chain,
+        ),
         (
             "newton-slow+radial",
             Proposal::Newton,
             Some(SLOW_RATES),
             true,
+            Chain,
+        ),
+        (
+            "independence",
+            Proposal::CrankNicolson,
+            None,
+            false,
+            Independence,
+        ),
+        (
+            "independence+rb",
+            Proposal::CrankNicolson,
+            None,
+            false,
+            RaoBlackwell,
+        ),
+        (
+            "independence-split+rb",
+            Proposal::CrankNicolson,
+            None,
+            false,
+            SplitRaoBlackwell,
         ),
     ];
     println!(
@@ -301,21 +409,23 @@ fn main() {
                 (i, r, m, theory.tension_ratio(r).expect("exact tension"))
             })
             .collect();
-        for (label, kind, limit, radial) in proposals {
+        for (label, kind, limit, radial, sampler) in proposals {
             if !chosen(label, &proposals.map(|p| p.0)) {
                 continue;
             }
             // best[strain] = the cheapest step's CPU-s
             let mut best = vec![f64::INFINITY; models.len()];
             let mut best_dt = vec![0.0; models.len()];
-            for &dt_tau1 in steps {
+            // independence moves have no step: one row (the burn-in's step is the first)
+            let own_steps = if sampler == Chain { steps } else { &steps[..1] };
+            for &dt_tau1 in own_steps {
                 let points: Vec<Point> = models
                     .iter()
                     .map(|(i, _, m, exact)| {
                         run_point(
                             m,
                             &modes,
-                            (kind, limit, radial),
+                            (kind, limit, radial, sampler),
                             dt_tau1,
                             tau1,
                             *exact,

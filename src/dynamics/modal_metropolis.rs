@@ -25,6 +25,7 @@
 //! into a state whose `A_a` is not positive definite are rejected.
 
 mod drift;
+mod independence;
 
 use super::driver::Trajectory;
 use crate::error::{Error, Result};
@@ -170,6 +171,8 @@ pub struct ModalMetropolis<'m> {
     radial: bool,
     /// Radial moves accepted.
     pub radial_accepted: u64,
+    /// `Some`: every step an independence move instead ([`Self::with_independence_moves`]).
+    independence: Option<independence::Independence>,
     /// Test hook: the log-determinant term of the new proposals' Hastings ratio dropped
     /// (a deliberately wrong chain, which the exactness test must catch); for the radial
     /// move, its Jacobian term.
@@ -338,6 +341,7 @@ impl<'m> ModalMetropolis<'m> {
             rank_one: Vec::new(),
             radial: false,
             radial_accepted: 0,
+            independence: None,
             #[cfg(test)]
             drop_log_det: false,
         };
@@ -521,28 +525,16 @@ impl<'m> ModalMetropolis<'m> {
         let z: f64 = rng.sample(StandardNormal);
         let uniform: f64 = rng.random();
         let cur = &self.current;
-        let half_n = 0.5 * (self.n() * self.components) as f64;
+        let half_n = self.half_dimension();
         let (q, two_l_s, kt) = (cur.bend, cur.two_l_s, self.kt);
         if !(q > 0.0 && two_l_s.is_finite() && cur.energy.is_finite()) {
             return;
         }
         let p = &self.constraint;
-        let c = &p.constraint;
         let s = p.excess(two_l_s);
-        let a = c.stiffness * c.measure * s * s / kt;
-        let b = (0.5 * q - c.stiffness * c.measure * s * p.strain) / kt;
-        let disc = (b * b + 4.0 * a * half_n).sqrt();
-        // The positive root of Aτ² + Bτ − N/2 = 0, without cancellation.
-        let tau_star = if b > 0.0 {
-            2.0 * half_n / (b + disc)
-        } else {
-            (disc - b) / (2.0 * a)
-        };
-        if !(tau_star.is_finite() && tau_star > 0.0) {
+        let Some((x_star, var)) = self.radial_laplace(q, two_l_s) else {
             return;
-        }
-        let x_star = tau_star.ln();
-        let var = 1.0 / (half_n + a * tau_star * tau_star);
+        };
         #[cfg(test)]
         let jacobian = if self.drop_log_det { 0.0 } else { half_n };
         #[cfg(not(test))]
@@ -1179,6 +1171,10 @@ impl Trajectory for ModalMetropolis<'_> {
     /// One Metropolis-adjusted step: the normals (all components), then one uniform, as the
     /// banded scheme draws them. Allocation-free.
     fn step(&mut self, rng: &mut TrajectoryRng) {
+        if self.independence.is_some() {
+            self.independence_move(rng);
+            return;
+        }
         for z in &mut self.z {
             *z = rng.sample(StandardNormal);
         }
@@ -1230,9 +1226,9 @@ impl Default for Evaluation {
     }
 }
 
-/// The inverse and determinant of the symmetric `k × k` matrix `a` (row-major, stride 4,
-/// `k ≤ 4`) by Cholesky; `None` unless positive definite.
-fn spd_inverse(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
+/// The lower Cholesky factor `L` and the determinant of the symmetric `k × k` matrix `a`
+/// (row-major, stride 4, `k ≤ 4`); `None` unless positive definite.
+fn cholesky(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
     let mut l = [0.0; 16];
     let mut det = 1.0;
     for j in 0..k {
@@ -1248,6 +1244,13 @@ fn spd_inverse(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
             l[4 * i + j] = s / ljj;
         }
     }
+    Some((l, det))
+}
+
+/// The inverse and determinant of the symmetric `k × k` matrix `a` (row-major, stride 4,
+/// `k ≤ 4`) by Cholesky; `None` unless positive definite.
+fn spd_inverse(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
+    let (l, det) = cholesky(a, k)?;
     // columns of L⁻¹ by forward substitution, then A⁻¹ = L⁻ᵀ L⁻¹
     let mut li = [0.0; 16];
     for c in 0..k {
@@ -1377,7 +1380,7 @@ mod tests {
     use crate::rng::trajectory_rng;
     use nalgebra::{DMatrix, DVector};
 
-    fn model(dims: usize, ne: usize, strain_ratio: f64) -> CompressedFilament {
+    pub(super) fn model(dims: usize, ne: usize, strain_ratio: f64) -> CompressedFilament {
         let p = FilamentParams {
             bending_rigidity: 100.0,
             stretch_rigidity: 1e6,
@@ -1673,7 +1676,7 @@ mod tests {
     /// A tiny membrane under imposed area for the exactness tests of the new proposals:
     /// `n_el × n_el` elements, κ = 20 kT, `K_A`, ε = `ratio`·ε_c0, on a 1.2 × 1 patch (no
     /// tied modes on the simply supported one).
-    fn tiny_membrane(
+    pub(super) fn tiny_membrane(
         boundary: crate::spectral::membrane::MembraneBoundary,
         n_el: usize,
         k_a: f64,
@@ -1693,7 +1696,7 @@ mod tests {
     }
 
     /// `τ1 = ξ/(κ q⁴_min)` of the membrane.
-    fn membrane_tau1(m: &AreaMembrane) -> f64 {
+    pub(super) fn membrane_tau1(m: &AreaMembrane) -> f64 {
         let p = m.plate().params();
         p.drag / (p.bending_rigidity * p.min_wavenumber_sq().powi(2))
     }
