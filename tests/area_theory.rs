@@ -548,3 +548,116 @@ fn cli_json_ranges_and_exit_codes() {
         assert!(out.stdout.is_empty());
     }
 }
+
+/// What: the mesh's acoustic modes within a fixed lattice cutoff are the continuum's modes
+/// of that cutoff one for one (same count and labels, μ within 5 %), and the tension of
+/// that fixed mode set converges to the continuum's at the element's fourth order, while
+/// the whole mesh's free excess area keeps growing by about `kT ln 2/(4πκ)` per doubling
+/// (the Helfrich–Servuss logarithm: physics, not error).
+/// Set-up: both boundaries, meshes 4, 8, 16 (fixed cutoff: the 4-element lattice), strain
+/// ratios −2, 0.5 and 3.
+/// Tolerance: observed orders in [3.5, 4.5]; the excess-area increment of 8 → 16 within
+/// 25 % of the continuum's `kT ln 2/(4πκ)` (the mesh's top modes carry O(1) eigenvalue
+/// errors at every N, so only the asymptotic increment is the continuum's).
+#[test]
+fn fixed_cutoff_converges_at_fourth_order_while_the_whole_mesh_drifts() {
+    use langevin_fem::fem::plate_area::{mesh_convergence, within_lattice};
+    for boundary in BOUNDARIES {
+        let p = params(boundary);
+        let all = discrete_compliances(&p, 8, 8).unwrap();
+        let mut fixed = within_lattice(&p, &all, 4, 4);
+        let mut cont = continuum_compliances(&p, AreaCutoff::Lattice { nx: 4, ny: 4 }).unwrap();
+        assert_eq!(fixed.len(), cont.len(), "{boundary:?}");
+        let key = |c: &langevin_fem::fem::plate_area::AreaCompliance| (c.m, c.n);
+        fixed.sort_by(|a, b| key(a).cmp(&key(b)).then(a.mu.total_cmp(&b.mu)));
+        cont.sort_by(|a, b| key(a).cmp(&key(b)).then(a.mu.total_cmp(&b.mu)));
+        for (d, c) in fixed.iter().zip(&cont) {
+            assert_eq!(key(d), key(c), "{boundary:?}");
+            assert!(
+                (d.mu / c.mu - 1.0).abs() < 0.05,
+                "{boundary:?}: {d:?} vs {c:?}"
+            );
+        }
+        let ratios = [-2.0, 0.5, 3.0];
+        let (_, rows) = mesh_convergence(&p, &[4, 8, 16], &ratios).unwrap();
+        for row in &rows[1..] {
+            for (j, order) in row.fixed_order.iter().enumerate() {
+                let order = order.unwrap();
+                eprintln!(
+                    "{boundary:?} N {} ratio {}: error {:.3e} order {order:.2}",
+                    row.elements, ratios[j], row.fixed_error[j]
+                );
+                assert!(
+                    (3.5..=4.5).contains(&order),
+                    "{boundary:?} N {}: {order}",
+                    row.elements
+                );
+            }
+        }
+        let step = rows[2].free_excess_area_ratio - rows[1].free_excess_area_ratio;
+        let continuum = p.kt * 2f64.ln() / (4.0 * std::f64::consts::PI * p.bending_rigidity);
+        eprintln!("{boundary:?}: excess-area increment {step:.4e} vs {continuum:.4e}");
+        assert!(
+            (step / continuum - 1.0).abs() < 0.25,
+            "{boundary:?}: {step} vs {continuum}"
+        );
+    }
+}
+
+/// What: `theory area --mesh-convergence` prints per mesh the whole mesh's curve, the
+/// continuum at its cutoff, the fixed-cutoff error and order, and the note naming the
+/// drift as physics; a descending, out-of-range or malformed list, or one given with
+/// `--elements`, exits 2 naming the flag.
+#[test]
+fn cli_mesh_convergence() {
+    let out = run_cli(&[
+        "--boundary",
+        "periodic",
+        "--strain-ratio",
+        "0,10",
+        "--mesh-convergence",
+        "4,8",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["note"].as_str().unwrap().contains("Helfrich-Servuss"));
+    assert_eq!(v["fixed_cutoff"], serde_json::json!([4, 4]));
+    let meshes = v["meshes"].as_array().unwrap();
+    assert_eq!(meshes.len(), 2);
+    assert!(meshes[0]["fixed_cutoff_order"][0].is_null());
+    let order = meshes[1]["fixed_cutoff_order"][0].as_f64().unwrap();
+    assert!((3.5..4.5).contains(&order), "{order}");
+    for key in [
+        "tension_ratio",
+        "continuum_at_mesh_cutoff",
+        "fixed_cutoff_error",
+    ] {
+        assert_eq!(meshes[1][key].as_array().unwrap().len(), 2, "{key}");
+    }
+    for bad in ["8,4", "4,65", "2,4", "4,x"] {
+        let out = run_cli(&[
+            "--boundary",
+            "periodic",
+            "--strain-ratio",
+            "0",
+            "--mesh-convergence",
+            bad,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("--mesh-convergence"), "{bad}: {err}");
+    }
+    let out = run_cli(&[
+        "--strain-ratio",
+        "0",
+        "--elements",
+        "4",
+        "--mesh-convergence",
+        "4,8",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}

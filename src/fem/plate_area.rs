@@ -454,6 +454,137 @@ pub fn discrete_compliances(
     Ok(out)
 }
 
+/// The acoustic compliances of a mesh (`discrete`, from [`discrete_compliances`]) whose
+/// modes lie within the lattice cutoff `nx × ny` ([`AreaCutoff::Lattice`]): the mesh's
+/// approximations of exactly the continuum modes of that cutoff, one for one (same count
+/// and labels as [`continuum_compliances`]), so that a theory of these converges to the
+/// continuum's at a fixed cutoff as the mesh is refined, at the O(h⁴) of the modes.
+pub fn within_lattice(
+    params: &AreaParams,
+    discrete: &[AreaCompliance],
+    nx: usize,
+    ny: usize,
+) -> Vec<AreaCompliance> {
+    let periodic = params.boundary == MembraneBoundary::Periodic;
+    discrete
+        .iter()
+        .filter(|c| {
+            c.acoustic
+                && if periodic {
+                    2 * c.m < nx && 2 * c.n < ny && (c.m > 0 || c.n > 0)
+                } else {
+                    (1..nx).contains(&c.m) && (1..ny).contains(&c.n)
+                }
+        })
+        .copied()
+        .collect()
+}
+
+/// One mesh of [`mesh_convergence`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshConvergenceRow {
+    /// Elements per side.
+    pub elements: usize,
+    /// Modes of the mesh.
+    pub modes: usize,
+    /// `⟨ΔA⟩/A₀` of the free membrane on the whole mesh.
+    pub free_excess_area_ratio: f64,
+    /// ⟨σ⟩/σ_c0 of the whole mesh, per strain ratio.
+    pub tension_ratio: Vec<f64>,
+    /// ⟨σ⟩/σ_c0 of the continuum at the mesh's own lattice cutoff, per strain ratio.
+    pub continuum_at_mesh: Vec<f64>,
+    /// ⟨σ⟩/σ_c0 of the mesh's modes within the fixed cutoff ([`within_lattice`]).
+    pub fixed_cutoff: Vec<f64>,
+    /// `fixed_cutoff` minus the continuum at the fixed cutoff: the discretization error.
+    pub fixed_error: Vec<f64>,
+    /// `log₂` of the ratio of the previous (coarser) mesh's `|fixed_error|` to this one's,
+    /// divided by `log₂` of the ratio of element counts: the observed order (`None` on the
+    /// first mesh).
+    pub fixed_order: Vec<Option<f64>>,
+}
+
+/// The tension–strain curve of the membrane under imposed area over meshes of
+/// `elements × elements` (ascending, each ≥ the fixed cutoff), at `strain_ratios`
+/// (issue #28): the whole mesh's curve, which drifts with the mesh because the thermal
+/// excess area grows as the log of the mode cutoff (Helfrich–Servuss: physics, each mesh
+/// a different membrane), the continuum at the mesh's own cutoff beside it, and the
+/// discretization error separated from that drift: the mesh's modes within a fixed cutoff
+/// (the lattice of the first mesh, [`within_lattice`]) against the continuum at that
+/// cutoff, with its observed order (4 for the Bogner–Fox–Schmit element's eigenvalues).
+/// Returns the continuum at the fixed cutoff and one row per mesh.
+///
+/// # Errors
+/// As [`AreaTheory::discrete`], [`AreaTheory::continuum`] and their tension; invalid
+/// parameters for an empty or unsorted mesh list.
+pub fn mesh_convergence(
+    params: &AreaParams,
+    elements: &[usize],
+    strain_ratios: &[f64],
+) -> Result<(Vec<f64>, Vec<MeshConvergenceRow>)> {
+    let Some(&fixed) = elements.first() else {
+        return Err(Error::invalid("elements", "[]", "at least one mesh"));
+    };
+    if elements.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::invalid(
+            "elements",
+            format!("{elements:?}"),
+            "strictly ascending",
+        ));
+    }
+    let curve = |theory: &AreaTheory| -> Result<Vec<f64>> {
+        strain_ratios
+            .iter()
+            .map(|&r| theory.tension_ratio(r))
+            .collect()
+    };
+    let cutoff = AreaCutoff::Lattice {
+        nx: fixed,
+        ny: fixed,
+    };
+    let continuum_fixed = curve(&AreaTheory::continuum(params, cutoff)?)?;
+    let mut rows: Vec<MeshConvergenceRow> = Vec::with_capacity(elements.len());
+    for &n in elements {
+        let all = discrete_compliances(params, n, n)?;
+        let whole = AreaTheory::new(params, area_law(params, &all)?)?;
+        let restricted = within_lattice(params, &all, fixed, fixed);
+        let fixed_theory = AreaTheory::new(params, area_law(params, &restricted)?)?;
+        let continuum_at_mesh = curve(&AreaTheory::continuum(
+            params,
+            AreaCutoff::Lattice { nx: n, ny: n },
+        )?)?;
+        let fixed_cutoff = curve(&fixed_theory)?;
+        let fixed_error: Vec<f64> = fixed_cutoff
+            .iter()
+            .zip(&continuum_fixed)
+            .map(|(d, c)| d - c)
+            .collect();
+        let fixed_order = match rows.last() {
+            Some(prev) => prev
+                .fixed_error
+                .iter()
+                .zip(&fixed_error)
+                .map(|(e0, e1)| {
+                    let order =
+                        (e0.abs() / e1.abs()).log2() / (n as f64 / prev.elements as f64).log2();
+                    order.is_finite().then_some(order)
+                })
+                .collect(),
+            None => vec![None; strain_ratios.len()],
+        };
+        rows.push(MeshConvergenceRow {
+            elements: n,
+            modes: all.len(),
+            free_excess_area_ratio: whole.free_excess_area_ratio(),
+            tension_ratio: curve(&whole)?,
+            continuum_at_mesh,
+            fixed_cutoff,
+            fixed_error,
+            fixed_order,
+        });
+    }
+    Ok((continuum_fixed, rows))
+}
+
 /// The compliances of the assembled `nx × ny` [`PlateModel`] from the dense generalized
 /// eigenproblem: `K_b` the stiffness at σ = 0, `G` the stiffness at κ = 10⁻³⁰⁰, σ = 1
 /// (the bending part underflows against G's entries), `K_b` made definite by `z zᵀ` with
