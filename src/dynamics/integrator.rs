@@ -44,7 +44,7 @@ pub(super) fn check_dt(dt: f64) -> Result<()> {
 ///
 /// # Errors
 /// [`Error::UnstableTimeStep`] at or above the limit.
-pub(super) fn check_stability(
+pub(crate) fn check_stability(
     kind: IntegratorKind,
     dt: f64,
     max_rate: f64,

@@ -37,7 +37,7 @@ pub mod batch;
 pub mod discrete;
 pub mod driver;
 pub mod ensemble;
-mod integrator;
+pub(crate) mod integrator;
 pub mod modal_metropolis;
 pub mod modal_step;
 pub mod nonlinear;

@@ -473,6 +473,15 @@ impl CompressionRun {
         let (burn_in, sample_interval) = (comp.burn_in_tau1 * tau1, comp.sample_every_tau1 * tau1);
         let plan = StepPlan::new(dt, burn_in, sample_interval, dt);
         let modes = Box::new(PlateModes::new(models[0].plate())?);
+        // Fails early (exit 2) for an explicit step at or above the stability limit of the
+        // fastest bending mode (tension raises the rates further).
+        let max_rate = modes.modes().iter().map(|m| m.rate).fold(0.0, f64::max);
+        crate::dynamics::integrator::check_stability(
+            spec.integrator,
+            dt,
+            max_rate,
+            "metropolis-crank-nicolson (exact at any step)",
+        )?;
         Ok(CompressionRun {
             spec: spec.clone(),
             dt,
@@ -492,7 +501,9 @@ impl CompressionRun {
     /// The tolerance band of ⟨F⟩/F_c0 at each of `strain_ratios` for a run whose linear
     /// part is not fluctuation–dissipation exact at its step — the paper's explicit scheme
     /// (`euler-maruyama`: its stiff modes' variance `1/(1 − λΔt/2)`) or the paper's
-    /// element-uniform noise (eq. 5: a per-mode deficit) — on a filament: around the
+    /// element-uniform noise (eq. 5: a per-mode deficit) — on a filament, or the explicit
+    /// scheme on a membrane under imposed area ([`crate::theory::scheme_law::scheme_area_law`]):
+    /// around the
     /// linear-response prediction `F_pred = F_exact + Δ` of that scheme
     /// ([`crate::theory::scheme_law`]), half-width `|Δ|/2` (the allowance for the
     /// prediction's neglect of the nonlinear coupling under such noise), as
@@ -502,23 +513,34 @@ impl CompressionRun {
     /// # Errors
     /// As [`crate::theory::scheme_law::scheme_force_ratios`].
     pub fn scheme_band(&self, strain_ratios: &[f64]) -> Result<Option<Vec<(f64, f64)>>> {
-        let Some((params, dims, elements)) = self.filament else {
-            return Ok(None);
-        };
         if self.spec.integrator != IntegratorKind::EulerMaruyama
             && self.spec.noise != NoiseModel::ElementUniform
         {
             return Ok(None);
         }
-        let pairs = crate::theory::scheme_law::scheme_force_ratios(
-            &params,
-            dims,
-            elements,
-            self.spec.integrator,
-            self.spec.noise,
-            self.dt,
-            strain_ratios,
-        )?;
+        let pairs = match (&self.object, self.filament) {
+            (Strained::Membrane { models, modes }, _) => {
+                crate::theory::scheme_law::scheme_area_force_ratios(
+                    &models[0],
+                    modes,
+                    self.spec.integrator,
+                    self.dt,
+                    strain_ratios,
+                )?
+            }
+            (_, Some((params, dims, elements))) => {
+                crate::theory::scheme_law::scheme_force_ratios(
+                    &params,
+                    dims,
+                    elements,
+                    self.spec.integrator,
+                    self.spec.noise,
+                    self.dt,
+                    strain_ratios,
+                )?
+            }
+            _ => return Ok(None),
+        };
         Ok(Some(
             pairs
                 .into_iter()

@@ -20,12 +20,15 @@
 //! `fig2-paper-2d` and `fig2-paper-3d` must tolerate, not as their reference.
 
 use super::compression::{CompressionTheory, Dims, StoredLengthLaw};
-use crate::dynamics::{DiscreteLaw, IntegratorKind};
-use crate::error::Result;
+use crate::dynamics::{DiscreteLaw, Family, IntegratorKind};
+use crate::error::{Error, Result};
+use crate::fem::area::AreaMembrane;
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::modal::generalized_modes;
 use crate::fem::noise::NoiseModel;
+use crate::fem::plate_area::{AreaParams, AreaTheory};
+use crate::fem::plate_modes::PlateModes;
 use crate::params::FilamentParams;
 use nalgebra::DMatrix;
 
@@ -91,6 +94,89 @@ pub fn scheme_force_ratios(
     strain_ratios
         .iter()
         .map(|&r| Ok((scheme.force_ratio(r)?, exact.force_ratio(r)?)))
+        .collect()
+}
+
+/// The stored-area law a θ-scheme with consistent noise at step `dt` samples for the
+/// bending part of the membrane `model` under imposed area (issue #28: the paper's
+/// explicit scheme, θ = 0, as the membrane's analogue of Fig. 2's), in the plate's
+/// separated modes `modes`: per mode the variance `kT/(λ(1 + (θ − ½)λΔt))` (the θ-scheme's
+/// exact stationary variance of `ȧ = −λa + noise`; `1/(1 − λΔt/2)` for the explicit step),
+/// and the weights the eigenvalues of `Σ_b^{½} B_b Σ_b^{½}/(2A₀)` per geometric block
+/// (`B_b` the true area matrix: a reference). At a vanishing step this is
+/// [`crate::fem::plate_area::area_law`] of the mesh.
+///
+/// # Errors
+/// Invalid parameters for a non-θ integrator or an unstable step (a mode with
+/// `1 + (θ − ½)λΔt ≤ 0`); a weight that is not finite.
+pub fn scheme_area_law(
+    model: &AreaMembrane,
+    modes: &PlateModes,
+    integrator: IntegratorKind,
+    dt: f64,
+) -> Result<StoredLengthLaw> {
+    let Family::Theta(theta) = integrator.family() else {
+        return Err(Error::invalid(
+            "integrator",
+            integrator,
+            "a theta-scheme (euler-maruyama, backward-euler, crank-nicolson)",
+        ));
+    };
+    let p = model.plate().params();
+    let (kt, two_area) = (p.kt, 2.0 * p.area());
+    let zero = modes.zero_mode();
+    let mut weights = Vec::with_capacity(modes.n_modes());
+    for block in modes.geometric_blocks() {
+        let kept: Vec<usize> = (0..block.modes.len())
+            .filter(|&r| Some(block.modes[r]) != zero)
+            .collect();
+        let kb = block.modes.len();
+        let root: Vec<f64> = kept
+            .iter()
+            .map(|&r| {
+                let lam = modes.modes()[block.modes[r]].rate;
+                let factor = 1.0 + (theta - 0.5) * lam * dt;
+                if factor > 0.0 {
+                    Ok((kt / (lam * factor)).sqrt())
+                } else {
+                    Err(Error::invalid(
+                        "dt",
+                        dt,
+                        format!("below the stability limit {:e} of the step", 2.0 / lam),
+                    ))
+                }
+            })
+            .collect::<Result<_>>()?;
+        let k = kept.len();
+        let m = DMatrix::from_fn(k, k, |i, j| {
+            root[i] * block.matrix[kept[i] * kb + kept[j]] * root[j] / two_area
+        });
+        let m = (&m + m.transpose()) * 0.5;
+        weights.extend(m.symmetric_eigenvalues().iter().map(|v| v.max(0.0)));
+    }
+    StoredLengthLaw::from_weights(weights, 1)
+}
+
+/// The linear-response prediction of ⟨F⟩/σ_c0 = −⟨σ⟩/σ_c0 at each `strain_ratios` entry
+/// (ε/ε_c0) for a θ-scheme on the membrane under imposed area ([`scheme_area_law`]), with
+/// the exact discrete theory of the mesh beside it: pairs `(prediction, exact)`.
+///
+/// # Errors
+/// As [`scheme_area_law`] and the theories' tension.
+pub fn scheme_area_force_ratios(
+    model: &AreaMembrane,
+    modes: &PlateModes,
+    integrator: IntegratorKind,
+    dt: f64,
+    strain_ratios: &[f64],
+) -> Result<Vec<(f64, f64)>> {
+    let params = AreaParams::from_membrane(model.plate().params(), model.area_modulus());
+    let (nx, ny) = model.plate().elements();
+    let scheme = AreaTheory::new(&params, scheme_area_law(model, modes, integrator, dt)?)?;
+    let exact = AreaTheory::discrete(&params, nx, ny)?;
+    strain_ratios
+        .iter()
+        .map(|&r| Ok((-scheme.tension_ratio(r)?, -exact.tension_ratio(r)?)))
         .collect()
 }
 
@@ -216,5 +302,70 @@ mod tests {
         let c2 = at(Dims::Two, 7.0e-6, NoiseModel::Consistent);
         let c2h = at(Dims::Two, 3.5e-6, NoiseModel::Consistent);
         assert!((c2[0] + 0.017).abs() < 0.002 && (c2h[0] + 0.0033).abs() < 0.001);
+    }
+
+    /// The membrane's oracle: consistent noise at a vanishing explicit step samples
+    /// `kT K_b⁻¹`, so the scheme's area law and tension are the exact discrete theory's;
+    /// at a finite explicit step the stiff modes' excess variance raises the excess area,
+    /// so the predicted tension rises (⟨F⟩ falls) by an amount that halves with the step.
+    #[test]
+    fn membrane_scheme_law_is_the_exact_theory_at_a_vanishing_step() {
+        use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
+        for boundary in [
+            MembraneBoundary::SimplySupported,
+            MembraneBoundary::Periodic,
+        ] {
+            let mp = MembraneParams {
+                bending_rigidity: 20.0,
+                width: 1.1,
+                boundary,
+                ..MembraneParams::default()
+            };
+            let model = AreaMembrane::new(mp, 4, 4, 1e5, 0.0).unwrap();
+            let modes = PlateModes::new(model.plate()).unwrap();
+            let lam_max = modes.modes().iter().map(|m| m.rate).fold(0.0, f64::max);
+            let law = scheme_area_law(
+                &model,
+                &modes,
+                IntegratorKind::EulerMaruyama,
+                1e-12 / lam_max,
+            )
+            .unwrap();
+            let params = AreaParams::from_membrane(&mp, 1e5);
+            let exact = crate::fem::plate_area::area_law(
+                &params,
+                &crate::fem::plate_area::discrete_compliances(&params, 4, 4).unwrap(),
+            )
+            .unwrap();
+            assert!(
+                (law.mean() / exact.mean() - 1.0).abs() < 1e-9,
+                "{boundary:?}: {} vs {}",
+                law.mean(),
+                exact.mean()
+            );
+            let shift = |dt: f64| {
+                let [(pred, exact)] = scheme_area_force_ratios(
+                    &model,
+                    &modes,
+                    IntegratorKind::EulerMaruyama,
+                    dt,
+                    &[0.5],
+                )
+                .unwrap()[..] else {
+                    unreachable!()
+                };
+                pred - exact
+            };
+            let (coarse, fine) = (shift(0.4 / lam_max), shift(0.2 / lam_max));
+            assert!(coarse < 0.0 && fine < 0.0, "{boundary:?}: {coarse}, {fine}");
+            assert!(
+                (coarse / fine - 2.0).abs() < 0.3,
+                "{boundary:?}: first order in dt: {coarse} / {fine}"
+            );
+            assert!(
+                scheme_area_law(&model, &modes, IntegratorKind::EulerMaruyama, 2.1 / lam_max)
+                    .is_err()
+            );
+        }
     }
 }
