@@ -122,6 +122,7 @@ mod tests {
             reference_kind: "discrete".to_string(),
             unit: "[L]^2".to_string(),
             detail: String::new(),
+            largest_deviation: None,
         }
     }
 
