@@ -1229,7 +1229,7 @@ fn finish_scene(
             .collect()
     };
     let (figures, captions): (Vec<PathBuf>, Vec<String>) = figures.into_iter().unzip();
-    Ok(SceneSummary {
+    let mut summary = SceneSummary {
         name: scene.name.clone(),
         passed: checks.iter().all(|c| c.passed),
         wall_seconds: start.elapsed().as_secs_f64(),
@@ -1240,7 +1240,16 @@ fn finish_scene(
         warnings: Vec::new(),
         skipped,
         checks,
-    })
+    };
+    // Per run with a failed check, the pattern of its per-mode ratios, if any (issue #31).
+    for (run, hint) in crate::verify::diagnosis::run_hints(&summary) {
+        summary.notes.push(format!(
+            "run {run}: {} (a pattern among the run's per-mode ratios estimate/reference, \
+             not a verdict: the checks are)",
+            hint.text
+        ));
+    }
+    Ok(summary)
 }
 
 /// Runs a linear scene: every run, its checks, notes, tables and figures, and the
