@@ -165,7 +165,7 @@ impl Pooled {
     fn of(r: &[ModeRatio]) -> Option<Pooled> {
         if r.is_empty()
             || r.iter()
-                .any(|m| !m.ratio.is_finite() || !(m.std_error.is_finite() && m.std_error > 0.0))
+                .any(|m| !(m.ratio.is_finite() && m.std_error.is_finite() && m.std_error > 0.0))
         {
             return None;
         }

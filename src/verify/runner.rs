@@ -1088,7 +1088,7 @@ enum DataHalving {
     /// The scene does not ask for it.
     NotAsked,
     /// The data hold both runs of the pair: the check and its note.
-    Checked(CheckResult, String),
+    Checked(Box<CheckResult>, String),
     /// The data lack a run of the pair: listed as skipped, with the reason.
     Skipped(SkippedCheck),
 }
@@ -1117,7 +1117,7 @@ fn data_halving_check(
     let ib = runs.iter().position(|r| r == b);
     if let (Some(ia), Some(ib)) = (ia, ib) {
         let (check, note) = halving_check([a, b], &estimates[ia], &estimates[ib])?;
-        return Ok(DataHalving::Checked(check, note));
+        return Ok(DataHalving::Checked(Box::new(check), note));
     }
     let missing: Vec<&str> = [(ia, a), (ib, b)]
         .iter()
@@ -1495,7 +1495,7 @@ fn check_compression_data(
         .map_err(|e| Error::run_failed(scene.path.display().to_string(), "dt-halving check", e))?
     {
         DataHalving::Checked(check, note) => {
-            outputs.checks.push(check);
+            outputs.checks.push(*check);
             outputs.notes.push(note);
         }
         DataHalving::Skipped(skipped) => outputs.skipped.push(skipped),
