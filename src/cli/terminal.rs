@@ -1,7 +1,8 @@
 //! What `verify` and `check` print: per-scene lines and the closing totals line on
 //! stdout, warnings on stderr, at the chosen [`Verbosity`].
 //!
-//! - quiet: every failed check (`SCENE  failed: NAME`), then the totals line;
+//! - quiet: every failed check (`SCENE  failed: NAME`, with its ratio as below), then
+//!   the totals line;
 //! - normal: a line per scene (verdict, checks passed, failed and skipped, wall time),
 //!   its failed checks, each with the ratio estimate/reference where it means something
 //!   ([`diagnosis::ratio_of`]), a hint per run with a failed check where its per-mode
@@ -93,7 +94,7 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
         }
         for c in s.checks.iter().filter(|c| !c.passed) {
             match verbosity {
-                Verbosity::Quiet => println!("{}  failed: {}", s.name, c.name),
+                Verbosity::Quiet => println!("{}  failed: {}", s.name, failed_name(c)),
                 Verbosity::Normal => println!("    failed: {}", failed_name(c)),
                 Verbosity::Verbose => {
                     println!("    failed: {}: {}", c.name, failure_detail(c));
