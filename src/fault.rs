@@ -1302,6 +1302,44 @@ mod tests {
         assert_eq!(v, Verdict::FailedChecks, "{kind} at its stated size");
     }
 
+    /// **The hints name the faults' signatures** (issue #31). `hinged-linear-3d`
+    /// restricted to its Crank–Nicolson run, at the quick budget and its own seed, under
+    /// one fault at a time at its stated size: the noise variance × 1.1 (variances × 1.1,
+    /// rates unchanged) is hinted as noise amplitude or kT; the integrator's K × 1.05
+    /// (variances × 1/1.05, rates × 1.05) as a stiffness; the integrator's C × 1.1 with
+    /// the noise of the true C (variances and rates × 1/1.1) as a drag in the
+    /// deterministic step without its noise. Each hint is stated on the run with the
+    /// failed checks, as a question. Deterministic (fixed seed).
+    #[test]
+    fn the_hints_name_the_signatures_of_noise_stiffness_and_drag_faults() {
+        use crate::verify::diagnosis::{Pattern, run_hints};
+        let mut linear = builtin::find("hinged-linear-3d").unwrap().load().unwrap();
+        linear.runs.retain(|r| r.name == "crank-nicolson");
+        for (kind, pattern) in [
+            (FaultKind::NoiseVariance, Pattern::NoiseAmplitude),
+            (FaultKind::IntegratorStiffness, Pattern::Stiffness),
+            (FaultKind::IntegratorDrag, Pattern::DragWithoutItsNoise),
+        ] {
+            let summary = quick_verify(
+                linear.clone().with_fault(Fault::stated(kind)),
+                &format!("hint-{kind}"),
+            )
+            .unwrap();
+            let hints = run_hints(&summary.scenes[0]);
+            assert!(
+                matches!(&hints[..], [(run, h)] if run == "crank-nicolson" && h.pattern == pattern && h.text.ends_with('?')),
+                "{kind}: {hints:?}"
+            );
+            assert!(
+                summary.scenes[0]
+                    .notes
+                    .iter()
+                    .any(|n| n.starts_with("run crank-nicolson: hint: ")),
+                "{kind}: the report's note"
+            );
+        }
+    }
+
     /// **Membrane faults of 2 % fail `verify` at quick** (issue #27). `membrane-hinged`
     /// and `membrane-periodic` restricted to their Crank–Nicolson run pass clean; a 2 %
     /// error of the noise variance, of κ in the integrator only or of the drag in the

@@ -270,6 +270,7 @@ fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
         continuum: Some(0.126),
         reference_kind: "discrete".to_string(),
         detail: "n = 4000 samples & 3 lags".to_string(),
+        largest_deviation: None,
     }
 }
 

@@ -168,6 +168,154 @@ fn an_injected_bias_fails_naming_the_checks() {
     );
 }
 
+/// A noise-variance error (issue #31): modal amplitudes scaled by √1.1, so every variance
+/// × 1.1 and every decay rate unchanged. `check` exits 1; each failed mode-variance line
+/// of the default output shows its ratio estimate/reference (1.1 within 5 of its
+/// standard errors), and the run's hint names the uniform variance ratio with the rates
+/// unchanged — noise amplitude or kT — as does the report's note.
+#[test]
+fn a_noise_variance_error_fails_with_ratios_and_the_uniform_variance_hint() {
+    let dir = TempDir::new("run-check-noise");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let side = json(&Path::new(&data).join("data.json"));
+    scale_columns(&data, &side, |h| h.starts_with("aw_"), 1.1f64.sqrt());
+    let report = dir.join("report");
+    let (o, args) = check(&data, report.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let variance_lines: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("    failed: crank-nicolson/mode-variance/n="))
+        .collect();
+    assert!(variance_lines.len() >= 3, "{stdout}");
+    for line in &variance_lines {
+        let (_, ratio) = line.split_once(" (ratio ").expect(line);
+        let (r, se) = ratio.trim_end_matches(')').split_once(" ± ").expect(line);
+        let (r, se): (f64, f64) = (r.parse().expect(line), se.parse().expect(line));
+        assert!((r - 1.1).abs() < 5.0 * se, "{line}");
+    }
+    // No ratio where it means nothing: the KS and chi2 goodness-of-fit lines.
+    for line in stdout.lines().filter(|l| l.contains("/mode-ks/")) {
+        assert!(!line.contains("ratio"), "{line}");
+    }
+    let hint = stdout
+        .lines()
+        .find(|l| l.starts_with("    crank-nicolson: hint: "))
+        .unwrap_or_else(|| panic!("no hint in {stdout}"));
+    assert!(
+        hint.contains("uniform variance ratio 1.1")
+            && hint.contains("with decay rates unchanged (ratio ")
+            && hint.ends_with("noise amplitude or kT?"),
+        "{hint}"
+    );
+    let s = json(&report.join("summary.json"));
+    let notes = common::strings(&s["scenes"][0]["notes"]);
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.starts_with("run crank-nicolson: hint: uniform variance ratio")),
+        "{notes:?}"
+    );
+}
+
+/// Compression data of both runs of the scene's Δt-halving pair get the `dt-halving`
+/// check; data of one run list it as skipped with the reason (issue #31: it was dropped
+/// silently). The strain-averaged `force-mean-bias` names its largest single-strain
+/// deviation and the force check that tests that strain.
+#[test]
+fn check_runs_dt_halving_when_the_data_hold_both_runs_and_skips_it_otherwise() {
+    let dir = TempDir::new("run-check-halving");
+    let data = dir.join_str("data");
+    let args = [
+        "run",
+        "--scene",
+        "compression-2d",
+        "--format",
+        "csv",
+        "--out",
+        &data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let report = dir.join("report");
+    let args = [
+        "check",
+        "--scene",
+        "compression-2d",
+        "--data",
+        &data,
+        "--out",
+        report.to_str().unwrap(),
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let s = json(&report.join("summary.json"));
+    let scene = &s["scenes"][0];
+    assert_eq!(scene["skipped"].as_array().unwrap().len(), 0, "{scene}");
+    let checks = scene["checks"].as_array().unwrap();
+    assert!(
+        checks
+            .iter()
+            .any(|c| c["name"] == "dt-halving/metropolis-vs-metropolis-half"),
+        "{checks:?}"
+    );
+    let names: Vec<&str> = checks.iter().filter_map(|c| c["name"].as_str()).collect();
+    for c in checks.iter().filter(|c| c["check"] == "force-mean-bias") {
+        let detail = c["detail"].as_str().unwrap();
+        assert!(detail.starts_with("strain-averaged bias: "), "{detail}");
+        let l = &c["largest_deviation"];
+        let tested_by = l["tested_by"].as_str().unwrap();
+        assert!(names.contains(&tested_by), "{tested_by}");
+        assert!(tested_by.ends_with(l["parameter"].as_str().unwrap()));
+        assert!(
+            detail.contains("largest single-strain deviation"),
+            "{detail}"
+        );
+    }
+    assert!(common::schema::violations(&common::schema::summary_schema(), &s).is_empty());
+    // The same data without the run at dt/2: skipped, with the reason.
+    let path = Path::new(&data).join("data.json");
+    let mut side = json(&path);
+    side["runs"]
+        .as_array_mut()
+        .unwrap()
+        .retain(|r| r["name"] != "metropolis-half");
+    std::fs::write(&path, serde_json::to_string_pretty(&side).unwrap()).unwrap();
+    let args = [
+        "-v",
+        "check",
+        "--scene",
+        "compression-2d",
+        "--data",
+        &data,
+        "--out",
+        report.to_str().unwrap(),
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains(
+            "    skipped: dt-halving/metropolis-vs-metropolis-half: the data hold run(s) \
+             metropolis but not metropolis-half"
+        ) && stdout.contains(", 1 skipped"),
+        "{stdout}"
+    );
+    let s = json(&report.join("summary.json"));
+    let skipped = &s["scenes"][0]["skipped"];
+    assert_eq!(
+        skipped[0]["name"], "dt-halving/metropolis-vs-metropolis-half",
+        "{skipped}"
+    );
+    assert!(
+        skipped[0]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("compares run metropolis (at dt) with run metropolis-half (at dt/2)")
+    );
+}
+
 /// Every file under `dir` with its bytes.
 /// Modal amplitudes scaled by 3 (variances 9×, the size of a wrong boundary condition in
 /// an integrator): every mode-variance check fails with p < 1e-12 — its null law, scale

@@ -1,9 +1,13 @@
 //! What `verify` and `check` print: per-scene lines and the closing totals line on
 //! stdout, warnings on stderr, at the chosen [`Verbosity`].
 //!
-//! - quiet: every failed check (`SCENE  failed: NAME`), then the totals line;
+//! - quiet: every failed check (`SCENE  failed: NAME`, with its ratio as below), then
+//!   the totals line;
 //! - normal: a line per scene (verdict, checks passed, failed and skipped, wall time),
-//!   its failed checks, the verdict with the report's path, then the totals line;
+//!   its failed checks, each with the ratio estimate/reference where it means something
+//!   ([`diagnosis::ratio_of`]), a hint per run with a failed check where its per-mode
+//!   ratios show a pattern ([`diagnosis::run_hints`]), the verdict with the report's
+//!   path, then the totals line;
 //! - verbose: also, per failed check, its test, statistic, p-values and estimate
 //!   against the reference, per skipped check the reason, and the seed of each scene.
 //!
@@ -11,6 +15,7 @@
 //! summed over the scenes; T the command's wall time), for a person and for a script.
 
 use super::Verbosity;
+use langevin_fem::verify::diagnosis;
 use langevin_fem::verify::summary::{CheckResult, Summary, Totals};
 
 /// The closing line of `verify` and `check`: `N passed, N failed, N skipped in T s`.
@@ -51,7 +56,19 @@ fn failure_detail(c: &CheckResult) -> String {
             num(c.reference)
         ));
     }
+    if let Some((r, se)) = diagnosis::ratio_of(c) {
+        parts.push(diagnosis::ratio_text(r, se));
+    }
     parts.join("; ")
+}
+
+/// The failed line's name with the ratio estimate/reference where it means something:
+/// `run/mode-variance/n=3 (ratio 1.099 ± 0.013)`.
+fn failed_name(c: &CheckResult) -> String {
+    match diagnosis::ratio_of(c) {
+        Some((r, se)) => format!("{} ({})", c.name, diagnosis::ratio_text(r, se)),
+        None => c.name.clone(),
+    }
 }
 
 /// Prints the scenes of `summary` at `verbosity`: failures and per-scene lines on
@@ -77,11 +94,16 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
         }
         for c in s.checks.iter().filter(|c| !c.passed) {
             match verbosity {
-                Verbosity::Quiet => println!("{}  failed: {}", s.name, c.name),
-                Verbosity::Normal => println!("    failed: {}", c.name),
+                Verbosity::Quiet => println!("{}  failed: {}", s.name, failed_name(c)),
+                Verbosity::Normal => println!("    failed: {}", failed_name(c)),
                 Verbosity::Verbose => {
                     println!("    failed: {}: {}", c.name, failure_detail(c));
                 }
+            }
+        }
+        if verbosity != Verbosity::Quiet {
+            for (run, hint) in diagnosis::run_hints(s) {
+                println!("    {run}: {}", hint.text);
             }
         }
         if verbosity == Verbosity::Verbose {
@@ -122,6 +144,7 @@ mod tests {
             reference_kind: "discrete".to_string(),
             unit: "[L]^2".to_string(),
             detail: String::new(),
+            largest_deviation: None,
         }
     }
 
@@ -170,7 +193,22 @@ mod tests {
         let d = failure_detail(&check("a", false));
         assert_eq!(
             d,
-            "z-test; statistic 3.5000; p = 4.6000e-4, adjusted p = 2.1000e-3; estimate 1.1000e0 +- 3.0000e-2 against reference 1.0000e0 [L]^2"
+            "z-test; statistic 3.5000; p = 4.6000e-4, adjusted p = 2.1000e-3; estimate 1.1000e0 +- 3.0000e-2 against reference 1.0000e0 [L]^2; ratio 1.100 ± 0.030"
         );
+    }
+
+    /// The default failed line: the name with the ratio where the check has an estimate
+    /// and a nonzero reference; the name alone for a check against 0 or without a
+    /// p-value (a residual, an oracle).
+    #[test]
+    fn failed_lines_show_the_ratio_where_it_means_something() {
+        let c = check("r/mode-variance/n=3", false);
+        assert_eq!(failed_name(&c), "r/mode-variance/n=3 (ratio 1.100 ± 0.030)");
+        let mut zero = check("r/mode-mean/n=3", false);
+        zero.reference = Some(0.0);
+        assert_eq!(failed_name(&zero), "r/mode-mean/n=3");
+        let mut residual = check("r/axial-equilibrium", false);
+        residual.p_value = None;
+        assert_eq!(failed_name(&residual), "r/axial-equilibrium");
     }
 }

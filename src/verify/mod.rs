@@ -14,6 +14,7 @@ pub mod calibrate;
 pub mod checks;
 pub mod compression;
 pub mod data;
+pub mod diagnosis;
 pub mod oracle;
 pub mod runner;
 pub mod shard;

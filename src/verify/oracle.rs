@@ -128,6 +128,7 @@ fn oracle_check(
             "{detail}; allowed observed - predicted in [{:.3e}, {:.3e}]",
             band.0, band.1
         ),
+        largest_deviation: None,
     }
 }
 

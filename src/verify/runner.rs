@@ -1085,6 +1085,65 @@ fn scene_halving_check(
     Ok(None)
 }
 
+/// What `check` does with the Δt-halving check of a compression scene.
+enum DataHalving {
+    /// The scene does not ask for it.
+    NotAsked,
+    /// The data hold both runs of the pair: the check and its note.
+    Checked(Box<CheckResult>, String),
+    /// The data lack a run of the pair: listed as skipped, with the reason.
+    Skipped(SkippedCheck),
+}
+
+/// The Δt-halving check of `check` (data of run names `runs`, force estimates
+/// `estimates` in the same order): made when the data hold both runs of the scene's
+/// pair, otherwise listed as skipped with the reason (never silently dropped, issue #31).
+///
+/// # Errors
+/// [`halving_check`]'s.
+fn data_halving_check(
+    scene: &Scene,
+    runs: &[&str],
+    estimates: &[ForceEstimates],
+) -> Result<DataHalving> {
+    let Some(comp) = &scene.compression else {
+        return Ok(DataHalving::NotAsked);
+    };
+    let Some([a, b]) = &comp.halving else {
+        return Ok(DataHalving::NotAsked);
+    };
+    if !scene.checks.contains(&CheckKind::DtHalving) {
+        return Ok(DataHalving::NotAsked);
+    }
+    let ia = runs.iter().position(|r| r == a);
+    let ib = runs.iter().position(|r| r == b);
+    if let (Some(ia), Some(ib)) = (ia, ib) {
+        let (check, note) = halving_check([a, b], &estimates[ia], &estimates[ib])?;
+        return Ok(DataHalving::Checked(Box::new(check), note));
+    }
+    let missing: Vec<&str> = [(ia, a), (ib, b)]
+        .iter()
+        .filter(|(i, _)| i.is_none())
+        .map(|(_, n)| n.as_str())
+        .collect();
+    let held = if runs.is_empty() {
+        "no run".to_string()
+    } else {
+        format!("run(s) {}", runs.join(", "))
+    };
+    Ok(DataHalving::Skipped(SkippedCheck {
+        name: format!("dt-halving/{a}-vs-{b}"),
+        reason: format!(
+            "the data hold {held} but not {}: the dt-halving check of scene {} compares run \
+             {a} (at dt) with run {b} (at dt/2); give the data of both runs (e.g. `langevin-fem \
+             run --scene {}` writes every run) to have it checked",
+            missing.join(" nor "),
+            scene.name,
+            scene.name
+        ),
+    }))
+}
+
 /// The paper's Fig. 2: ⟨F⟩/F_c0 against ε/ε_c0 in 2D and 3D, one colour per dimension:
 /// simulated points with error bars, exact theory (discretized filament: solid light
 /// line, continuum: dashed).
@@ -1172,7 +1231,7 @@ fn finish_scene(
             .collect()
     };
     let (figures, captions): (Vec<PathBuf>, Vec<String>) = figures.into_iter().unzip();
-    Ok(SceneSummary {
+    let mut summary = SceneSummary {
         name: scene.name.clone(),
         passed: checks.iter().all(|c| c.passed),
         wall_seconds: start.elapsed().as_secs_f64(),
@@ -1183,7 +1242,16 @@ fn finish_scene(
         warnings: Vec::new(),
         skipped,
         checks,
-    })
+    };
+    // Per run with a failed check, the pattern of its per-mode ratios, if any (issue #31).
+    for (run, hint) in crate::verify::diagnosis::run_hints(&summary) {
+        summary.notes.push(format!(
+            "run {run}: {} (a pattern among the run's per-mode ratios estimate/reference, \
+             not a verdict: the checks are)",
+            hint.text
+        ));
+    }
+    Ok(summary)
 }
 
 /// Runs a linear scene: every run, its checks, notes, tables and figures, and the
@@ -1386,6 +1454,7 @@ fn check_compression_data(
     let mut outputs = SceneOutputs::new(scene, &report);
     outputs.notes.push(data_note(sidecar, data_dir));
     let mut fig: Option<Figure> = None;
+    let mut estimates = Vec::new();
     for (k, c) in checks.iter().enumerate() {
         let name = &c.run.spec.name;
         outputs.runs.push(name.clone());
@@ -1421,6 +1490,18 @@ fn check_compression_data(
             k,
             &c.theory,
         )));
+        estimates.push(est);
+    }
+    let runs: Vec<&str> = checks.iter().map(|c| c.run.spec.name.as_str()).collect();
+    match data_halving_check(scene, &runs, &estimates)
+        .map_err(|e| Error::run_failed(scene.path.display().to_string(), "dt-halving check", e))?
+    {
+        DataHalving::Checked(check, note) => {
+            outputs.checks.push(*check);
+            outputs.notes.push(note);
+        }
+        DataHalving::Skipped(skipped) => outputs.skipped.push(skipped),
+        DataHalving::NotAsked => {}
     }
     if let Some(f) = fig {
         outputs.write_figure(&f, dir.join("force-strain.svg"))?;

@@ -60,6 +60,29 @@ pub struct CheckResult {
     pub unit: String,
     /// Free-text detail for a reader (what was compared, sample size, …).
     pub detail: String,
+    /// For a check of a mean over points (`force-mean-bias`: the mean over the strains),
+    /// the single point farthest from its reference, which the mean can hide; absent
+    /// (not serialized) for every other check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub largest_deviation: Option<LargestDeviation>,
+}
+
+/// The point of a pooled check farthest from its reference (issue #31): a bias of a few
+/// points of opposite signs, or at a few strains only, can hide in a mean that passes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LargestDeviation {
+    /// Where, e.g. `strain_ratio=6`.
+    pub parameter: String,
+    /// The point's estimate, in the check's unit.
+    pub estimate: f64,
+    /// Its exact reference (the exact discrete theory), in the check's unit.
+    pub reference: f64,
+    /// Its standard error (that of the point's own check), in the check's unit.
+    pub std_error: f64,
+    /// (estimate − reference) / std_error.
+    pub z: f64,
+    /// The check that tests this point on its own (name `run/check/parameter`).
+    pub tested_by: String,
 }
 
 /// A check the scene asks for that was not evaluated, with the reason (e.g. the series at
@@ -130,6 +153,7 @@ impl CheckResult {
             continuum,
             reference_kind: "discrete".to_string(),
             detail,
+            largest_deviation: None,
         }
     }
 

@@ -1,0 +1,590 @@
+//! Diagnosis of failed checks (issue #31): the ratio estimate/reference of a check, and
+//! the pattern a run's per-mode ratios show, stated as a *hint with its evidence*, never
+//! as a verdict.
+//!
+//! The patterns are those of one wrong parameter of the Langevin equation
+//! ξ ẇ = −K w + η, ⟨η η⟩ = 2 kT ξ δ(t − t′), whose mode n has the stationary variance
+//! kT/kₙ and the decay rate kₙ/ξ:
+//!
+//! | error | variance ratio | decay-rate ratio |
+//! |---|---|---|
+//! | noise amplitude or kT × c | c, every mode | 1 |
+//! | stiffness K × c (e.g. EI) | 1/c, every mode | c, every mode |
+//! | drag ξ × c, the noise following it (fluctuation–dissipation kept) | 1 | 1/c, every mode |
+//! | drag ξ × c in the deterministic step only, the noise of the true drag | 1/c | 1/c |
+//! | the time unit of the data (dt, dt_sample) × 1/c | 1 | c |
+//! | mesh or time step | departs from 1 more at higher modes | departs from 1 more at higher modes |
+//!
+//! [`diagnose`] recognises these patterns in lists of per-mode ratios with standard
+//! errors (pure, unit-tested on synthetic lists); [`run_hints`] applies it to the
+//! `mode-variance` and `decay-rate` checks of every run of a scene that has a failed
+//! check. A pattern needs at least [`MIN_MODES`] modes; "off 1" means that the
+//! inverse-variance weighted mean lies more than [`Z_HINT`] standard errors from 1,
+//! "uniform" (one factor) that every mode lies within [`BAND`] of that deviation (or
+//! within [`Z_HINT`] of its own errors) of the mean, "about the inverse" or "about the
+//! same" that the logs of the variance and rate ratios agree within a factor [`APPROX`].
+//! These are thresholds for a hint, not tests: the checks themselves are the verdict.
+
+use crate::verify::summary::{CheckResult, SceneSummary};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Fewest modes in which a pattern is named.
+pub const MIN_MODES: usize = 3;
+/// Standard errors by which a pooled ratio (or the growth of a deviation) must depart
+/// from 1 to be named.
+pub const Z_HINT: f64 = 3.0;
+/// The χ² p-value below which ratios are not consistent with 1.
+pub const P_STRUCTURE: f64 = 1e-3;
+/// Ratios are one factor over the modes when each lies within this fraction of the
+/// weighted mean's deviation from 1 (or within [`Z_HINT`] of its own standard errors) of
+/// that mean: a discrete integrator's rate is not exactly proportional to the stiffness at
+/// large λΔt (Crank–Nicolson's −ln((1 − a/2)/(1 + a/2)) grows faster than a), so the
+/// rates of a stiffness error are one factor only roughly.
+pub const BAND: f64 = 0.5;
+/// Two deviations (logs of the pooled ratios) are of one size when their quotient lies
+/// within [1/APPROX, APPROX].
+pub const APPROX: f64 = 1.5;
+
+/// The ratio estimate/reference of a check with its standard error (that of the
+/// estimate over |reference|; `None` when the check has none), where the ratio means
+/// something: a statistical check (with a p-value) with a finite estimate and a nonzero
+/// reference resolved by the estimate's error (|reference| > standard error). `None` for
+/// a deterministic check (oracle, residual), a check whose result is its statistic (χ²,
+/// KS) and one against 0 (a mean, a cross-correlation, a symmetry, a bias).
+pub fn ratio_of(c: &CheckResult) -> Option<(f64, Option<f64>)> {
+    c.p_value?;
+    let (e, r) = (c.estimate?, c.reference?);
+    let se = c.std_error.filter(|s| s.is_finite() && *s >= 0.0);
+    if !e.is_finite() || !r.is_finite() || r == 0.0 || se.is_some_and(|s| r.abs() <= s) {
+        return None;
+    }
+    let ratio = e / r;
+    ratio
+        .is_finite()
+        .then_some((ratio, se.map(|s| s / r.abs())))
+}
+
+/// `ratio 1.052 ± 0.013` (or `ratio 1.052` without an error) for a failed line; three
+/// decimals, or three significant digits in exponent form outside [0.01, 1000) (the
+/// error: outside [0.001, 1000), two).
+pub fn ratio_text(ratio: f64, std_error: Option<f64>) -> String {
+    let f = |v: f64| {
+        if v == 0.0 || (0.01..1000.0).contains(&v.abs()) {
+            format!("{v:.3}")
+        } else {
+            format!("{v:.2e}")
+        }
+    };
+    let err = |s: f64| {
+        if (0.001..1000.0).contains(&s) {
+            format!("{s:.3}")
+        } else {
+            format!("{s:.1e}")
+        }
+    };
+    match std_error {
+        Some(s) => format!("ratio {} ± {}", f(ratio), err(s)),
+        None => format!("ratio {}", f(ratio)),
+    }
+}
+
+/// The ratio estimate/reference of one mode's check, with its standard error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeRatio {
+    /// The mode, as its check names it (`n=3`, or `3`).
+    pub mode: String,
+    /// estimate / reference.
+    pub ratio: f64,
+    /// Its standard error (> 0).
+    pub std_error: f64,
+}
+
+impl ModeRatio {
+    /// A mode's ratio.
+    pub fn new(mode: impl Into<String>, ratio: f64, std_error: f64) -> Self {
+        ModeRatio {
+            mode: mode.into(),
+            ratio,
+            std_error,
+        }
+    }
+}
+
+/// A pattern among a run's per-mode ratios.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pattern {
+    /// Variances off by one factor over the modes, decay rates unchanged: the noise
+    /// amplitude or kT.
+    NoiseAmplitude,
+    /// Variances off by one factor over the modes, no decay rates to compare: the noise
+    /// amplitude, kT or the stiffness.
+    UniformVariance,
+    /// Variances × 1/c and decay rates × c, each uniform: the stiffness × c.
+    Stiffness,
+    /// Decay rates off by one factor, variances unchanged: the drag (with its noise) or
+    /// the time unit.
+    DragOrTimeUnit,
+    /// Variances and decay rates off by the same factor 1/c: the drag × c in the
+    /// deterministic step, with the noise of the true drag.
+    DragWithoutItsNoise,
+    /// Variances and decay rates each off by a uniform factor, in no single-parameter
+    /// relation: more than one parameter.
+    UniformBoth,
+    /// Deviations from 1 that grow with the mode number: mesh or time step.
+    GrowingWithMode,
+}
+
+/// A hint: the pattern and the sentence naming it with its evidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hint {
+    /// The pattern seen.
+    pub pattern: Pattern,
+    /// `uniform variance ratio 1.100 ± 0.004 over modes 1–8 with decay rates unchanged
+    /// (ratio 1.002 ± 0.010) — noise amplitude or kT?`
+    pub text: String,
+}
+
+/// The weighted summary of a list of ratios.
+#[derive(Debug, Clone, Copy)]
+struct Pooled {
+    /// Inverse-variance weighted mean.
+    mean: f64,
+    /// Its standard error.
+    se: f64,
+    /// Every ratio within [`BAND`] of the mean's deviation from 1, or within [`Z_HINT`]
+    /// of its own standard errors, of the mean.
+    in_band: bool,
+    /// p-value of the χ² of the ratios about 1 (k dof).
+    p_one: f64,
+    /// Number of ratios.
+    n: usize,
+}
+
+impl Pooled {
+    /// `None` for an empty list or one with a non-finite ratio or a non-positive error.
+    fn of(r: &[ModeRatio]) -> Option<Pooled> {
+        if r.is_empty()
+            || r.iter()
+                .any(|m| !(m.ratio.is_finite() && m.std_error.is_finite() && m.std_error > 0.0))
+        {
+            return None;
+        }
+        let w: Vec<f64> = r.iter().map(|m| m.std_error.powi(-2)).collect();
+        let sw: f64 = w.iter().sum();
+        let mean = r.iter().zip(&w).map(|(m, w)| m.ratio * w).sum::<f64>() / sw;
+        let band = BAND * (mean - 1.0).abs();
+        let chi2: f64 = r
+            .iter()
+            .map(|m| ((m.ratio - 1.0) / m.std_error).powi(2))
+            .sum();
+        Some(Pooled {
+            mean,
+            se: sw.sqrt().recip(),
+            in_band: r
+                .iter()
+                .all(|m| (m.ratio - mean).abs() <= band.max(Z_HINT * m.std_error)),
+            p_one: ChiSquared::new(r.len() as f64).map_or(f64::NAN, |d| d.sf(chi2)),
+            n: r.len(),
+        })
+    }
+
+    /// The mean more than [`Z_HINT`] standard errors from 1.
+    fn off_one(&self) -> bool {
+        (self.mean - 1.0).abs() > Z_HINT * self.se
+    }
+
+    /// At least [`MIN_MODES`] ratios, off 1 and within the band about their mean: one
+    /// factor for every mode.
+    fn uniformly_off(&self) -> bool {
+        self.n >= MIN_MODES && self.off_one() && self.in_band
+    }
+
+    /// Neither off 1 nor structured about 1.
+    fn unchanged(&self) -> bool {
+        !self.off_one() && self.p_one >= P_STRUCTURE
+    }
+
+    /// ln of the mean: the size and sign of the deviation.
+    fn log(&self) -> f64 {
+        self.mean.ln()
+    }
+
+    /// `1.100 ± 0.004`.
+    fn text(&self) -> String {
+        format!("{:.3} ± {:.3}", self.mean, self.se)
+    }
+}
+
+/// Whether two deviations (logs of ratios) are of one size within [`APPROX`]: the
+/// signature of one parameter acting on both observables.
+fn same_size(a: f64, b: f64) -> bool {
+    let q = (a / b).abs();
+    q.is_finite() && (1.0 / APPROX..=APPROX).contains(&q)
+}
+
+/// The mode number of a label (`n=3` → `3`).
+fn mode_label(m: &ModeRatio) -> &str {
+    m.mode.strip_prefix("n=").unwrap_or(&m.mode)
+}
+
+/// `modes 1–8` (or `mode 3`).
+fn modes_text(r: &[ModeRatio]) -> String {
+    match r {
+        [] => "no modes".to_string(),
+        [one] => format!("mode {}", mode_label(one)),
+        [first, .., last] => format!("modes {}–{}", mode_label(first), mode_label(last)),
+    }
+}
+
+/// Whether the deviations from 1 grow with the mode number (the list's order): the
+/// highest mode off 1 by more than [`Z_HINT`] standard errors and by that much more than
+/// the weighted mean of the lower modes (a poorly resolved lowest mode does not hide the
+/// growth), no mode significantly (2 s.e.) on the other side of 1, and no mode below its
+/// predecessor by more than [`Z_HINT`] standard errors of their difference.
+fn grows_with_mode(r: &[ModeRatio]) -> bool {
+    let Some((last, lower)) = r.split_last() else {
+        return false;
+    };
+    let Some(below) = Pooled::of(lower) else {
+        return false;
+    };
+    if r.len() < MIN_MODES || Pooled::of(r).is_none() {
+        return false;
+    }
+    let sign = (last.ratio - 1.0).signum();
+    let dev = |m: &ModeRatio| sign * (m.ratio - 1.0);
+    let hyp = |a: &ModeRatio, b: &ModeRatio| a.std_error.hypot(b.std_error);
+    dev(last) > Z_HINT * last.std_error
+        && dev(last) - sign * (below.mean - 1.0) > Z_HINT * last.std_error.hypot(below.se)
+        && r.iter().all(|m| dev(m) > -2.0 * m.std_error)
+        && r.windows(2)
+            .all(|w| dev(&w[1]) >= dev(&w[0]) - Z_HINT * hyp(&w[0], &w[1]))
+}
+
+/// `1.000, 1.002, 1.099, 1.343 over modes 1–4` (the first and last of a long list).
+fn ratios_text(r: &[ModeRatio]) -> String {
+    let list: Vec<String> = if r.len() <= 8 {
+        r.iter().map(|m| format!("{:.3}", m.ratio)).collect()
+    } else {
+        vec![
+            format!("{:.3}", r[0].ratio),
+            "…".to_string(),
+            format!("{:.3}", r[r.len() - 1].ratio),
+        ]
+    };
+    format!("{} over {}", list.join(", "), modes_text(r))
+}
+
+/// The pattern among the per-mode variance ratios `variance` and decay-rate ratios
+/// `rate` of one run (each in mode order), stated as a hint with its evidence (see the
+/// [module docs](self)); `None` when the ratios are consistent with 1, too few, or show
+/// no pattern named here.
+///
+/// The variances decide first (a linear scheme's stationary variance does not depend on
+/// its step when it is exact, so they are the cleaner signature): one factor over the
+/// modes, then the rates say which parameter — unchanged (noise amplitude or kT), off by
+/// about the inverse factor (stiffness), off by about the same factor (a drag without its
+/// noise), otherwise more than one parameter. Variances unchanged with rates off by one
+/// factor: the drag or the time unit. Otherwise, deviations that grow with the mode
+/// number: mesh or time step.
+pub fn diagnose(variance: &[ModeRatio], rate: &[ModeRatio]) -> Option<Hint> {
+    let v = Pooled::of(variance);
+    let r = Pooled::of(rate);
+    let hint = |pattern, text: String| {
+        Some(Hint {
+            pattern,
+            text: format!("hint: {text}"),
+        })
+    };
+    if let Some(v) = v.filter(Pooled::uniformly_off) {
+        let over = modes_text(variance);
+        let var = format!("uniform variance ratio {} over {over}", v.text());
+        let c = 1.0 / v.mean;
+        return match r {
+            None => hint(
+                Pattern::UniformVariance,
+                format!("{var} (no decay rates to compare) — noise amplitude, kT or stiffness?"),
+            ),
+            Some(r) if !r.off_one() => hint(
+                Pattern::NoiseAmplitude,
+                format!(
+                    "{var} with decay rates unchanged (ratio {} over {}) — noise amplitude or kT?",
+                    r.text(),
+                    modes_text(rate)
+                ),
+            ),
+            Some(r) => {
+                let both = format!(
+                    "{var} and decay-rate ratio {} over {}",
+                    r.text(),
+                    modes_text(rate)
+                );
+                if same_size(v.log(), r.log()) && v.log() * r.log() < 0.0 {
+                    hint(
+                        Pattern::Stiffness,
+                        format!(
+                            "{both}, about its inverse — stiffness × {c:.3} (K or EI: \
+                             variances × 1/c, rates × c)?"
+                        ),
+                    )
+                } else if same_size(v.log(), r.log()) {
+                    hint(
+                        Pattern::DragWithoutItsNoise,
+                        format!(
+                            "{both}, about the same — drag × {c:.3} in the deterministic step \
+                             with the noise of the true drag (fluctuation–dissipation broken)?"
+                        ),
+                    )
+                } else {
+                    hint(
+                        Pattern::UniformBoth,
+                        format!(
+                            "{both}, in no single-parameter relation — more than one of noise \
+                             amplitude (kT), stiffness and drag?"
+                        ),
+                    )
+                }
+            }
+        };
+    }
+    if let (Some(v), Some(r)) = (v, r)
+        && v.unchanged()
+        && r.uniformly_off()
+    {
+        return hint(
+            Pattern::DragOrTimeUnit,
+            format!(
+                "uniform decay-rate ratio {} over {} with variances unchanged (ratio {} over \
+                 {}) — drag × {:.3} (its noise following it), or the time unit (dt, \
+                 dt_sample)?",
+                r.text(),
+                modes_text(rate),
+                v.text(),
+                modes_text(variance),
+                1.0 / r.mean
+            ),
+        );
+    }
+    let mut grown = Vec::new();
+    if grows_with_mode(variance) {
+        grown.push(format!("variance {}", ratios_text(variance)));
+    }
+    if grows_with_mode(rate) {
+        grown.push(format!("decay rate {}", ratios_text(rate)));
+    }
+    if grown.is_empty() {
+        return None;
+    }
+    hint(
+        Pattern::GrowingWithMode,
+        format!(
+            "ratios depart from 1 more at higher modes ({}) — mesh or time step?",
+            grown.join("; ")
+        ),
+    )
+}
+
+/// The per-mode ratios of run `run`'s checks named `check` in `checks`, in their order.
+/// A `quadratic-form` check's standard error is the null one (from the reference, at
+/// ratio 1); the relative error of a variance is what stays fixed, so it is scaled by the
+/// ratio.
+fn mode_ratios(checks: &[CheckResult], run: &str, check: &str) -> Vec<ModeRatio> {
+    checks
+        .iter()
+        .filter(|c| c.run == run && c.check == check)
+        .filter_map(|c| {
+            let (ratio, se) = ratio_of(c)?;
+            let se = se?
+                * if c.kind == "quadratic-form" {
+                    ratio.abs()
+                } else {
+                    1.0
+                };
+            Some(ModeRatio::new(c.parameter.clone(), ratio, se))
+        })
+        .collect()
+}
+
+/// The hint of every run of `scene` with a failed check, in the order of their first
+/// failure: [`diagnose`] on its `mode-variance` and `decay-rate` checks (passed and
+/// failed: a pattern needs every mode).
+pub fn run_hints(scene: &SceneSummary) -> Vec<(String, Hint)> {
+    let mut runs: Vec<&str> = Vec::new();
+    for c in scene
+        .checks
+        .iter()
+        .filter(|c| !c.passed && !c.run.is_empty())
+    {
+        if !runs.contains(&c.run.as_str()) {
+            runs.push(&c.run);
+        }
+    }
+    runs.into_iter()
+        .filter_map(|run| {
+            let v = mode_ratios(&scene.checks, run, "mode-variance");
+            let r = mode_ratios(&scene.checks, run, "decay-rate");
+            diagnose(&v, &r).map(|h| (run.to_string(), h))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ratios `values` with standard error `se` each, modes 1, 2, ….
+    fn ratios(values: &[f64], se: f64) -> Vec<ModeRatio> {
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| ModeRatio::new(format!("n={}", i + 1), v, se))
+            .collect()
+    }
+
+    fn pattern(v: &[ModeRatio], r: &[ModeRatio]) -> Option<Pattern> {
+        diagnose(v, r).map(|h| h.pattern)
+    }
+
+    /// A noise amplitude (or kT) error: every variance × 1.10 within its error, the rates
+    /// at 1 within theirs; the hint names the ratio, the modes and the unchanged rates.
+    #[test]
+    fn a_uniform_variance_ratio_with_rates_unchanged_hints_at_the_noise() {
+        let v = ratios(
+            &[1.104, 1.097, 1.101, 1.093, 1.108, 1.099, 1.102, 1.096],
+            0.005,
+        );
+        let r = ratios(&[1.01, 0.99, 1.02, 0.995, 1.0, 0.985], 0.015);
+        let h = diagnose(&v, &r).unwrap();
+        assert_eq!(h.pattern, Pattern::NoiseAmplitude);
+        assert!(
+            h.text
+                .starts_with("hint: uniform variance ratio 1.100 ± 0.002 over modes 1–8")
+                && h.text.contains("decay rates unchanged (ratio 1.00")
+                && h.text.ends_with("noise amplitude or kT?"),
+            "{}",
+            h.text
+        );
+        // Without decay rates the stiffness cannot be told apart.
+        assert_eq!(pattern(&v, &[]), Some(Pattern::UniformVariance));
+    }
+
+    /// A stiffness error K × 1.05: variances × 1/1.05, rates × 1.05; a drag error of the
+    /// deterministic step alone (ξ × 1.1, the noise of the true ξ): both × 1/1.1; a drag
+    /// with its noise, or a wrong time unit: rates × 1/1.1 with variances unchanged.
+    #[test]
+    fn variance_and_rate_ratios_together_hint_at_stiffness_or_drag() {
+        let v = ratios(&[0.953, 0.951, 0.954, 0.950, 0.952, 0.953], 0.003);
+        let r = ratios(&[1.046, 1.055, 1.050, 1.052, 1.049], 0.006);
+        let h = diagnose(&v, &r).unwrap();
+        assert_eq!(h.pattern, Pattern::Stiffness, "{}", h.text);
+        assert!(h.text.contains("stiffness × 1.050"), "{}", h.text);
+        let v = ratios(&[0.909, 0.911, 0.907, 0.910, 0.908], 0.003);
+        let r = ratios(&[0.905, 0.913, 0.909, 0.910, 0.908], 0.006);
+        let h = diagnose(&v, &r).unwrap();
+        assert_eq!(h.pattern, Pattern::DragWithoutItsNoise, "{}", h.text);
+        assert!(h.text.contains("drag × 1.10"), "{}", h.text);
+        let v = ratios(&[1.002, 0.998, 1.001, 0.999, 1.003], 0.003);
+        let h = diagnose(&v, &r).unwrap();
+        assert_eq!(h.pattern, Pattern::DragOrTimeUnit, "{}", h.text);
+        assert!(h.text.contains("time unit"), "{}", h.text);
+        // Crank–Nicolson's rates at large λΔt are not proportional to the stiffness: the
+        // integrator's K × 1.05 in hinged-linear-3d gave these (quick budget), still a
+        // stiffness.
+        let v = ratios(&[0.979, 0.940, 0.954, 0.954, 0.953, 0.953], 0.002);
+        let mut r = ratios(&[0.982, 1.045, 1.048, 1.049, 1.054, 1.079], 0.0026);
+        r[0].std_error = 0.072;
+        r[1].std_error = 0.016;
+        let mut v = v;
+        v[0].std_error = 0.04;
+        v[1].std_error = 0.0097;
+        assert_eq!(pattern(&v, &r), Some(Pattern::Stiffness));
+        // Variances × 1.1 and rates × 1.2: no one parameter does that.
+        let v = ratios(&[1.101, 1.099, 1.1, 1.102, 1.098], 0.003);
+        let r = ratios(&[1.2, 1.205, 1.195, 1.2, 1.198], 0.006);
+        assert_eq!(pattern(&v, &r), Some(Pattern::UniformBoth));
+    }
+
+    /// A time-step error (Euler–Maruyama's 1/(1 − λΔt/2), λₙ ∝ n⁴): variances and rates
+    /// depart from 1 more at higher modes; the evidence lists the ratios.
+    #[test]
+    fn deviations_growing_with_mode_number_hint_at_mesh_or_time_step() {
+        let v = ratios(&[1.001, 1.008, 1.044, 1.149], 0.01);
+        let r = ratios(&[1.003, 1.02, 1.09, 1.38], 0.02);
+        let h = diagnose(&v, &r).unwrap();
+        assert_eq!(h.pattern, Pattern::GrowingWithMode);
+        assert!(
+            h.text
+                .contains("variance 1.001, 1.008, 1.044, 1.149 over modes 1–4")
+                && h.text.contains("decay rate 1.003")
+                && h.text.ends_with("mesh or time step?"),
+            "{}",
+            h.text
+        );
+        // A coarse mesh: eigenvalues too large, variances falling below 1 with n.
+        let v = ratios(&[0.999, 0.99, 0.96, 0.9, 0.82, 0.73], 0.01);
+        assert_eq!(pattern(&v, &[]), Some(Pattern::GrowingWithMode));
+        // A poorly resolved lowest mode (short data) does not hide the growth.
+        let mut v = ratios(&[1.29, 1.073, 1.099, 1.344], 0.01);
+        v[0].std_error = 0.15;
+        v[1].std_error = 0.03;
+        assert_eq!(pattern(&v, &[]), Some(Pattern::GrowingWithMode));
+    }
+
+    /// No hint for ratios consistent with 1, for too few modes, or for an unstructured
+    /// pattern (deviations of both signs, or up and down with the mode number).
+    #[test]
+    fn no_hint_without_a_pattern() {
+        let one = ratios(&[1.004, 0.995, 1.01, 0.99, 1.002, 0.998], 0.008);
+        let rates = ratios(&[0.99, 1.01, 1.0, 1.02], 0.015);
+        assert_eq!(pattern(&one, &rates), None);
+        assert_eq!(pattern(&one, &[]), None);
+        assert_eq!(pattern(&[], &[]), None);
+        let two = ratios(&[1.1, 1.1], 0.002);
+        assert_eq!(pattern(&two, &[]), None);
+        for unstructured in [
+            vec![1.0, 1.2, 0.9, 1.15, 0.85, 1.1],
+            vec![1.0, 1.2, 1.02, 1.18, 1.01, 1.2],
+            vec![1.15, 1.0, 1.05, 0.92, 1.2],
+        ] {
+            let v = ratios(&unstructured, 0.01);
+            assert_eq!(pattern(&v, &rates), None, "{unstructured:?}");
+        }
+        // A bad standard error gives no pattern, and no panic.
+        let bad = vec![
+            ModeRatio::new("n=1", 1.1, 0.0),
+            ModeRatio::new("n=2", f64::NAN, 0.1),
+        ];
+        assert_eq!(pattern(&bad, &bad), None);
+    }
+
+    /// The ratio of a check: estimate/reference with the error over |reference|; none for
+    /// a deterministic check, one against 0, or an unresolved reference.
+    #[test]
+    fn a_ratio_only_where_it_means_something() {
+        let outcome = crate::stats::TestOutcome {
+            statistic: 3.3,
+            p_value: 1e-3,
+            dof: None,
+        };
+        let c = |values| {
+            CheckResult::statistical(
+                "r/x/n=1".into(),
+                "z-test",
+                values,
+                None,
+                &outcome,
+                String::new(),
+            )
+        };
+        let (r, se) = ratio_of(&c((1.1, 1.0, 0.03))).unwrap();
+        assert!((r - 1.1).abs() < 1e-12 && (se.unwrap() - 0.03).abs() < 1e-12);
+        assert_eq!(ratio_text(r, se), "ratio 1.100 ± 0.030");
+        assert_eq!(ratio_text(2.5e-4, None), "ratio 2.50e-4");
+        assert!(ratio_of(&c((0.1, 0.0, 0.03))).is_none());
+        assert!(ratio_of(&c((0.1, 0.02, 0.03))).is_none());
+        assert!(ratio_of(&c((f64::NAN, 1.0, 0.03))).is_none());
+        let mut det = c((1.1, 1.0, 0.03));
+        det.p_value = None;
+        assert!(ratio_of(&det).is_none());
+    }
+}
