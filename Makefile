@@ -50,10 +50,10 @@ verify: build
 # (seed k = 1 + k, each exactly `verify --scene S --seed <seed>`): the false-alarm rate
 # per scene with its exact binomial interval against alpha, and the uniformity of the
 # checks' p-values per check kind (KS, Holm), in $(OUT)/calibration/. Exit 1 if a scene's
-# rate is above alpha or a kind's p-values are not uniform. About 22 s per seed at the
-# quick budget on 2 cores (37 min for 100 seeds).
+# rate is above alpha or a kind's p-values are not uniform. About 60 s per seed at the
+# quick budget on 2 cores (100 min for 100 seeds; the fig2-paper scenes take half).
 SEEDS ?= 100
-CALIBRATION_SCENES = actin-10um clamped-clamped-3d compression-2d compression-3d grafted-clamped-free hinged-linear-2d hinged-linear-3d membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral microtubule-free-free pinned-free-2d spectral-reference tension-2d
+CALIBRATION_SCENES = actin-10um clamped-clamped-3d compression-2d compression-3d fig2-paper-2d fig2-paper-3d grafted-clamped-free hinged-linear-2d hinged-linear-3d membrane-area-paper membrane-area-soft membrane-area-stiff membrane-bilayer membrane-hinged membrane-periodic membrane-spectral microtubule-free-free pinned-free-2d spectral-reference tension-2d
 calibrate: build
 	$(BIN) calibrate $(foreach s,$(CALIBRATION_SCENES),--scene $(s)) --seeds $(SEEDS) --budget $(BUDGET) --out $(OUT)/calibration
 

@@ -528,17 +528,15 @@ impl CompressionRun {
                     strain_ratios,
                 )?
             }
-            (_, Some((params, dims, elements))) => {
-                crate::theory::scheme_law::scheme_force_ratios(
-                    &params,
-                    dims,
-                    elements,
-                    self.spec.integrator,
-                    self.spec.noise,
-                    self.dt,
-                    strain_ratios,
-                )?
-            }
+            (_, Some((params, dims, elements))) => crate::theory::scheme_law::scheme_force_ratios(
+                &params,
+                dims,
+                elements,
+                self.spec.integrator,
+                self.spec.noise,
+                self.dt,
+                strain_ratios,
+            )?,
             _ => return Ok(None),
         };
         Ok(Some(
