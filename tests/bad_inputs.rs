@@ -2662,7 +2662,11 @@ fn cli_cases() -> Vec<Case> {
         args(
             "theory-area-no-law",
             &["theory", "area", "--strain-ratio", "0"],
-            &["--elements/--cutoff", "got neither", "exactly one of"],
+            &[
+                "--elements/--cutoff/--mesh-convergence",
+                "got none",
+                "exactly one of",
+            ],
         ),
         args(
             "theory-area-elements-large",
