@@ -1407,6 +1407,28 @@ mod tests {
         assert!(!at_zero.passed, "{at_zero:?}");
     }
 
+    /// **The membrane's explicit-scheme scene (issue #28) does not swallow an error in its
+    /// tolerance band.** `membrane-area-paper` with the excess area's ½ missing in the
+    /// dynamics (the von Kármán-strain fault at s = ½: area matrix × 2, the references
+    /// keep the true one) fails its force check at ε = 0 at quick; without the fault the
+    /// scene passes (the golden snapshot). Deterministic (fixed seed).
+    #[test]
+    fn membrane_papers_scheme_scene_fails_with_a_missing_half_in_the_area() {
+        let scene = builtin::find("membrane-area-paper")
+            .unwrap()
+            .load()
+            .unwrap();
+        let fault = Fault::new(FaultKind::VonKarmanStrain, 0.5).unwrap();
+        let summary = quick_verify(scene.with_fault(fault), "membrane-paper-half").unwrap();
+        assert!(!summary.passed);
+        let checks = &summary.scenes[0].checks;
+        let at_zero = checks
+            .iter()
+            .find(|c| c.name == "paper/force/strain_ratio=0")
+            .unwrap();
+        assert!(!at_zero.passed, "{at_zero:?}");
+    }
+
     /// **The axial equilibrium residual finds a von Kármán strain error far below the
     /// statistical checks' reach.** `compression-2d` with its stored length 1e-4 too
     /// large (the fault at s = 5e-5; `make power` finds 0.0125 with the force checks
