@@ -373,7 +373,13 @@ fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
         h.push_str("</div>\n</details>\n");
     }
     if !s.tables.is_empty() {
-        h.push_str("<p class=\"tables\">Tables (CSV): ");
+        // collapsed like the notes and figures: a scene's CSV list wraps over several
+        // lines, and the page of a run must stay short before expansion
+        let _ = write!(
+            h,
+            "<details class=\"tables\"><summary>Tables (CSV, {})</summary>\n<p>",
+            s.tables.len()
+        );
         for (k, table) in s.tables.iter().enumerate() {
             if k > 0 {
                 h.push_str(", ");
@@ -385,7 +391,7 @@ fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
                 esc(file_name(table))
             );
         }
-        h.push_str("</p>\n");
+        h.push_str("</p>\n</details>\n");
     }
     if !s.skipped.is_empty() {
         let _ = writeln!(
