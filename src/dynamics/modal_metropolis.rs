@@ -122,6 +122,22 @@ struct Group {
     b: [f64; 16],
 }
 
+impl Group {
+    /// `Λ_b − F B_b` (row-major, stride 4): the block's Hessian of the linearization at
+    /// the force `f`.
+    fn linearized(&self, f: f64) -> [f64; 16] {
+        let k = self.k;
+        let mut h = [0.0; 16];
+        for r in 0..k {
+            for col in 0..k {
+                h[4 * r + col] = -f * self.b[4 * r + col];
+            }
+            h[5 * r] += self.rates[r];
+        }
+        h
+    }
+}
+
 /// What the modal coordinates are coordinates of (for the nodal state).
 #[derive(Debug, Clone)]
 enum Basis<'m> {
@@ -1077,14 +1093,7 @@ impl ModalMetropolis<'_> {
         let (mut log_var, mut prod, mut at) = (0.0, 1.0_f64, 0);
         for (vectors, grp) in e.vectors.iter_mut().zip(&self.groups) {
             let k = grp.k;
-            let mut hm = [0.0; 16];
-            for r in 0..k {
-                for col in 0..k {
-                    hm[4 * r + col] = -f * grp.b[4 * r + col];
-                }
-                hm[5 * r] += grp.rates[r];
-            }
-            let (values, v) = jacobi_eigen(&hm, k);
+            let (values, v) = jacobi_eigen(&grp.linearized(f), k);
             *vectors = v;
             for (j, &hj) in values.iter().enumerate().take(k) {
                 let x = -dt * hj;

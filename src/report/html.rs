@@ -372,27 +372,7 @@ fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
         }
         h.push_str("</div>\n</details>\n");
     }
-    if !s.tables.is_empty() {
-        // collapsed like the notes and figures: a scene's CSV list wraps over several
-        // lines, and the page of a run must stay short before expansion
-        let _ = write!(
-            h,
-            "<details class=\"tables\"><summary>Tables (CSV, {})</summary>\n<p>",
-            s.tables.len()
-        );
-        for (k, table) in s.tables.iter().enumerate() {
-            if k > 0 {
-                h.push_str(", ");
-            }
-            let _ = write!(
-                h,
-                "<a href=\"{}\">{}</a>",
-                esc(&url_path(table)),
-                esc(file_name(table))
-            );
-        }
-        h.push_str("</p>\n</details>\n");
-    }
+    tables_details(h, s);
     if !s.skipped.is_empty() {
         let _ = writeln!(
             h,
@@ -426,6 +406,31 @@ fn scene_section(h: &mut String, i: usize, s: &SceneSummary) {
         h.push_str("</tbody>\n</table></div>\n</details>\n");
     }
     h.push_str("</section>\n");
+}
+
+/// A scene's CSV tables, collapsed like its notes and figures: a scene's CSV list wraps
+/// over several lines, and the page of a run must stay short before expansion.
+fn tables_details(h: &mut String, s: &SceneSummary) {
+    if s.tables.is_empty() {
+        return;
+    }
+    let _ = write!(
+        h,
+        "<details class=\"tables\"><summary>Tables (CSV, {})</summary>\n<p>",
+        s.tables.len()
+    );
+    for (k, table) in s.tables.iter().enumerate() {
+        if k > 0 {
+            h.push_str(", ");
+        }
+        let _ = write!(
+            h,
+            "<a href=\"{}\">{}</a>",
+            esc(&url_path(table)),
+            esc(file_name(table))
+        );
+    }
+    h.push_str("</p>\n</details>\n");
 }
 
 /// The checks of a scene counted per run (rows; `scene` for the scene's own checks) and

@@ -818,28 +818,25 @@ fn read_record(
     let rigid_col = |k: usize, r: usize| extra + k * layout.n_rigid_data + r;
     let tangent_col =
         |k: usize, i: usize| extra + c * layout.n_rigid_data + k * layout.n_tangent_data + i;
+    // column `col` at the profile cadence, × `scale`, after its magnitude check
+    let scaled = |col: usize, scale: f64| -> Result<Vec<f64>> {
+        require_magnitude(table, (path, key), col, scale)?;
+        Ok(rows_from(run.profile_every)
+            .map(|row| table.get(row, col) * scale)
+            .collect())
+    };
     let rigid_refs = &run.reference.rigid;
     let mut rigid = Vec::with_capacity(c * rigid_refs.len());
     for k in 0..c {
         for (r, law) in rigid_refs.iter().enumerate() {
-            require_magnitude(table, (path, key), rigid_col(k, r), law.coordinate_scale)?;
-            rigid.push(
-                rows_from(run.profile_every)
-                    .map(|row| table.get(row, rigid_col(k, r)) * law.coordinate_scale)
-                    .collect(),
-            );
+            rigid.push(scaled(rigid_col(k, r), law.coordinate_scale)?);
         }
     }
     let nt = run.reference.tangent.len();
     let mut tangent = Vec::with_capacity(c * nt);
     for k in 0..c {
         for i in 0..nt {
-            require_magnitude(table, (path, key), tangent_col(k, i), 1.0)?;
-            tangent.push(
-                rows_from(run.profile_every)
-                    .map(|row| table.get(row, tangent_col(k, i)))
-                    .collect(),
-            );
+            tangent.push(scaled(tangent_col(k, i), 1.0)?);
         }
     }
     let mut profile = Vec::with_capacity(c * layout.profile_cols.len());
@@ -852,6 +849,30 @@ fn read_record(
             );
         }
     }
+    let two_time = two_time_products(run, data, (path, key), table, layout)?;
+    let record = TrajectoryRecord {
+        modes,
+        profile,
+        rigid,
+        tangent,
+        two_time: two_time.clone(),
+        slope_squares: Vec::new(),
+        slope_samples: 0,
+    };
+    Ok((record, two_time))
+}
+
+/// The two-time products `w(x, t) w(y, t + η)` of [`read_record`]'s table, per component
+/// and two-time point; refused if the table is too short for a point.
+fn two_time_products(
+    run: &LinearRun,
+    data: &DataRun,
+    (path, key): (&Path, &str),
+    table: &Table,
+    layout: &Layout,
+) -> Result<Vec<f64>> {
+    let c = run.components;
+    let deflection_col = |k: usize, j: usize| 1 + k * layout.n_positions + j;
     let tt = &run.reference.two_time;
     let mut two_time = vec![0.0; c * tt.len()];
     for (j, (q, &(cx, cy))) in tt.iter().zip(&layout.tt_cols).enumerate() {
@@ -875,16 +896,7 @@ fn read_record(
                 table.get(rt, deflection_col(k, cx)) * table.get(re, deflection_col(k, cy));
         }
     }
-    let record = TrajectoryRecord {
-        modes,
-        profile,
-        rigid,
-        tangent,
-        two_time: two_time.clone(),
-        slope_squares: Vec::new(),
-        slope_samples: 0,
-    };
-    Ok((record, two_time))
+    Ok(two_time)
 }
 
 /// The run specification the checks of data run `data` take from `scene`: the scene's

@@ -150,14 +150,7 @@ impl ModalMetropolis<'_> {
         let mut part = Vec::with_capacity(self.n());
         for grp in &self.groups {
             let k = grp.k;
-            let mut h = [0.0; 16];
-            for r in 0..k {
-                for c in 0..k {
-                    h[4 * r + c] = -force * grp.b[4 * r + c];
-                }
-                h[5 * r] += grp.rates[r];
-            }
-            let (inv, _) = spd_inverse(&h, k).ok_or_else(invalid)?;
+            let (inv, _) = spd_inverse(&grp.linearized(force), k).ok_or_else(invalid)?;
             let cov = inv.map(|v| v * self.kt);
             factors.push(cholesky(&cov, k).ok_or_else(invalid)?.0);
             let slowest = grp.rates[..k].iter().copied().fold(f64::INFINITY, f64::min);
