@@ -92,7 +92,8 @@ docs-check: numpy-venv
 # README's filament from tension through buckling (tension-2d at the full budget, about 2 s; a
 # test in tests/docs.rs fails when the committed figure differs from that run's, byte for byte),
 # and the README's membrane under imposed projected area (both membrane-area scenes at the
-# standard budget, about 80 s).
+# standard budget, about 80 s), and the README's cost of Fig. 2 per scheme (work-precision
+# on fig2-paper-2d, about 4 min; CPU times are measured, so this one is not byte-stable).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
 FIG2_IMAGE      = docs/src/images/fig2.svg
 TENSION_IMAGE   = docs/src/images/tension-2d.svg
@@ -108,6 +109,8 @@ docs: build
 	$(BIN) verify -q --scene membrane-area-soft --scene membrane-area-stiff --budget standard --out target/docs-area
 	cp target/docs-area/membrane-area-soft/force-strain.svg docs/src/images/membrane-area-soft.svg
 	cp target/docs-area/membrane-area-stiff/force-strain.svg docs/src/images/membrane-area-stiff.svg
+	$(BIN) work-precision -q --scene fig2-paper-2d --out target/docs-wp-fig2
+	cp target/docs-wp-fig2/work-precision-fig2.svg docs/src/images/fig2-work-precision.svg
 
 # The reports as a reader sees them (issue #14): a quick verification of every default
 # scene (passing) and the example check's failing report (NumPy at a large step) rendered

@@ -1411,6 +1411,13 @@ mod tests {
             .find(|c| c.name == "paper/force/strain_ratio=0")
             .unwrap();
         assert!(!at_zero.passed, "{at_zero:?}");
+        // The points are band tests, so their χ² sum is one too (conservative: not
+        // tested for uniformity by `calibrate`).
+        let sum = checks
+            .iter()
+            .find(|c| c.name == "paper/force-strain-chi2")
+            .unwrap();
+        assert_eq!(sum.kind, "band-chi2-sum");
     }
 
     /// **The membrane's explicit-scheme scene (issue #28) does not swallow an error in its

@@ -2626,13 +2626,59 @@ fn cli_cases() -> Vec<Case> {
             ],
         ),
         args(
-            "wp-compression-scene",
-            &[W, "--scene", "compression-2d"],
+            "wp-membrane-area-scene",
+            &[W, "--scene", "membrane-area-stiff"],
             &[
                 "--scene",
-                "got compression-2d",
-                "a linear finite-element scene",
+                "got membrane-area-stiff",
+                "a compression scene of a filament",
             ],
+        ),
+        args(
+            "wp-strain-ratios-linear",
+            &[W, "--scene", HL, "--strain-ratios", "0,6"],
+            &[
+                "--strain-ratios",
+                "got hinged-linear-2d",
+                "a compression scene",
+            ],
+        ),
+        args(
+            "wp-fig2-exact-modal",
+            &[
+                W,
+                "--scene",
+                "fig2-paper-2d",
+                "--methods",
+                "exact-modal/consistent",
+            ],
+            &[
+                "--methods",
+                "got exact-modal/consistent",
+                "metropolis-crank-nicolson",
+            ],
+        ),
+        args(
+            "wp-fig2-duration-short",
+            &[
+                W,
+                "--scene",
+                "fig2-paper-2d",
+                "--duration-tau1",
+                "2",
+                "--sample-every-tau1",
+                "0.05",
+            ],
+            &[
+                "--duration-tau1",
+                "got 2",
+                ">= 100 x --sample-every-tau1 = 5",
+            ],
+        ),
+        args(
+            "wp-fig2-sample-every-zero",
+            &[W, "--scene", "fig2-paper-2d", "--sample-every-tau1", "0"],
+            &["--sample-every-tau1", "got 0", "in [0.00001, 1]"],
         ),
         // theory area (the membrane under imposed projected area)
         args(

@@ -377,6 +377,21 @@ fn parse_list_or<T: FromStr + Clone>(
     text.map_or_else(|| Ok(default.to_vec()), |t| parse_list(flag, t, allowed))
 }
 
+/// The end of a study command: rebuilds the convergence report's index in `out` and
+/// prints the files the study wrote there and its wall time.
+///
+/// # Errors
+/// As [`langevin_fem::report::write_convergence_index`].
+fn study_written(out: &std::path::Path, files: &[String], wall_seconds: f64) -> Result<()> {
+    langevin_fem::report::write_convergence_index(out)?;
+    println!(
+        "wrote {} in {} ({wall_seconds:.1} s)",
+        files.join(", "),
+        out.display()
+    );
+    Ok(())
+}
+
 /// The seed and thread count of a command that simulates (`--seed`, `--threads`),
 /// flattened into each: `verify`, `converge`, `stability`, `work-precision`.
 #[derive(Debug, Args)]

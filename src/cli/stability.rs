@@ -160,13 +160,7 @@ pub fn run(args: StabilityArgs, verbosity: Verbosity) -> Result<i32> {
             "FAILED somewhere (see the table)"
         }
     );
-    langevin_fem::report::write_convergence_index(&args.out)?;
-    println!(
-        "wrote {} in {} ({:.1} s)",
-        s.files.join(", "),
-        args.out.display(),
-        s.wall_seconds
-    );
+    super::study_written(&args.out, &s.files, s.wall_seconds)?;
     Ok(if s.formula_rejections == 0 && s.stability_as_predicted {
         0
     } else {

@@ -13,6 +13,7 @@ use super::html::{CSS, esc, url_path};
 use crate::error::{Error, Result};
 use crate::output::{Manifest, read_manifest, write_atomic};
 use crate::studies::converge::{ConvergeSummary, OrderFit};
+use crate::studies::fig2_schemes::{self, Fig2SchemesSummary};
 use crate::studies::output::{INDEX, STUDY_COMMANDS, stem_of_journal, summary_name};
 use crate::studies::stability::{Cell, StabilitySummary, Status};
 use crate::studies::work_precision::WorkPrecisionSummary;
@@ -209,6 +210,85 @@ fn work_precision_section(h: &mut String, dir: &Path, journal: &str, v: &WorkPre
     files(h, dir, &v.files);
 }
 
+/// The schemes of Fig. 2: a table of every method and step (cost, projected CPU time,
+/// largest |bias|), the dynamics comparison, the figures.
+fn fig2_schemes_section(h: &mut String, dir: &Path, journal: &str, v: &Fig2SchemesSummary) {
+    let _ = writeln!(
+        h,
+        "<h2>Work–precision of Fig. 2 ({}, {}D)</h2>\n<p class=\"meta\">The paper's explicit scheme, Crank–Nicolson with the stretching force explicit and the Metropolis chain at strains eps/eps_c0 = {}, {} elements, {} trajectories x {} tau1 per strain and step, {} threads. Bias: &lt;F&gt;/F_c0 minus the exact discrete theory of the mesh. Projected CPU time to a standard error of {} F_c0 at every strain with the bias below it (a theta-scheme: its 95 % bound |bias| + 2 s.e.; the chain is exact at any step), from the measured CPU time per tau1 (getrusage) and standard errors.</p>",
+        esc(&v.scene),
+        v.dims,
+        v.strain_ratios
+            .iter()
+            .map(json)
+            .collect::<Vec<_>>()
+            .join(", "),
+        v.elements,
+        v.trajectories,
+        json(&v.duration_tau1),
+        v.threads,
+        num(v.tolerance)
+    );
+    run_line(h, journal, &v.run_id);
+    h.push_str("<table><tr><th>integrator</th><th>noise</th><th>dt/tau1</th><th>CPU-s per tau1</th><th>projected CPU-s</th><th>largest |bias| (its s.e.)</th></tr>\n");
+    for r in &v.runs {
+        let worst = r
+            .points
+            .iter()
+            .max_by(|a, b| a.bias.abs().total_cmp(&b.bias.abs()));
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            esc(&r.integrator),
+            esc(&r.noise),
+            num(r.dt_tau1),
+            num(r.cpu_per_tau1),
+            match (&r.failed, r.cpu_to_tolerance) {
+                (Some(why), _) => format!("no estimate: {}", esc(why)),
+                (None, t) => num_opt(t),
+            },
+            worst.map_or("–".to_string(), |p| format!(
+                "{} ({}) at eps/eps_c0 = {}",
+                num(p.bias.abs()),
+                num(p.force_std_error),
+                json(&p.strain_ratio)
+            ))
+        );
+    }
+    h.push_str("</table>\n");
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\">The dynamics at each scheme's smallest step: the integrated autocorrelation time of F and of the buckled mode's squared amplitude A² (tau1), chi2 of log tau about the weighted mean, Holm at alpha = {}.</p>",
+        json(&v.alpha)
+    );
+    h.push_str("<table><tr><th>eps/eps_c0</th><th>observable</th><th>tau_int ± s.e. per scheme (dt/tau1)</th><th>p</th><th>Holm p</th><th>verdict</th></tr>\n");
+    for t in &v.dynamics {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"num\">{}</td><td>{}</td><td class=\"detail\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"{}\">{}</td></tr>",
+            json(&t.strain_ratio),
+            esc(&t.observable),
+            t.methods
+                .iter()
+                .map(|(m, dt, tau, se)| format!(
+                    "{}: {} ± {} ({})",
+                    esc(m),
+                    num(*tau),
+                    num(*se),
+                    num(*dt)
+                ))
+                .collect::<Vec<_>>()
+                .join("; "),
+            num(t.p_value),
+            num(t.p_holm),
+            if t.passed { "pass" } else { "fail" },
+            if t.passed { "agree" } else { "differ" }
+        );
+    }
+    h.push_str("</table>\n");
+    files(h, dir, &v.files);
+}
+
 /// The run id of a listed study, with a link to its journal.
 fn run_line(h: &mut String, journal: &str, run_id: &str) {
     let _ = writeln!(
@@ -307,6 +387,7 @@ fn read<T: DeserializeOwned>(dir: &Path, name: &str) -> Option<T> {
 enum Study {
     Stability(StabilitySummary),
     WorkPrecision(WorkPrecisionSummary),
+    Fig2Schemes(Box<Fig2SchemesSummary>),
     Converge(Box<ConvergeSummary>),
 }
 
@@ -317,6 +398,9 @@ impl Study {
         let name = summary_name(stem);
         let study = match journal.command.as_str() {
             "stability" => Study::Stability(read(dir, &name)?),
+            "work-precision" if stem == fig2_schemes::STEM => {
+                Study::Fig2Schemes(Box::new(read(dir, &name)?))
+            }
             "work-precision" => Study::WorkPrecision(read(dir, &name)?),
             "converge" => Study::Converge(Box::new(read(dir, &name)?)),
             _ => return None,
@@ -324,6 +408,7 @@ impl Study {
         let run_id = match &study {
             Study::Stability(v) => &v.run_id,
             Study::WorkPrecision(v) => &v.run_id,
+            Study::Fig2Schemes(v) => &v.run_id,
             Study::Converge(v) => &v.run_id,
         };
         (*run_id == journal.run_id).then_some(study)
@@ -334,7 +419,7 @@ impl Study {
     fn rank(&self) -> u8 {
         match self {
             Study::Stability(_) => 0,
-            Study::WorkPrecision(_) => 1,
+            Study::WorkPrecision(_) | Study::Fig2Schemes(_) => 1,
             Study::Converge(_) => 2,
         }
     }
@@ -403,6 +488,7 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
         match study {
             Study::Stability(v) => stability_section(&mut h, dir, journal, v),
             Study::WorkPrecision(v) => work_precision_section(&mut h, dir, journal, v),
+            Study::Fig2Schemes(v) => fig2_schemes_section(&mut h, dir, journal, v),
             Study::Converge(v) => {
                 if !converge_heading {
                     h.push_str("<h2>Convergence over element count and time step</h2>\n");
@@ -420,6 +506,39 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    /// The schemes of Fig. 2 are listed from their journal beside a linear work–precision
+    /// study of the same command (not named as unfinished), with both tables and the four
+    /// figures.
+    #[test]
+    fn the_fig2_schemes_study_is_listed_with_its_tables_and_figures() {
+        let dir = std::env::temp_dir().join(format!("lfem-conv-fig2-{}", std::process::id()));
+        let opts = crate::studies::fig2_schemes::test_options(
+            crate::studies::fig2_schemes::DEFAULT_METHODS.to_vec(),
+            &dir,
+        );
+        crate::studies::fig2_schemes::run_fig2_schemes(&opts).unwrap();
+        write_convergence_index(&dir).unwrap();
+        let html = std::fs::read_to_string(dir.join(INDEX)).unwrap();
+        assert!(
+            html.contains("Work–precision of Fig. 2 (fig2-paper-2d, 2D)"),
+            "{html}"
+        );
+        assert!(!html.contains("Not listed"), "{html}");
+        assert!(
+            html.contains("metropolis-crank-nicolson/consistent: "),
+            "{html}"
+        );
+        for f in [
+            "work-precision-fig2.svg",
+            "fig2-bias.svg",
+            "fig2-tau-int-force.svg",
+            "fig2-tau-int-buckled-mode.svg",
+        ] {
+            assert!(html.contains(f), "{f}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     /// Non-finite numbers, written as `null`, read back as NaN (or `None`) and render as
     /// "–"; the summary serializes back to the same JSON.

@@ -560,7 +560,7 @@ fn reading_guide(h: &mut String, summary: &Summary) {
          <code>oracle</code> and <code>residual</code>: no p-value) pass or fail on their \
          own tolerance and are outside the family.</p>\n<ul>\
          <li><b>Test</b>: t-test, z-test, band-t-test and band-z-test (against the nearest \
-         point of a tolerance band, p = 1 inside it), chi2-variance (χ² test of a variance), quadratic-form \
+         point of a tolerance band, p = 1 inside it; band-chi2-sum their sum of squared scores), chi2-variance (χ² test of a variance), quadratic-form \
          (a sum of squares of AR(1) series against its exact null law, scale from the \
          reference), chi2-gof \
          (χ² goodness of fit of a distribution), chi2-sum (sum of squared scores), ks \

@@ -189,6 +189,8 @@ struct ForceRecorder<'m> {
     model: &'m CompressedFilament,
     euler_load: f64,
     rec: ForceRecord,
+    /// Whether to record [`ForceRecord::buckled_mode`].
+    buckled_mode: bool,
 }
 
 impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
@@ -196,6 +198,11 @@ impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
         let (model, w) = (self.model, &state.w);
         let f = model.compressive_force(model.stored_length(w));
         self.rec.force_ratio.push(f / self.euler_load);
+        if self.buckled_mode {
+            self.rec
+                .buckled_mode
+                .push(buckled_mode_square(model.beam(), w));
+        }
         if self.rec.slope_samples.is_multiple_of(AXIAL_RESIDUAL_EVERY) {
             note_axial_residual(&mut self.rec, model.axial_residual(w, f));
         }
@@ -219,11 +226,19 @@ struct ModalForceRecorder<'m> {
     euler_load: f64,
     rec: ForceRecord,
     block_squares: Vec<f64>,
+    /// Whether to record [`ForceRecord::buckled_mode`].
+    buckled_mode: bool,
 }
 
 impl Observer<ModalMetropolis<'_>> for ModalForceRecorder<'_> {
     fn on_sample(&mut self, _: usize, _: u64, chain: &ModalMetropolis<'_>) {
         self.rec.force_ratio.push(chain.force() / self.euler_load);
+        if self.buckled_mode {
+            let w = chain.nodal_state();
+            self.rec
+                .buckled_mode
+                .push(buckled_mode_square(self.model.beam(), &w));
+        }
         chain.add_block_rotation_squares(&mut self.block_squares);
         if self.rec.slope_samples.is_multiple_of(AXIAL_RESIDUAL_EVERY) {
             let r = self
@@ -326,6 +341,9 @@ pub struct CompressionRun {
     /// The scene's filament, its dims and element count (a membrane: `None`): the true
     /// parameters, whatever fault the chain's model carries, for [`Self::scheme_band`].
     filament: Option<(FilamentParams, Dims, usize)>,
+    /// Whether trajectories record the buckled mode's squared amplitude
+    /// ([`Self::with_buckled_mode`]).
+    buckled_mode: bool,
     /// The injected fault's factor on the modal chain's proposal force
     /// ([`crate::fault::FaultKind::ProposalForce`]).
     #[cfg(any(test, feature = "faults"))]
@@ -378,6 +396,33 @@ pub struct ForceRecord {
     pub drift_residual: Option<f64>,
     /// Number of states the drift was probed at.
     pub drift_states: u64,
+    /// The squared amplitude of the buckled mode at every sample, `A² = Σ_c s_c²` over the
+    /// transverse components, `s_c = (2/N) Σ_j w_c(x_j) sin(πx_j/L)` the first discrete
+    /// sine coefficient of the nodal deflections (units of L²); empty unless the run
+    /// records it ([`CompressionRun::with_buckled_mode`]: the dynamics comparison of
+    /// [`crate::studies::fig2_schemes`]).
+    pub buckled_mode: Vec<f64>,
+}
+
+/// The squared amplitude of the buckled mode of the nodal state `w` (one vector per
+/// transverse component): `Σ_c s_c²`, `s_c = (2/N) Σ_{j=1}^{N−1} w_c(x_j) sin(πj/N)` on
+/// `N` uniform elements (a hinged filament's first sine; on the paired modal form
+/// exactly the deflection part of the wavenumber-1 block, [`crate::fem::paired`]).
+pub fn buckled_mode_square(beam: &crate::fem::beam::BeamModel, w: &[Vec<f64>]) -> f64 {
+    let n = beam.mesh().n_nodes() - 1;
+    w.iter()
+        .map(|c| {
+            let s: f64 = (1..n)
+                .filter_map(|j| {
+                    beam.node_deflection_index(j)
+                        .map(|i| c[i] * (std::f64::consts::PI * j as f64 / n as f64).sin())
+                })
+                .sum::<f64>()
+                * 2.0
+                / n as f64;
+            s * s
+        })
+        .sum()
 }
 
 impl CompressionRun {
@@ -423,6 +468,7 @@ impl CompressionRun {
             },
             euler_load: p.euler_load(),
             filament: Some((p, Dims::from_u32(scene.dims as u32)?, scene.mesh.elements)),
+            buckled_mode: false,
             #[cfg(any(test, feature = "faults"))]
             proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
@@ -493,6 +539,7 @@ impl CompressionRun {
             object: Strained::Membrane { models, modes },
             euler_load: sigma_c0,
             filament: None,
+            buckled_mode: false,
             #[cfg(any(test, feature = "faults"))]
             proposal_force_factor: crate::fault::proposal_force_factor(scene.fault),
         })
@@ -575,6 +622,28 @@ impl CompressionRun {
     pub fn burn_in_at(&self, point: usize) -> f64 {
         let p = &self.plans[point];
         p.burn_in_steps as f64 * p.burn_in_dt
+    }
+
+    /// This run with every filament trajectory recording the squared amplitude of its
+    /// buckled mode at each sample ([`ForceRecord::buckled_mode`]; a membrane's records
+    /// stay without it). Changes nothing else: the same streams, the same forces.
+    pub fn with_buckled_mode(mut self) -> Self {
+        self.buckled_mode = true;
+        self
+    }
+
+    /// The time between samples, in physical time, at every strain set to
+    /// `sample_interval` (at least one step), for a study that samples finer than the
+    /// scene. Changes no trajectory, only which states are recorded.
+    pub fn with_sample_interval(mut self, sample_interval: f64) -> Self {
+        self.sample_interval = sample_interval;
+        for plan in &mut self.plans {
+            plan.sample_every = ((sample_interval / plan.dt).round() as u64).max(1);
+        }
+        if let Some(p) = self.plans.first() {
+            self.sample_every = p.sample_every;
+        }
+        self
     }
 
     /// This run with its own time step at every strain, `dt_tau1[i]` (units of τ1) at
@@ -692,6 +761,7 @@ impl CompressionRun {
                 slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
                 ..Default::default()
             },
+            buckled_mode: self.buckled_mode,
         };
         let burn_in_steps = (self.burn_in / plan.dt).round() as u64;
         Driver::new(plan.dt, burn_in_steps, sampled_steps, plan.sample_every).run(
@@ -736,6 +806,7 @@ impl CompressionRun {
                 ..Default::default()
             },
             block_squares: vec![0.0; modes.pairs().len() + modes.singles().len()],
+            buckled_mode: self.buckled_mode,
         };
         self.sample(
             &mut chain,

@@ -273,6 +273,7 @@ pub fn decode_force(bytes: &[u8], source: &str) -> Result<Vec<Vec<ForceRecord>>>
                 axial_states: d.u64()?,
                 drift_residual: d.optional()?,
                 drift_states: d.u64()?,
+                buckled_mode: Vec::new(),
             });
         }
         out.push(point);
@@ -354,6 +355,7 @@ mod tests {
                         axial_states: 40 * j,
                         drift_residual: (j != 2).then_some(3.5e-9 * j as f64),
                         drift_states: j,
+                        buckled_mode: Vec::new(),
                     })
                     .collect()
             })

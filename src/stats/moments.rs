@@ -85,35 +85,111 @@ pub fn integrated_autocorrelation_time(x: &[f64]) -> Result<IatEstimate> {
     let n = x.len();
     let max_lag = n / 2;
     let rho = normalize(autocovariance_about(x, mean_of(x), max_lag)?)?;
+    let (tau, m) = sokal_window(&rho, "integrated_autocorrelation_time", n)?;
+    let std_error = tau * (2.0 * (2.0 * m as f64 + 1.0) / n as f64).sqrt();
+    Ok(IatEstimate {
+        tau_int: tau,
+        window: m,
+        std_error,
+    })
+}
+
+/// Sokal's automatic window on the normalized autocorrelation `rho` (ρ(0) = 1 first):
+/// `(τ̂_int(M), M)` for the smallest M ≥ 1 with M ≥ [`SOKAL_C`]·τ̂_int(M); `n` (the
+/// samples behind `rho`) and `routine` name the estimate in errors.
+///
+/// # Errors
+/// [`Error::Numerical`] if τ̂_int at the window is not positive, or no window up to
+/// `rho.len() − 1` is self-consistent.
+fn sokal_window(rho: &[f64], routine: &str, n: usize) -> Result<(f64, usize)> {
     let mut tau = 0.5;
     for (m, r) in rho.iter().enumerate().skip(1) {
         tau += r;
         if m as f64 >= SOKAL_C * tau {
             if !(tau.is_finite() && tau > 0.0) {
                 return Err(Error::Numerical {
-                    routine: "integrated_autocorrelation_time".into(),
+                    routine: routine.into(),
                     detail: format!(
                         "estimated tau_int = {tau} is not positive (strongly \
                          anti-correlated or too short series)"
                     ),
                 });
             }
-            let std_error = tau * (2.0 * (2.0 * m as f64 + 1.0) / n as f64).sqrt();
-            return Ok(IatEstimate {
-                tau_int: tau,
-                window: m,
-                std_error,
-            });
+            return Ok((tau, m));
         }
     }
+    let max_lag = rho.len().saturating_sub(1);
     Err(Error::Numerical {
-        routine: "integrated_autocorrelation_time".into(),
+        routine: routine.into(),
         detail: format!(
             "no self-consistent window M <= n/2 = {max_lag} with M >= {SOKAL_C} tau_int(M) \
              (tau_int(n/2) = {tau:.3}): the series of {n} samples is too short for its \
              correlation time"
         ),
     })
+}
+
+/// Integrated autocorrelation time of one stationary process observed in several
+/// independent series of it (trajectories), with its standard error.
+///
+/// The autocovariance is pooled over the series about their common (grand) mean: the
+/// series are of one process, and a mean per series would lower every lag's
+/// autocovariance by about that mean's variance, 2τσ²/n, biasing τ̂ by about −2Mτ/n (M
+/// the window: −12 % at n = 100 τ). Each series contributes `Σ_t (x_t − x̄)(x_{t+k} − x̄)`
+/// (lags up to half the shortest series), the sum over series is divided by the total
+/// sample count N (the biased 1/n estimator), normalized and windowed as in
+/// [`integrated_autocorrelation_time`] (Sokal, c = [`SOKAL_C`]); the standard error is
+/// the Madras–Sokal `τ̂ sqrt(2(2M + 1)/N)`. Its remaining bias is about
+/// `−Σ_j jρ(j)/n − 2τ(M − τ)/N` (n samples per series): −2 % at 8 series of 100 τ.
+///
+/// Compare such estimates on the log scale, `ln τ̂` with standard error
+/// `sqrt(2(2M + 1)/N)`: there the estimate's law is nearly symmetric, while on the
+/// linear scale a low τ̂ comes with a low error (a delete-one jackknife over 8 series put
+/// 6 % of |z| beyond 3; the log-scale z of this error stays within ±2.5, validated in
+/// `tests/stats_validation.rs`).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for fewer than 2 series, a series shorter than
+/// [`MIN_SERIES_LEN`], a non-finite or constant series; [`Error::Numerical`] as
+/// [`integrated_autocorrelation_time`].
+pub fn pooled_integrated_autocorrelation_time(series: &[&[f64]]) -> Result<IatEstimate> {
+    if series.len() < 2 {
+        return Err(Error::invalid(
+            "series",
+            series.len(),
+            "at least 2 independent series",
+        ));
+    }
+    for x in series {
+        require_samples("series", x, MIN_SERIES_LEN)?;
+    }
+    let (tau, window) = pooled_window(series)?;
+    let n: usize = series.iter().map(|x| x.len()).sum();
+    Ok(IatEstimate {
+        tau_int: tau,
+        window,
+        std_error: tau * (2.0 * (2.0 * window as f64 + 1.0) / n as f64).sqrt(),
+    })
+}
+
+/// The windowed τ̂_int of the autocovariance pooled over `series` about their grand mean
+/// (see [`pooled_integrated_autocorrelation_time`]): `(τ̂_int, M)`.
+fn pooled_window(series: &[&[f64]]) -> Result<(f64, usize)> {
+    let n: usize = series.iter().map(|x| x.len()).sum();
+    let grand = series.iter().map(|x| x.iter().sum::<f64>()).sum::<f64>() / n as f64;
+    let max_lag = series.iter().map(|x| x.len()).min().unwrap_or(0) / 2;
+    let mut total = vec![0.0; max_lag + 1];
+    for x in series {
+        let g = autocovariance_about(x, grand, max_lag)?;
+        for (t, v) in total.iter_mut().zip(g) {
+            *t += v * x.len() as f64;
+        }
+    }
+    sokal_window(
+        &normalize(total)?,
+        "pooled_integrated_autocorrelation_time",
+        n,
+    )
 }
 
 /// Sample mean of a (possibly autocorrelated) stationary series with a standard error

@@ -10,11 +10,15 @@
 //!   integrators' exact discrete-time stationary-variance formulas.
 //! - [`work_precision`]: error in ⟨w²(L/2)⟩ against wall time, and the projected cost to a
 //!   tolerance.
+//! - [`fig2_schemes`]: the schemes of Fig. 2 (the paper's, Crank–Nicolson with explicit
+//!   stretching, the Metropolis chain) over Δt: the bias of ⟨F⟩, the projected CPU time to
+//!   the figure, and the autocorrelation times of F and of the buckled mode compared.
 //! - [`output`]: the shared study folder: one output set and journal per study
 //!   ([`output::StudyReport`]), so that studies keep each other's files and a rerun
 //!   replaces its own.
 
 pub mod converge;
+pub mod fig2_schemes;
 pub mod output;
 pub mod stability;
 pub mod work_precision;

@@ -25,7 +25,7 @@ pub struct CheckResult {
     /// check has no parameter.
     #[serde(default)]
     pub parameter: String,
-    /// The test, e.g. `t-test`, `z-test`, `chi2-variance`, `quadratic-form`, `chi2-gof`, `chi2-sum`, `ks`, `band-t-test`, `band-z-test` (against the nearest point of a tolerance band);
+    /// The test, e.g. `t-test`, `z-test`, `chi2-variance`, `quadratic-form`, `chi2-gof`, `chi2-sum`, `ks`, `band-t-test`, `band-z-test` (against the nearest point of a tolerance band), `band-chi2-sum` (their sum of squared scores);
     /// `oracle` and `residual` for deterministic checks.
     pub kind: String,
     /// The test statistic (t, z, χ², KS distance D); `None` for a deterministic check.

@@ -27,6 +27,8 @@ pub const SEED_MEMBRANE_QUADRATURE: u64 = 0x3E3B_7004;
 // tests/stats_validation.rs
 pub const SEED_IID_MEAN: u64 = 0x11D_0001;
 pub const SEED_AR1_TAU: u64 = 0xA41_0002;
+/// `stats_validation`: the pooled τ_int over several short AR(1) series.
+pub const SEED_AR1_POOLED_TAU: u64 = 0x0900_17A0;
 pub const SEED_AR1_MOMENTS: u64 = 0xA41_0003;
 pub const SEED_BLOCKING: u64 = 0xB10C_0004;
 pub const SEED_DECAY: u64 = 0xDECA_0005;

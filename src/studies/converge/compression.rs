@@ -96,7 +96,11 @@ fn dims_of(scene: &Scene) -> Result<Dims> {
 }
 
 /// ⟨F⟩/F_c0 at `strains` of the filament with `elements` elements (`None`: continuum).
-fn theory_forces(scene: &Scene, elements: Option<usize>, strains: &[f64]) -> Result<Vec<f64>> {
+pub(crate) fn theory_forces(
+    scene: &Scene,
+    elements: Option<usize>,
+    strains: &[f64],
+) -> Result<Vec<f64>> {
     let p = scene.filament;
     let dims = dims_of(scene)?;
     let law = match elements {
