@@ -95,6 +95,23 @@ fn own_output_round_trips_in_both_formats() {
         }
         let summary = json(&report.join("summary.json"));
         assert_eq!(summary["budget"], "data");
+        // The data's own description leads (the report's scene table shows it), the
+        // scene's description follows, and the references are the producer's
+        // discretization's: discrete.
+        let scene = &summary["scenes"][0];
+        let lead = scene["notes"][0].as_str().unwrap();
+        assert!(lead.starts_with("checked data: "), "{lead}");
+        assert!(lead.contains("fem, 10 elements, crank-nicolson"), "{lead}");
+        let second = scene["notes"][1].as_str().unwrap();
+        assert!(
+            second.starts_with("references and checks of scene hinged-linear-2d: "),
+            "{second}"
+        );
+        for c in scene["checks"].as_array().unwrap() {
+            if c["check"] == "mode-variance" {
+                assert_eq!(c["reference_kind"], "discrete", "{c}");
+            }
+        }
     }
 }
 
@@ -649,6 +666,12 @@ fn membrane_output_round_trips_and_a_bias_fails() {
     let against = dir.join("continuum");
     let _ = check_scene("membrane-periodic", &data, against.to_str().unwrap());
     let results = checks(&against);
+    // Without a declared discretization every reference is the continuum's, and every
+    // check of the run says so.
+    let summary = json(&against.join("summary.json"));
+    for c in summary["scenes"][0]["checks"].as_array().unwrap() {
+        assert_eq!(c["reference_kind"], "continuum", "{c}");
+    }
     // Modes 1-4: ac_0_1, as_0_1, ac_1_0, as_1_0.
     for n in 1..=4 {
         let name = format!("crank-nicolson/mode-variance/n={n}");

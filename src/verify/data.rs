@@ -47,6 +47,10 @@ pub struct DataCheck {
     /// Notes: the references used, the expected discretization deficit, what the data
     /// did not allow to check and why.
     pub notes: Vec<String>,
+    /// Whether every reference is the continuum's (the producer's discretization is not
+    /// one this tool models, or not declared): the run's checks then say
+    /// `reference_kind = "continuum"`.
+    pub continuum_references: bool,
 }
 
 /// Relative tolerance on a time or position of the data matching a scene's.
@@ -89,6 +93,7 @@ pub fn prepare_data_check(
     let discrete = discrete_run(&data_scene, tau1, (dir, k), data, &mut notes)?;
     let spec = data_spec(scene, data);
     let (modes, scale, discrete) = mode_references(scene, data, &continuum, discrete, &mut notes);
+    let continuum_references = discrete.is_none();
     let d = discrete.as_ref();
     let profile = profile_references(scene, data, &continuum, d, &mut notes)?;
     let (two_time, tt_cols) = two_time_references(scene, data, tau1, &continuum, d, &mut notes)?;
@@ -151,6 +156,7 @@ pub fn prepare_data_check(
         records,
         two_time: products,
         notes,
+        continuum_references,
     })
 }
 

@@ -1362,15 +1362,22 @@ pub fn check_data(
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
-    outputs.notes.push(data_note(&sidecar, data_dir));
+    lead_with_data(&mut outputs, scene, data_note(&sidecar, data_dir));
     for (data, dc) in sidecar.runs.iter().zip(&prepared) {
         outputs.runs.push(data.name.clone());
+        let first_check = outputs.checks.len();
         let est = apply_linear_checks(scene, &dc.run, &dc.records, &dc.two_time, &mut outputs)
             .map_err(|e| {
                 Error::run_failed(format!("data run {}", data.name), "checks", e).with_advice(
                     "the data did not support the estimate; longer or more trajectories may help",
                 )
             })?;
+        if dc.continuum_references {
+            // No reference of this run is the producer's discretization's.
+            for c in &mut outputs.checks[first_check..] {
+                c.reference_kind = "continuum".to_string();
+            }
+        }
         outputs.skipped.extend(est.skipped.iter().cloned());
         outputs.notes.extend(dc.notes.iter().cloned());
         outputs.notes.push(format!(
@@ -1398,18 +1405,52 @@ fn begin_check(scene: &Scene, out: &Path) -> Result<ReportRun> {
     Ok(report)
 }
 
-/// The note naming the data a `check` run read.
+/// The note naming the data a `check` run read: the directory, the producer and each
+/// run's declared discretization (model, elements, integrator, noise, step) and row
+/// interval.
 fn data_note(sidecar: &crate::data::DataSidecar, data_dir: &Path) -> String {
+    let runs: Vec<String> = sidecar
+        .runs
+        .iter()
+        .map(|r| {
+            let disc = r.discretization.as_ref().map_or_else(
+                || "discretization not declared".to_string(),
+                |d| {
+                    let mut parts = vec![d.model.clone()];
+                    parts.extend(d.elements.map(|n| format!("{n} elements")));
+                    parts.extend(d.integrator.clone());
+                    parts.extend(d.noise.as_ref().map(|n| format!("{n} noise")));
+                    parts.extend(d.dt.map(|dt| format!("dt {dt:e}")));
+                    parts.join(", ")
+                },
+            );
+            format!("{} ({disc}; rows every {:e})", r.name, r.dt_sample)
+        })
+        .collect();
     format!(
-        "checked data: {} (producer: {}), {} run(s)",
+        "checked data: {} (producer: {}), {} run(s): {}",
         data_dir.display(),
         if sidecar.producer.is_empty() {
             "not given"
         } else {
             &sidecar.producer
         },
-        sidecar.runs.len()
+        sidecar.runs.len(),
+        runs.join("; ")
     )
+}
+
+/// Puts the data's own description first among a `check` run's notes (the report's
+/// scene table shows the first note), the scene's description after it, saying that it
+/// describes the references and checks applied.
+fn lead_with_data(outputs: &mut SceneOutputs<'_>, scene: &Scene, note: String) {
+    if let Some(first) = outputs.notes.first_mut() {
+        *first = format!(
+            "references and checks of scene {}: {}",
+            scene.name, scene.description
+        );
+    }
+    outputs.notes.insert(0, note);
 }
 
 /// The summary of a `check` run (budget `data`): the family-wise correction over the
@@ -1452,7 +1493,7 @@ fn check_compression_data(
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
-    outputs.notes.push(data_note(sidecar, data_dir));
+    lead_with_data(&mut outputs, scene, data_note(sidecar, data_dir));
     let mut fig: Option<Figure> = None;
     let mut estimates = Vec::new();
     for (k, c) in checks.iter().enumerate() {
