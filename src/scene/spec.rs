@@ -449,6 +449,38 @@ fn default_noise() -> NoiseModel {
 }
 
 impl RunSpec {
+    /// A study's run `integrator-noise` at `dt_tau1` with the same fixed ensemble at every
+    /// budget (`trajectories` × `duration_tau1` τ1, no two-time extras, no target
+    /// precision) and the scene's checks.
+    pub fn fixed(
+        integrator: IntegratorKind,
+        noise: NoiseModel,
+        dt_tau1: f64,
+        trajectories: usize,
+        duration_tau1: f64,
+    ) -> Self {
+        let e = Ensemble {
+            trajectories,
+            duration_tau1,
+            two_time_trajectories: 0,
+            target_std_error: None,
+            pilot_tau1: None,
+            max_duration_tau1: None,
+            max_dt_tau1: None,
+            min_acceptance: None,
+        };
+        RunSpec {
+            name: format!("{}-{}", integrator.name(), noise.name()),
+            integrator,
+            noise,
+            dt_tau1,
+            checks: None,
+            quick: e,
+            standard: e,
+            full: e,
+        }
+    }
+
     /// The checks of this run: its own list, or the scene's.
     pub fn checks<'a>(&'a self, scene: &'a Scene) -> &'a [CheckKind] {
         self.checks.as_deref().unwrap_or(&scene.checks)

@@ -43,7 +43,7 @@ use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::compression::{CompressionRun, ForceRecord, force_estimates};
 use crate::scene::validate::Num;
-use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
+use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::stats::{self, holm};
 use crate::studies::converge::nan_if_null;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
@@ -356,26 +356,13 @@ fn point_scene(
     dt_tau1: f64,
 ) -> Scene {
     let mut s = opts.scene.clone();
-    let e = Ensemble {
-        trajectories: opts.trajectories,
-        duration_tau1: opts.duration_tau1,
-        two_time_trajectories: 0,
-        target_std_error: None,
-        pilot_tau1: None,
-        max_duration_tau1: None,
-        max_dt_tau1: None,
-        min_acceptance: None,
-    };
-    s.runs = vec![RunSpec {
-        name: format!("{}-{}", kind.name(), noise.name()),
-        integrator: kind,
+    s.runs = vec![RunSpec::fixed(
+        kind,
         noise,
         dt_tau1,
-        checks: None,
-        quick: e,
-        standard: e,
-        full: e,
-    }];
+        opts.trajectories,
+        opts.duration_tau1,
+    )];
     if let Some(c) = s.compression.as_mut() {
         c.strain_ratios = opts.strain_ratios.clone();
         c.distribution_strain_ratios.clear();
@@ -570,24 +557,46 @@ fn run_point(
         .sum::<f64>()
         * opts.trajectories as f64;
     out.cpu_per_tau1 = cpu / simulated;
-    let est = match force_estimates(&records) {
-        Ok(est) => est,
+    match measure(opts, &out, run, &records, exact) {
+        Ok(points) => out.points = points,
         Err(e @ Error::Numerical { .. }) => return failed(out, e),
         Err(e) => return Err(e),
-    };
+    }
+    if opts.progress {
+        let worst = out.points.iter().map(|p| p.z.abs()).fold(0.0, f64::max);
+        eprintln!(
+            "work-precision {} dt/tau1={dt:.3e}: {:.1} CPU-s ({:.3e} per tau1), largest |z| {worst:.1}",
+            label(method),
+            cpu,
+            out.cpu_per_tau1
+        );
+    }
+    Ok(out)
+}
+
+/// The points of `run_out` (its method and step) at every strain from the ensemble's
+/// `records`: ⟨F⟩ against `exact`, the measured bias bound, the dynamics.
+///
+/// # Errors
+/// [`Error::Numerical`] when a series is too short for its autocorrelation time.
+fn measure(
+    opts: &Fig2SchemesOptions,
+    run_out: &SchemeRun,
+    run: &CompressionRun,
+    records: &[Vec<ForceRecord>],
+    exact: &[f64],
+) -> Result<Vec<SchemePoint>> {
+    let tau1 = opts.scene.tau1();
+    let est = force_estimates(records)?;
     let mut points = Vec::new();
     for (i, recs) in records.iter().enumerate() {
         let interval = run.sample_dt_at(i) / tau1;
-        let d = match dynamics_of(recs, interval) {
-            Ok(d) => d,
-            Err(e @ Error::Numerical { .. }) => return failed(out, e),
-            Err(e) => return Err(e),
-        };
+        let d = dynamics_of(recs, interval)?;
         let (force, se) = est.force[i];
         points.push(SchemePoint {
-            integrator: out.integrator.clone(),
-            noise: out.noise.clone(),
-            dt_tau1: dt,
+            integrator: run_out.integrator.clone(),
+            noise: run_out.noise.clone(),
+            dt_tau1: run_out.dt_tau1,
             strain_ratio: opts.strain_ratios[i],
             sample_interval_tau1: interval,
             force,
@@ -595,7 +604,7 @@ fn run_point(
             exact: exact[i],
             bias: force - exact[i],
             z: (force - exact[i]) / se,
-            bias_bound: if out.exact_at_any_dt {
+            bias_bound: if run_out.exact_at_any_dt {
                 0.0
             } else {
                 (force - exact[i]).abs() + 2.0 * se
@@ -608,17 +617,7 @@ fn run_point(
             acceptance: est.acceptance,
         });
     }
-    out.points = points;
-    if opts.progress {
-        let worst = out.points.iter().map(|p| p.z.abs()).fold(0.0, f64::max);
-        eprintln!(
-            "work-precision {} dt/tau1={dt:.3e}: {:.1} CPU-s ({:.3e} per tau1), largest |z| {worst:.1}",
-            label(method),
-            cpu,
-            out.cpu_per_tau1
-        );
-    }
-    Ok(out)
+    Ok(points)
 }
 
 /// The dynamics of one strain's records: τ_int of F and of A² with their standard

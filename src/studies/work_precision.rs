@@ -33,7 +33,7 @@ use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::linear::{FemObject, LinearRun};
 use crate::scene::validate::Num;
-use crate::scene::{Ensemble, ModelKind, RunSpec, Scene};
+use crate::scene::{ModelKind, RunSpec, Scene};
 use crate::studies::converge::nan_if_null;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
@@ -331,30 +331,18 @@ fn point_scene(
     dt_tau1: f64,
 ) -> Scene {
     let mut s = opts.scene.clone();
-    let e = Ensemble {
-        trajectories: opts.trajectories,
-        duration_tau1: if kind == IntegratorKind::EulerMaruyama {
-            opts.em_duration_tau1
-        } else {
-            opts.duration_tau1
-        },
-        two_time_trajectories: 0,
-        target_std_error: None,
-        pilot_tau1: None,
-        max_duration_tau1: None,
-        max_dt_tau1: None,
-        min_acceptance: None,
+    let duration = if kind == IntegratorKind::EulerMaruyama {
+        opts.em_duration_tau1
+    } else {
+        opts.duration_tau1
     };
-    s.runs = vec![RunSpec {
-        name: format!("{}-{}", kind.name(), noise.name()),
-        integrator: kind,
+    s.runs = vec![RunSpec::fixed(
+        kind,
         noise,
         dt_tau1,
-        checks: None,
-        quick: e,
-        standard: e,
-        full: e,
-    }];
+        opts.trajectories,
+        duration,
+    )];
     s.sampling.modes = 1;
     s.sampling.profile_points = vec![0.5];
     s.sampling.two_time.clear();
