@@ -1145,19 +1145,37 @@ pub struct ForceEstimates {
 
 /// ⟨F⟩/F_c0 per strain: per trajectory the time average with an autocorrelation-aware
 /// error (integrated autocorrelation time); trajectories are independent, so errors add
-/// in quadrature.
+/// in quadrature. Where one trajectory's series is too short for its own
+/// autocorrelation window (a quick run of a few τ₁), every trajectory of that strain
+/// takes the time pooled over them ([`stats::pooled_integrated_autocorrelation_time`]):
+/// the same process, so the same τ_int (issue #30; a strain whose own windows all exist
+/// is estimated as before).
 ///
 /// # Errors
-/// Estimator errors (too few samples).
+/// Estimator errors (too few samples, also for the pooled time).
 pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
     let mut out = ForceEstimates::default();
     let (mut prop, mut acc) = (0u64, 0u64);
     for point in records {
-        let mut parts = Vec::new();
-        for r in point {
-            let m = stats::mean_with_error(&r.force_ratio)?;
+        let own: Result<Vec<_>> = point
+            .iter()
+            .map(|r| stats::mean_with_error(&r.force_ratio))
+            .collect();
+        let parts = match own {
+            Ok(parts) => parts,
+            Err(e) => {
+                let series: Vec<&[f64]> = point.iter().map(|r| r.force_ratio.as_slice()).collect();
+                let tau = stats::pooled_integrated_autocorrelation_time(&series)
+                    .map_err(|_| e)?
+                    .tau_int;
+                point
+                    .iter()
+                    .map(|r| stats::mean_with_error_at(&r.force_ratio, tau))
+                    .collect()
+            }
+        };
+        for (m, r) in parts.iter().zip(point) {
             out.max_tau_int = out.max_tau_int.max(m.tau_int);
-            parts.push(m);
             prop += r.proposed;
             acc += r.accepted;
         }
@@ -1214,6 +1232,69 @@ pub fn force_estimates_diagnosed(
 mod tests {
     use super::*;
     use crate::spectral::membrane::MembraneParams;
+
+    /// Issue #30 (fig2-paper-2d at seed 65): a strain where one trajectory's series is too
+    /// short for its own autocorrelation window takes the time pooled over the strain's
+    /// trajectories, for every trajectory of it; a strain whose windows all exist is
+    /// estimated exactly as before (bit for bit).
+    #[test]
+    fn a_series_too_short_for_its_window_takes_the_pooled_time() {
+        // AR(1) series of 400 samples, ρ = 0.95 (τ_int = 19.5 samples, the window needs
+        // M ≥ 6τ ≈ 117 of at most n/2 = 200, which a noisy ρ̂ of one series can miss):
+        // seven whose own windows exist, and the first seed whose own window fails.
+        let ar1 = |n: usize, seed: u64| {
+            let mut rng = crate::rng::trajectory_rng(seed, 0);
+            let mut x = 0.0;
+            (0..n)
+                .map(|_| {
+                    let z: f64 =
+                        rand_distr::Distribution::sample(&rand_distr::StandardNormal, &mut rng);
+                    x = 0.95 * x + z;
+                    1.0 + 0.01 * x
+                })
+                .collect::<Vec<f64>>()
+        };
+        let all: Vec<Vec<f64>> = (1..400).map(|seed| ar1(400, seed)).collect();
+        let long: Vec<Vec<f64>> = all
+            .iter()
+            .filter(|x| stats::mean_with_error(x).is_ok())
+            .take(7)
+            .cloned()
+            .collect();
+        let drift = all
+            .iter()
+            .find(|x| stats::mean_with_error(x).is_err())
+            .expect("a series without its own window")
+            .clone();
+        let rec = |force_ratio: Vec<f64>| ForceRecord {
+            force_ratio,
+            ..ForceRecord::default()
+        };
+        let good: Vec<ForceRecord> = long.iter().cloned().map(rec).collect();
+        let mut short = good.clone();
+        short.push(rec(drift.clone()));
+        let e = force_estimates(&[good.clone(), short]).expect("pooled fallback");
+        let own: Vec<_> = long
+            .iter()
+            .map(|x| stats::mean_with_error(x).unwrap())
+            .collect();
+        assert_eq!(e.force[0], stats::combine_independent(&own));
+        let series: Vec<&[f64]> = long
+            .iter()
+            .map(Vec::as_slice)
+            .chain([drift.as_slice()])
+            .collect();
+        let tau = stats::pooled_integrated_autocorrelation_time(&series)
+            .unwrap()
+            .tau_int;
+        let pooled: Vec<_> = series
+            .iter()
+            .map(|x| stats::mean_with_error_at(x, tau))
+            .collect();
+        assert_eq!(e.force[1], stats::combine_independent(&pooled));
+        // Nothing to pool from: the error stands.
+        assert!(force_estimates(&[vec![rec(drift)]]).is_err());
+    }
 
     /// A compression scene carrying a membrane is the membrane under imposed projected
     /// area: without `compression.area_modulus` (refused by validation in a file,

@@ -51,8 +51,8 @@ pub use hypothesis::{
 };
 pub use moments::{
     IatEstimate, MeanEstimate, blocking_std_error, combine_independent, ensemble_mean,
-    integrated_autocorrelation_time, mean_with_error, pooled_integrated_autocorrelation_time,
-    variance_with_error,
+    integrated_autocorrelation_time, mean_with_error, mean_with_error_at,
+    pooled_integrated_autocorrelation_time, variance_with_error,
 };
 pub use quadform::{Ar1SquareSum, ar1_square_sum_test};
 pub use spectrum::{

@@ -206,16 +206,24 @@ fn pooled_window(series: &[&[f64]]) -> Result<(f64, usize)> {
 /// As [`integrated_autocorrelation_time`].
 pub fn mean_with_error(x: &[f64]) -> Result<MeanEstimate> {
     let iat = integrated_autocorrelation_time(x)?;
+    Ok(mean_with_error_at(x, iat.tau_int))
+}
+
+/// [`mean_with_error`] with the integrated autocorrelation time `tau_int` given (e.g.
+/// estimated from several series of one process, [`pooled_integrated_autocorrelation_time`],
+/// when one series is too short for its own window): SE² = 2τ_int s²/n. `x` holds at
+/// least 2 samples.
+pub fn mean_with_error_at(x: &[f64], tau_int: f64) -> MeanEstimate {
     let n = x.len();
     let mean = mean_of(x);
     let s2 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
-    Ok(MeanEstimate {
+    MeanEstimate {
         mean,
-        std_error: (2.0 * iat.tau_int * s2 / n as f64).sqrt(),
-        tau_int: iat.tau_int,
+        std_error: (2.0 * tau_int * s2 / n as f64).sqrt(),
+        tau_int,
         n,
-        n_eff: n as f64 / (2.0 * iat.tau_int),
-    })
+        n_eff: n as f64 / (2.0 * tau_int),
+    }
 }
 
 /// Variance of a (possibly autocorrelated) stationary series with its standard error.

@@ -499,11 +499,29 @@ fn force_distribution_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult
     let name = &x.run.spec.name;
     for (i, dist) in x.theory.distributions.iter().enumerate() {
         let Some(dist) = dist else { continue };
-        // Thin each trajectory's series to effectively independent samples.
+        // Thin each trajectory's series to effectively independent samples (the time
+        // pooled over the strain's trajectories where one is too short for its own
+        // window, as in force_estimates).
         let mut samples = Vec::new();
         let mut stride = 1;
-        for r in &x.records[i] {
-            let tau = stats::integrated_autocorrelation_time(&r.force_ratio)?.tau_int;
+        let own: Result<Vec<f64>> = x.records[i]
+            .iter()
+            .map(|r| Ok(stats::integrated_autocorrelation_time(&r.force_ratio)?.tau_int))
+            .collect();
+        let taus = match own {
+            Ok(t) => t,
+            Err(e) => {
+                let series: Vec<&[f64]> = x.records[i]
+                    .iter()
+                    .map(|r| r.force_ratio.as_slice())
+                    .collect();
+                let tau = stats::pooled_integrated_autocorrelation_time(&series)
+                    .map_err(|_| e)?
+                    .tau_int;
+                vec![tau]
+            }
+        };
+        for tau in taus {
             stride = stride.max((KS_THINNING_TAU * tau).ceil() as usize);
         }
         for r in &x.records[i] {
