@@ -627,3 +627,86 @@ fn invalid_inputs_are_errors() {
     p.kt = f64::NAN;
     assert!(BeamModel::new(p, Mesh::uniform(2.0, 4).unwrap()).is_err());
 }
+
+/// Issue #31: the finite-difference (bead-spring) chain as a run's model, through the same
+/// pipeline as the elements: its exact discrete references are the closed forms of the
+/// 5-point stencil — per mode the continuum variance times (x/sin x)⁴, x = nπh/(2L)
+/// (exact-modal), over 1 − λΔt/2 under explicit Euler–Maruyama, with the multiplier
+/// 1 − λΔt — and its profile at a node is the sum over its N − 1 sine modes, within
+/// O(h²) of the continuum's kT x²(L−x)²/(3EI·L).
+#[test]
+fn chain_references_are_the_stencil_closed_forms() {
+    use langevin_fem::scene::linear::LinearRun;
+    use langevin_fem::scene::{MeshScheme, Scene};
+    let mut scene =
+        Scene::load(std::path::Path::new("verification/hinged-linear-2d.toml")).unwrap();
+    scene.mesh.scheme = MeshScheme::Chain;
+    scene.mesh.elements = 10;
+    let p = scene.filament;
+    let h = p.length / 10.0;
+    let tau1 = scene.tau1();
+    let rate = |n: usize| {
+        let s = (n as f64 * PI * h / (2.0 * p.length)).sin();
+        p.bending_rigidity * (4.0 * s * s / (h * h)).powi(2) / p.drag
+    };
+    for (integrator, dt_tau1) in [("exact-modal", 1e-3), ("euler-maruyama", 1e-4)] {
+        let spec = scene
+            .runs
+            .iter()
+            .find(|r| r.integrator.to_string() == integrator)
+            .cloned()
+            .map(|mut r| {
+                r.dt_tau1 = dt_tau1;
+                r
+            })
+            .unwrap_or_else(|| panic!("a {integrator} run"));
+        let run = LinearRun::prepare(&scene, &spec).unwrap();
+        let dt = dt_tau1 * tau1;
+        for m in &run.reference.modes {
+            let n = m.n;
+            let x = n as f64 * PI * h / (2.0 * p.length);
+            let em = if integrator == "euler-maruyama" {
+                1.0 / (1.0 - 0.5 * rate(n) * dt)
+            } else {
+                1.0
+            };
+            let want = (x / x.sin()).powi(4) * em;
+            let got = m.variance_discrete / m.variance_continuum;
+            assert!(
+                (got / want - 1.0).abs() < 1e-9,
+                "{integrator} mode {n}: {got} vs {want}"
+            );
+            let mult = if integrator == "euler-maruyama" {
+                1.0 - rate(n) * dt
+            } else {
+                (-rate(n) * dt).exp()
+            };
+            assert!(
+                (m.multiplier / mult - 1.0).abs() < 1e-9,
+                "{integrator} mode {n}"
+            );
+        }
+        // The profile at the mid node: Σ_n (2kT/(ξLλ_n)) sin²(nπ/2) over the chain's modes.
+        let i = run
+            .reference
+            .profile_x
+            .iter()
+            .position(|&x| x == 0.5)
+            .unwrap();
+        if integrator == "exact-modal" {
+            let sum: f64 = (1..10)
+                .map(|n| {
+                    2.0 * p.kt / (p.drag * p.length * rate(n)) * (n as f64 * PI / 2.0).sin().powi(2)
+                })
+                .sum();
+            let got = run.reference.profile_discrete[i];
+            assert!((got / sum - 1.0).abs() < 1e-9, "profile {got} vs {sum}");
+            let cont = p.kt * 0.0625 / (3.0 * p.bending_rigidity * p.length);
+            // O(h²): +2.0 % on 10 intervals (by the sum above).
+            assert!(
+                (got / cont - 1.0 - 0.02).abs() < 1e-9,
+                "{got} vs continuum {cont}"
+            );
+        }
+    }
+}

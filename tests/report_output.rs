@@ -298,6 +298,7 @@ fn sample_summary() -> Summary {
                     check("mode-variance/n=1", true, Some(0.42)),
                     check("energy/equipartition", true, None),
                 ],
+                detectable: vec![],
             },
             SceneSummary {
                 name: "pinned".to_string(),
@@ -313,6 +314,7 @@ fn sample_summary() -> Summary {
                     check("msd/<script>alert(1)</script>", true, Some(0.3)),
                     check("msd/late-time", false, Some(1.234_567e-9)),
                 ],
+                detectable: vec![],
             },
         ],
         files: vec![

@@ -840,3 +840,87 @@ fn free_filament_data_carry_rigid_and_tangent_angle_columns() {
     let err = stderr_of(&o);
     assert!(err.contains("runs[0].rigid"), "{err}");
 }
+
+/// Issue #31: `fit` on `run` output returns EI, ξ and kT with intervals that cover the
+/// truth (the sidecar's 1, 1, 1), prints them and writes fit.json beside the report of
+/// `check`; on data whose variances are scaled by 1.1 (a noise amplitude error), kT with
+/// EI known is 1.1 within its interval and the interval excludes 1. A pass says where
+/// the data could have missed an error: every passing run prints its detectable
+/// deviation. `fit` of compression data is refused (exit 2).
+#[test]
+fn fit_recovers_the_parameters_with_intervals() {
+    let dir = TempDir::new("run-check-fit");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let fit = |data: &str, out: &str| {
+        let args = [
+            "fit",
+            "--scene",
+            "hinged-linear-2d",
+            "--data",
+            data,
+            "--out",
+            out,
+        ];
+        let o = run(&args);
+        let d = describe(&args, &o);
+        (o, d)
+    };
+    let out = dir.join_str("fit");
+    let (o, d) = fit(&data, &out);
+    assert_eq!(o.status.code(), Some(0), "{d}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("fit crank-nicolson (95 % intervals):"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("    crank-nicolson: passed; would have caught a variance error ≥ "),
+        "{stdout}"
+    );
+    let f = json(&Path::new(&out).join("fit.json"));
+    let run0 = &f["runs"][0];
+    for key in ["bending_rigidity", "drag", "kt_given_bending_rigidity"] {
+        let i = &run0[key]["interval"];
+        let (lo, hi) = (i[0].as_f64().unwrap(), i[1].as_f64().unwrap());
+        assert!(
+            lo <= 1.0 && 1.0 <= hi && hi / lo < 1.1,
+            "{key}: [{lo}, {hi}]"
+        );
+    }
+    let s = json(&Path::new(&out).join("summary.json"));
+    let notes = common::strings(&s["scenes"][0]["notes"]);
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.starts_with("fit, run crank-nicolson"))
+    );
+
+    let side = json(&Path::new(&data).join("data.json"));
+    scale_columns(&data, &side, |h| h.starts_with("aw_"), 1.1f64.sqrt());
+    let out = dir.join_str("fit-noise");
+    let (o, d) = fit(&data, &out);
+    assert_eq!(o.status.code(), Some(0), "{d}");
+    let f = json(&Path::new(&out).join("fit.json"));
+    let kt = &f["runs"][0]["kt_given_bending_rigidity"];
+    let (lo, hi) = (
+        kt["interval"][0].as_f64().unwrap(),
+        kt["interval"][1].as_f64().unwrap(),
+    );
+    assert!(
+        lo > 1.0 && lo <= 1.1 && 1.1 <= hi,
+        "kT interval [{lo}, {hi}]"
+    );
+
+    let args = [
+        "fit",
+        "--scene",
+        "compression-2d",
+        "--data",
+        &data,
+        "--out",
+        &dir.join_str("c"),
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+}

@@ -5,9 +5,11 @@ use super::Verbosity;
 use super::terminal::{print_scenes, totals_line};
 use clap::Args;
 use langevin_fem::error::{Error, Result};
+use langevin_fem::output::ReportRun;
 use langevin_fem::report::write_report;
+use langevin_fem::scene::Scene;
 use langevin_fem::verify::check_data;
-use langevin_fem::verify::summary::Totals;
+use langevin_fem::verify::summary::{Summary, Totals};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -34,7 +36,7 @@ pub struct CheckArgs {
     /// Data directory: data.json (the sidecar) and the trajectory files it lists, as
     /// `langevin-fem run` writes them (see the guide, docs/src/reference/data-format.md).
     #[arg(short, long, value_name = "DIR")]
-    data: PathBuf,
+    pub(super) data: PathBuf,
     /// Output directory for summary.json, index.html and per-run tables and figures.
     #[arg(short, long, default_value = "check-report")]
     pub(super) out: PathBuf,
@@ -55,6 +57,46 @@ pub struct CheckArgs {
 /// and the totals on stdout at `verbosity` ([`super::terminal`]).
 pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
+    let (_, summary, report) = evaluate(&args)?;
+    write_report(report, &summary)?;
+    print_verdict(&args, &summary, verbosity, start, &[]);
+    Ok(if summary.passed { 0 } else { 1 })
+}
+
+/// The scenes, `extra` lines, the verdict line and the totals of `check` on stdout at
+/// `verbosity`.
+pub(super) fn print_verdict(
+    args: &CheckArgs,
+    summary: &Summary,
+    verbosity: Verbosity,
+    start: Instant,
+    extra: &[String],
+) {
+    print_scenes(summary, verbosity, false, true);
+    for line in extra {
+        println!("{line}");
+    }
+    if verbosity != Verbosity::Quiet {
+        println!(
+            "{} (data {}, family-wise alpha {}, Holm); report: {}",
+            if summary.passed { "PASSED" } else { "FAILED" },
+            args.data.display(),
+            summary.alpha,
+            args.out.join("index.html").display()
+        );
+    }
+    println!(
+        "{}",
+        totals_line(&Totals::of(&summary.scenes), start.elapsed().as_secs_f64())
+    );
+}
+
+/// The checks of `args`: the scene, the summary and the report (its files written, its
+/// index and summary not yet).
+///
+/// # Errors
+/// Invalid flags, scene or data; the checks' errors.
+pub(super) fn evaluate(args: &CheckArgs) -> Result<(Scene, Summary, ReportRun)> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -74,20 +116,5 @@ pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
         args.alpha,
         super::gib_bytes(args.max_memory_gib),
     )?;
-    write_report(report, &summary)?;
-    print_scenes(&summary, verbosity, false);
-    if verbosity != Verbosity::Quiet {
-        println!(
-            "{} (data {}, family-wise alpha {}, Holm); report: {}",
-            if summary.passed { "PASSED" } else { "FAILED" },
-            args.data.display(),
-            summary.alpha,
-            args.out.join("index.html").display()
-        );
-    }
-    println!(
-        "{}",
-        totals_line(&Totals::of(&summary.scenes), start.elapsed().as_secs_f64())
-    );
-    Ok(if summary.passed { 0 } else { 1 })
+    Ok((scene, summary, report))
 }

@@ -3,6 +3,7 @@
 mod calibrate;
 mod check;
 mod converge;
+mod fit;
 mod list;
 mod merge;
 #[cfg(feature = "faults")]
@@ -112,6 +113,9 @@ enum Command {
     /// Apply a scene's statistical checks to trajectories written by any simulator in
     /// the trajectory data format (the format `run` writes).
     Check(check::CheckArgs),
+    /// The bending rigidity (from the mode variances) and the drag (from the decay rates)
+    /// that a filament's data imply, with 95 % intervals, beside the report of `check`.
+    Fit(fit::FitArgs),
     /// List the scenes: the built-in ones, and with --scene-dir the files there.
     List(list::ListArgs),
     /// Inspect a scene.
@@ -188,6 +192,10 @@ pub fn run() -> Result<i32> {
         Command::Check(args) => {
             check_out_dir(&args.out, report("check", false))?;
             check::run(args, v)
+        }
+        Command::Fit(args) => {
+            check_out_dir(&args.check.out, report("check", false))?;
+            fit::run(args, v)
         }
         Command::List(args) => list::run(args),
         Command::Scene(args) => scene::run(args),

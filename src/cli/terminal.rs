@@ -9,7 +9,10 @@
 //!   ratios show a pattern ([`diagnosis::run_hints`]), the verdict with the report's
 //!   path, then the totals line;
 //! - verbose: also, per failed check, its test, statistic, p-values and estimate
-//!   against the reference, per skipped check the reason, and the seed of each scene.
+//!   against the reference, per skipped check the reason, and the seed of each scene;
+//! - per run without a failed check, the smallest relative error of each observable it
+//!   would have caught with 80 % power ([`diagnosis::detectable_deviations`]): `check`
+//!   at normal verbosity, `verify` at verbose.
 //!
 //! The last line of stdout is always `N passed, N failed, N skipped in T s` (checks
 //! summed over the scenes; T the command's wall time), for a person and for a script.
@@ -72,8 +75,10 @@ fn failed_name(c: &CheckResult) -> String {
 }
 
 /// Prints the scenes of `summary` at `verbosity`: failures and per-scene lines on
-/// stdout, warnings on stderr (`wall`: print each scene's wall time).
-pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
+/// stdout, warnings on stderr (`wall`: print each scene's wall time; `detectable`: at
+/// normal verbosity too, per run without a failed check, the smallest errors it would
+/// have caught — `check`'s default; `verify` prints them with `--verbose`).
+pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool, detectable: bool) {
     for s in &summary.scenes {
         let t = Totals::of([s]);
         if verbosity != Verbosity::Quiet {
@@ -104,6 +109,14 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool) {
         if verbosity != Verbosity::Quiet {
             for (run, hint) in diagnosis::run_hints(s) {
                 println!("    {run}: {}", hint.text);
+            }
+        }
+        if verbosity == Verbosity::Verbose || (detectable && verbosity == Verbosity::Normal) {
+            for (run, text) in diagnosis::detectable_lines(&s.detectable) {
+                if s.checks.iter().any(|c| c.run == run && !c.passed) {
+                    continue;
+                }
+                println!("    {run}: passed; {text}");
             }
         }
         if verbosity == Verbosity::Verbose {
@@ -165,6 +178,7 @@ mod tests {
                 })
                 .collect(),
             checks,
+            detectable: vec![],
         }
     }
 

@@ -157,7 +157,7 @@ pub(super) fn finish(
         scene.notes.push(note);
     }
     write_report(report, &summary)?;
-    print_scenes(&summary, verbosity, true);
+    print_scenes(&summary, verbosity, true, false);
     if verbosity != Verbosity::Quiet {
         println!(
             "{} (budget {}, family-wise alpha {} per scene, Holm); report: {} (run {})",

@@ -40,11 +40,13 @@
 //!   are ignored), or NumPy `.npy` (little-endian float64, C order, shape (rows,
 //!   columns), the columns in the order above).
 //! - `discretization` (optional): what produced the data. When it is one this tool
-//!   models (`model = "fem"` with `elements`, `integrator`, `noise` and the time step
-//!   `dt`, or `"spectral"`), the checks compare with that discretization's exact
-//!   reference and state its expected deficit against the continuum; otherwise with the
-//!   continuum, and the producer's discretization and time-step errors are part of what
-//!   is checked. For `fem` and `spectral`, `elements` must be in [1, 1000] (as
+//!   models (`model = "fem"`, `"finite-difference"` or `"bead-spring"` — a chain of
+//!   `elements` intervals, [`crate::fem::chain`] — with `elements`, `integrator`, `noise`
+//!   and the time step `dt`, or `"spectral"`), the checks compare with that
+//!   discretization's exact reference and state its expected difference from the
+//!   continuum; otherwise with the continuum, labelled so, and the producer's
+//!   discretization and time-step errors are part of what is checked. For the modelled
+//!   ones, `elements` must be in [1, 1000] ([2, 1000] for a chain; as
 //!   `mesh.elements` in scene files), `integrator` and `noise` names as in scene files,
 //!   and `dt` at most 100 τ₁ (as `dt_tau1` in scene files) and at least `dt_sample`/1e10
 //!   (at most 1e10 steps per row); for another model they are only reported.
@@ -440,10 +442,13 @@ impl DataRun {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Discretization {
-    /// `fem` (this tool's Hermite-cubic elements), `spectral` (exact modal), or any other
-    /// name (then only reported).
+    /// `fem` (this tool's Hermite-cubic elements), `spectral` (exact modal),
+    /// `finite-difference` (the 5-point filament on its nodes) or `bead-spring` (the
+    /// linearized discrete worm-like chain; [`crate::fem::chain`]), or any other name
+    /// (then only reported).
     pub model: String,
-    /// Elements (`fem`) or modes carried (`spectral`); of a membrane, along x.
+    /// Elements (`fem`), modes carried (`spectral`) or intervals — bonds of a
+    /// bead-spring chain — (`finite-difference`, `bead-spring`); of a membrane, along x.
     #[serde(default)]
     pub elements: Option<usize>,
     /// Membrane data: elements (`fem`) or mode indices (`spectral`) along y (left out:
@@ -470,11 +475,17 @@ pub const MAX_STEPS_PER_ROW: f64 = 1e10;
 pub const MAX_DT_TAU1: f64 = 100.0;
 
 impl Discretization {
-    /// Whether this tool models the discretization (`fem` or `spectral`): its
-    /// `elements`, `integrator`, `noise` and `dt` then size the reference `check`
-    /// builds, and are bounded.
+    /// Whether this tool models the discretization (`fem`, `spectral`,
+    /// `finite-difference` or `bead-spring`): its `elements`, `integrator`, `noise` and
+    /// `dt` then size the reference `check` builds, and are bounded.
     pub fn is_modelled(&self) -> bool {
-        matches!(self.model.as_str(), "fem" | "spectral")
+        matches!(self.model.as_str(), "fem" | "spectral") || self.is_chain()
+    }
+
+    /// Whether the discretization is a chain of nodes (`finite-difference` or
+    /// `bead-spring`: [`crate::fem::ChainModel`], at least 2 intervals).
+    pub fn is_chain(&self) -> bool {
+        matches!(self.model.as_str(), "finite-difference" | "bead-spring")
     }
 
     /// The integrator (default `exact-modal`), if its name is one of the scene files'.
@@ -509,14 +520,20 @@ impl Discretization {
         if !self.is_modelled() {
             return Ok(());
         }
+        let least = if self.is_chain() { 2 } else { 1 };
         for (name, count) in [("elements", self.elements), ("elements_y", self.elements_y)] {
             if let Some(e) = count
-                && !(1..=MAX_ELEMENTS).contains(&e)
+                && !(least..=MAX_ELEMENTS).contains(&e)
             {
                 return Err((
                     key(name),
                     format!(
-                        "must be in [1, {MAX_ELEMENTS}] (as mesh.{name} in scene files) for model {:?}, got {e}",
+                        "must be in [{least}, {MAX_ELEMENTS}] (as mesh.{name} in scene files{}) for model {:?}, got {e}",
+                        if self.is_chain() {
+                            "; intervals of the chain, at least one interior node"
+                        } else {
+                            ""
+                        },
                         self.model
                     ),
                 ));

@@ -10,6 +10,8 @@
 //! - [`system`]: the [`LinearSystem`] `C ẋ = −Kx + F` every object assembles to, with the
 //!   element loads of eq. (5).
 //! - [`beam`]: the assembled linear beam [`BeamModel`] and its stiffest rate `λ_max`.
+//! - [`chain`]: the filament as a chain of nodes ([`ChainModel`]): the 5-point
+//!   finite-difference filament and the linearized bead-spring chain (issue #31).
 //! - [`plate`]: the Helfrich membrane `ξ ∂h/∂t = −κ∇⁴h + σ∇²h + f` on Bogner–Fox–Schmit
 //!   rectangles ([`PlateModel`]), simply supported or periodic, and its `λ_max`.
 //! - [`plate_modes`]: the separable modes of the uniform plate ([`PlateModes`]): `K`, `C`
@@ -30,6 +32,7 @@
 pub mod area;
 pub mod banded;
 pub mod beam;
+pub mod chain;
 pub mod hermite;
 pub mod mesh;
 pub mod modal;
@@ -44,6 +47,7 @@ pub mod vonkarman;
 pub use area::AreaMembrane;
 pub use banded::{BandedCholesky, SymBanded};
 pub use beam::{BeamModel, UNIFORM_RATE_FACTOR};
+pub use chain::ChainModel;
 pub use mesh::Mesh;
 pub use modal::{
     GeneralizedModes, continuous_stationary_covariance, discrete_stationary_covariance,

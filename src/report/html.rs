@@ -524,11 +524,20 @@ fn check_row(h: &mut String, scene: Option<(usize, &str)>, c: &CheckResult) {
         (Some(e), Some(se)) => format!("{} ± {}", fmt4(Some(e)), fmt4(Some(se))),
         (e, _) => fmt4(e),
     };
+    // A reference that is the continuum's says so in its cell (issue #31).
+    let reference = if c.reference_kind == "continuum" && c.reference.is_some() {
+        format!(
+            "{} <span class=\"kind\" title=\"the continuum's value, not a discretization's\">(continuum)</span>",
+            fmt4(c.reference)
+        )
+    } else {
+        fmt4(c.reference)
+    };
     let _ = writeln!(
         h,
         "<td>{}</td><td title=\"{}\">{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>\
          <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
-         <td class=\"num\">{estimate}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
+         <td class=\"num\">{estimate}</td><td class=\"num\">{reference}</td><td class=\"num\">{}</td>\
          <td>{}</td><td class=\"{class}\">{verdict}</td></tr>\n<tr class=\"{class} detail\">\
          <td colspan=\"{}\" class=\"detail\">{}</td></tr>",
         esc(if c.run.is_empty() { "(scene)" } else { &c.run }),
@@ -540,7 +549,6 @@ fn check_row(h: &mut String, scene: Option<(usize, &str)>, c: &CheckResult) {
         fmt_dof(c.dof),
         fmt4(c.p_value),
         fmt4(c.p_adjusted),
-        fmt4(c.reference),
         fmt4(c.continuum),
         esc(&c.unit),
         if scene.is_some() { 14 } else { 13 },
@@ -574,7 +582,10 @@ fn reading_guide(h: &mut String, summary: &Summary) {
          (autocorrelation-aware); <b>Reference</b>: the exact value for the discretized \
          filament and integrator (for an oracle check, the closed form it is held to); \
          <b>Continuum</b>: the exact value of the continuum model (eqs. 2–4); the gap \
-         between them is the discretization error. <b>Unit</b>: the unit of those three, in \
+         between them is the discretization error. A reference marked <i>(continuum)</i> is \
+         the continuum's own value (data whose discretization this tool does not model, whose \
+         mesh and time-step errors are then part of what is checked; an oracle's closed \
+         form). <b>Unit</b>: the unit of those three, in \
          the scene's units ([L] length, [T] time; F_c0 the Euler load; 1 dimensionless); \
          empty for a test whose result is its statistic.</li>\
          <li><b>Skipped</b>: a check the scene asks for that the data at this budget cannot \

@@ -18,11 +18,12 @@ use crate::dynamics::{
 use crate::error::{Error, Result};
 use crate::fem::banded::LANES;
 use crate::fem::beam::BeamModel;
+use crate::fem::chain::ChainModel;
 use crate::fem::modal::GeneralizedModes;
 use crate::fem::noise::NoiseModel;
 use crate::params::End;
 use crate::rng::{TrajectoryRng, trajectory_rng};
-use crate::scene::{CheckKind, ModelKind, RunSpec, Scene};
+use crate::scene::{CheckKind, MeshScheme, ModelKind, RunSpec, Scene};
 use crate::spectral::HingedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode, MembraneSimulator};
 use crate::spectral::simulator::ModalSimulator;
@@ -1053,7 +1054,7 @@ impl Setup<'_> {
         // (‖φ‖² = A/4 or A/2, (M3); signs free).
         let rigid = match &object {
             FemObject::Beam(beam) => rigid_references(beam, spec.noise, spec.integrator)?,
-            FemObject::Plate { .. } => Vec::new(),
+            FemObject::Chain(_) | FemObject::Plate { .. } => Vec::new(),
         };
         let (tangent, tangent_rows) = match object.beam() {
             Some(beam) if spec.checks(self.scene).contains(&CheckKind::TangentAngle) => {
@@ -1065,6 +1066,10 @@ impl Setup<'_> {
             // Other ends: the modes are signed by their continuum mode already
             // (generalized_modes), whose normalization ∫φ² = L/2 is the sine's.
             FemObject::Beam(b) if !b.ends().is_hinged() => {
+                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
+            }
+            // The chain's modes are signed by their sine already (ChainModel::modes).
+            FemObject::Chain(_) => {
                 vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
             }
             FemObject::Beam(_) => {
@@ -1110,6 +1115,9 @@ impl Setup<'_> {
     fn fem_object(&self) -> Result<FemObject> {
         let p = self.scene.filament;
         Ok(match &self.continuum {
+            Continuum::Filament(_) if self.scene.mesh.scheme == MeshScheme::Chain => {
+                FemObject::Chain(Box::new(ChainModel::new(p, self.scene.mesh.elements)?))
+            }
             Continuum::Filament(_) => {
                 let beam =
                     BeamModel::with_ends(p, self.scene.mesh.build(p.length)?, self.scene.ends)?;

@@ -29,6 +29,6 @@ pub mod validate;
 
 pub use builtin::{BUILTIN, BuiltinScene, SceneSource, load_scene, load_scenes, resolve_scenes};
 pub use spec::{
-    Budget, CheckKind, CompressionSpec, Ensemble, MeshSpec, ModelKind, PrecisionTarget, RunSpec,
-    Sampling, Scene, StepSearch,
+    Budget, CheckKind, CompressionSpec, Ensemble, MeshScheme, MeshSpec, ModelKind, PrecisionTarget,
+    RunSpec, Sampling, Scene, StepSearch,
 };

@@ -372,6 +372,22 @@ pub struct MeshSpec {
     /// Ratio of the last to the first element length (geometric grading); 1 is uniform.
     #[serde(default = "one")]
     pub grading: f64,
+    /// How a filament's `fem` model is discretized (not in scene files): Hermite-cubic
+    /// elements, or a chain of nodes when `check` models another program's declared
+    /// finite-difference or bead-spring discretization (issue #31).
+    #[serde(skip)]
+    pub scheme: MeshScheme,
+}
+
+/// The discretization of a filament's `fem` model ([`MeshSpec::scheme`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MeshScheme {
+    /// Hermite-cubic beam elements ([`crate::fem::BeamModel`]).
+    #[default]
+    Hermite,
+    /// A chain of `elements` intervals ([`crate::fem::ChainModel`]): the 5-point
+    /// finite-difference filament, or the linearized bead-spring chain; hinged ends.
+    Chain,
 }
 
 fn one() -> f64 {

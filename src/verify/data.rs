@@ -31,7 +31,7 @@ use crate::scene::linear::{
     Continuum, LinearReference, LinearRun, ModeReference, RigidReference, TangentReference,
     TrajectoryRecord, TwoTimeReference, rigid_coordinates,
 };
-use crate::scene::{CheckKind, CompressionSpec, ModelKind, RunSpec, Scene};
+use crate::scene::{CheckKind, CompressionSpec, MeshScheme, ModelKind, RunSpec, Scene};
 use crate::stats::moments::MIN_SERIES_LEN;
 use std::path::Path;
 
@@ -421,7 +421,7 @@ fn mode_references(
             .map(|m| format!("{:+.2e}", m.variance_discrete / m.variance_continuum - 1.0))
             .collect();
         notes.push(format!(
-            "run {}: references of the producer's discretization (exact, discrete); expected deficit of its mode variances (mesh, noise, integrator and step) against the continuum, discrete/continuum - 1, modes 1..{n_modes}: {}",
+            "run {}: references of the producer's discretization (exact, discrete); expected difference of its mode variances (mesh, noise, integrator and step) from the continuum, discrete/continuum - 1, modes 1..{n_modes}: {}",
             data.name,
             deficits.join(", ")
         ));
@@ -941,13 +941,21 @@ fn discrete_run(
     let Some(d) = &data.discretization else {
         return Ok(None);
     };
-    let model = match d.model.as_str() {
-        "fem" => ModelKind::Fem,
-        "spectral" => ModelKind::Spectral,
+    let (model, scheme) = match d.model.as_str() {
+        "fem" => (ModelKind::Fem, MeshScheme::Hermite),
+        "spectral" => (ModelKind::Spectral, MeshScheme::Hermite),
+        _ if d.is_chain() && !scene.is_membrane() && scene.ends.is_hinged() => {
+            (ModelKind::Fem, MeshScheme::Chain)
+        }
         other => {
             notes.push(format!(
-                "run {}: the producer's discretization ({other}) is not one this tool models",
-                data.name
+                "run {}: the producer's discretization ({other}) is not one this tool models{}",
+                data.name,
+                if d.is_chain() {
+                    " for this object (a chain of nodes is modelled for a filament with hinged ends)"
+                } else {
+                    ""
+                }
             ));
             return Ok(None);
         }
@@ -977,9 +985,10 @@ fn discrete_run(
     let noise = d
         .noise_model()
         .ok_or_else(|| unknown("discretization.noise"))?;
-    fits(scene, data, (model, elements, dt / tau1)).map_err(|(key, m)| key_err(key, m))?;
+    fits(scene, data, (model, scheme, elements, dt / tau1)).map_err(|(key, m)| key_err(key, m))?;
     let mut scene = scene.clone();
     scene.model = model;
+    scene.mesh.scheme = scheme;
     scene.mesh.elements = elements;
     scene.mesh.elements_y = d.elements_y.filter(|_| scene.is_membrane());
     scene.mesh.grading = 1.0;
@@ -999,19 +1008,19 @@ fn discrete_run(
         })
 }
 
-/// Whether the modelled discretization `(model, elements, dt/τ₁)` of data run `data`
+/// Whether the modelled discretization `(model, scheme, elements, dt/τ₁)` of data run `data`
 /// can serve `scene`: it carries at least the modes the scene checks, and (from rest)
 /// puts every two-time point of the scene at most 1e10 steps from rest; on failure the
 /// key under `runs[k]` and the message.
 fn fits(
     scene: &Scene,
     data: &DataRun,
-    (model, elements, dt_tau1): (ModelKind, usize, f64),
+    (model, scheme, elements, dt_tau1): (ModelKind, MeshScheme, usize, f64),
 ) -> std::result::Result<(), (&'static str, String)> {
-    let carried = if model == ModelKind::Fem {
-        2 * elements
-    } else {
-        elements
+    let carried = match (model, scheme) {
+        (ModelKind::Fem, MeshScheme::Chain) => elements - 1,
+        (ModelKind::Fem, MeshScheme::Hermite) => 2 * elements,
+        _ => elements,
     };
     // A membrane's plate refuses, when prepared, a checked mode its mesh does not resolve.
     if carried < scene.sampling.modes && !scene.is_membrane() {
@@ -1019,10 +1028,10 @@ fn fits(
             "discretization.elements",
             format!(
                 "is {elements} (model {}): it carries {carried} modes, fewer than the {} modes scene {} checks (sampling.modes): check the data with a scene of at most {carried} modes, or leave the discretization out to be judged against the continuum",
-                if model == ModelKind::Fem {
-                    "fem"
-                } else {
-                    "spectral"
+                match (model, scheme) {
+                    (ModelKind::Fem, MeshScheme::Chain) => "finite-difference or bead-spring",
+                    (ModelKind::Fem, MeshScheme::Hermite) => "fem",
+                    _ => "spectral",
                 },
                 scene.sampling.modes,
                 scene.name
@@ -1663,6 +1672,28 @@ mod tests {
                 "runs[0].discretization.integrator",
                 "metropolis-crank-nicolson",
             ],
+        );
+        // A chain of nodes (issue #31): N intervals carry N − 1 modes; one interval has
+        // no interior node (refused with the sidecar, naming the key and [2, 1000]).
+        for model in ["finite-difference", "bead-spring"] {
+            let side = with(model, 3, "euler-maruyama", dts / 10.0);
+            let dc = prepare_data_check(&s, &side, &dir, 0, CAP).expect(model);
+            assert!(!dc.continuum_references, "{model}");
+            let side = with(model, 2, "euler-maruyama", dts / 10.0);
+            refusal(
+                prepare_data_check(&s, &side, &dir, 0, CAP),
+                &["runs[0].discretization.elements", "carries 1 modes"],
+            );
+        }
+        let mut side = with("finite-difference", 2, "euler-maruyama", dts / 10.0);
+        side.runs[0].discretization.as_mut().unwrap().elements = Some(1);
+        let err = side
+            .validate(Path::new("data.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("runs[0].discretization.elements") && err.contains("[2, 1000]"),
+            "{err}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

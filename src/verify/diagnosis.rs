@@ -26,7 +26,8 @@
 //! These are thresholds for a hint, not tests: the checks themselves are the verdict.
 
 use crate::verify::summary::{CheckResult, SceneSummary};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal, StudentsT};
 
 /// Fewest modes in which a pattern is named.
 pub const MIN_MODES: usize = 3;
@@ -388,7 +389,7 @@ pub fn diagnose(variance: &[ModeRatio], rate: &[ModeRatio]) -> Option<Hint> {
 /// A `quadratic-form` check's standard error is the null one (from the reference, at
 /// ratio 1); the relative error of a variance is what stays fixed, so it is scaled by the
 /// ratio.
-fn mode_ratios(checks: &[CheckResult], run: &str, check: &str) -> Vec<ModeRatio> {
+pub(crate) fn mode_ratios(checks: &[CheckResult], run: &str, check: &str) -> Vec<ModeRatio> {
     checks
         .iter()
         .filter(|c| c.run == run && c.check == check)
@@ -428,9 +429,320 @@ pub fn run_hints(scene: &SceneSummary) -> Vec<(String, Hint)> {
         .collect()
 }
 
+/// The power at which [`detectable_deviations`] states the smallest detectable error.
+pub const POWER: f64 = 0.8;
+
+/// The checks a detectable deviation is stated for, with what an error of their
+/// observable is called: per-mode variance and decay rate, the profile's variance and a
+/// compression run's mean force.
+pub const DETECTABLE: [(&str, &str); 4] = [
+    ("mode-variance", "variance"),
+    ("decay-rate", "rate"),
+    ("profile", "profile variance"),
+    ("force", "mean force"),
+];
+
+/// The smallest relative error of one observable of one run that its checks would have
+/// detected at the scene's α with probability [`POWER`] (issue #31: what a pass could
+/// have missed).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Detectable {
+    /// The run.
+    pub run: String,
+    /// The observable, as [`DETECTABLE`] names it (`variance`, `rate`, …).
+    pub observable: String,
+    /// The smallest relative deviation |estimate/reference − 1| detected with
+    /// probability [`POWER`].
+    pub deviation: f64,
+    /// The check that would detect it (the run's most precise of the observable).
+    pub check: String,
+}
+
+/// The relative deviation one statistical check detects with probability [`POWER`] at
+/// the scene's family-wise level `alpha` over `family` checks: under Holm the first
+/// step, at α/m, is the strictest, so δ = (q(1 − α/(2m)) + q(POWER))·s.e./|reference|
+/// for a two-sided test whose statistic is normal — or Student's t of the check's
+/// degrees of freedom for a t-test — about (estimate − reference)/s.e. An upper bound
+/// for the check's own detection threshold (Holm's later steps are more lenient, and an
+/// error of one factor over modes moves every mode's check). `None` where the check has
+/// no ratio ([`ratio_of`]) or no standard error.
+pub fn detectable_deviation(c: &CheckResult, alpha: f64, family: usize) -> Option<f64> {
+    let (se, dof) = relative_error_and_dof(c)?;
+    Some(detectable_shift(alpha / family.max(1) as f64, dof)? * se)
+}
+
+/// A check's relative standard error s.e./|reference| (positive; [`ratio_of`]) and, for
+/// a t-test, its degrees of freedom.
+fn relative_error_and_dof(c: &CheckResult) -> Option<(f64, Option<f64>)> {
+    let (_, se) = ratio_of(c)?;
+    let se = se.filter(|s| s.is_finite() && *s > 0.0)?;
+    let dof = c
+        .dof
+        .filter(|d| c.kind.ends_with("t-test") && d.is_finite() && *d > 0.0);
+    Some((se, dof))
+}
+
+/// Points of the midpoint rule over the χ² law in [`detectable_shift`].
+const CHI_POINTS: usize = 2000;
+
+/// The shift λ of the mean of a two-sided test's statistic at which it rejects at
+/// level `level` with probability [`POWER`]: for a normal statistic
+/// λ = z(1 − level/2) + z(POWER) (exact but for the far tail, below 1e-9 here); for
+/// Student's t of `dof` degrees of freedom, the noncentrality of the noncentral t,
+/// T = (Z + λ)/S, S² = χ²_ν/ν, whose power
+/// P(λ) = E_S[Φ(λ − t_c S) + Φ(−λ − t_c S)], t_c = t_ν(1 − level/2), is averaged over S by
+/// the midpoint rule in probability ([`CHI_POINTS`] quantiles of χ²_ν) and solved for
+/// P(λ) = POWER by bisection. (The sum of the two t quantiles would understate λ: at
+/// ν = 7 its power is 0.74, not 0.8.) `None` for an invalid level or dof.
+pub fn detectable_shift(level: f64, dof: Option<f64>) -> Option<f64> {
+    if !(level > 0.0 && level < 1.0) {
+        return None;
+    }
+    let n = Normal::standard();
+    let Some(nu) = dof else {
+        return Some(n.inverse_cdf(1.0 - level / 2.0) + n.inverse_cdf(POWER));
+    };
+    let t = StudentsT::new(0.0, 1.0, nu).ok()?;
+    let tc = t.inverse_cdf(1.0 - level / 2.0);
+    let chi = ChiSquared::new(nu).ok()?;
+    let s: Vec<f64> = (0..CHI_POINTS)
+        .map(|k| (chi.inverse_cdf((k as f64 + 0.5) / CHI_POINTS as f64) / nu).sqrt())
+        .collect();
+    let power = |lam: f64| {
+        s.iter()
+            .map(|&s| n.cdf(lam - tc * s) + n.cdf(-lam - tc * s))
+            .sum::<f64>()
+            / CHI_POINTS as f64
+    };
+    let (mut lo, mut hi) = (0.0, tc + 10.0);
+    while power(hi) < POWER {
+        hi *= 2.0;
+        if hi > 1e6 {
+            return None;
+        }
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if power(mid) < POWER {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// Per run and observable of `scene` ([`DETECTABLE`]), the smallest relative error its
+/// checks would have detected at the family-wise level `alpha` with probability
+/// [`POWER`] ([`detectable_deviation`], the family being the scene's statistical
+/// checks), minimized over the observable's checks in the run (its modes, points or
+/// strains): a pass says "no error this large". Runs in the order of their first check.
+pub fn detectable_deviations(scene: &SceneSummary, alpha: f64) -> Vec<Detectable> {
+    let family = scene.checks.iter().filter(|c| c.p_value.is_some()).count();
+    // The shift depends on the test's dof only: one solve per dof.
+    let mut shifts: Vec<(Option<u64>, Option<f64>)> = Vec::new();
+    let mut deviation = |c: &CheckResult| -> Option<f64> {
+        let (se, dof) = relative_error_and_dof(c)?;
+        let key = dof.map(f64::to_bits);
+        let shift = match shifts.iter().find(|(k, _)| *k == key) {
+            Some((_, v)) => *v,
+            None => {
+                let v = detectable_shift(alpha / family.max(1) as f64, dof);
+                shifts.push((key, v));
+                v
+            }
+        };
+        Some(shift? * se)
+    };
+    let mut runs: Vec<&str> = Vec::new();
+    for c in scene.checks.iter().filter(|c| !c.run.is_empty()) {
+        if !runs.contains(&c.run.as_str()) {
+            runs.push(&c.run);
+        }
+    }
+    let mut out = Vec::new();
+    for run in runs {
+        for (check, observable) in DETECTABLE {
+            let best = scene
+                .checks
+                .iter()
+                .filter(|c| c.run == run && c.check == check)
+                .filter_map(|c| Some((deviation(c)?, c)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((deviation, c)) = best {
+                out.push(Detectable {
+                    run: run.to_string(),
+                    observable: observable.to_string(),
+                    deviation,
+                    check: c.name.clone(),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// `would have caught a variance error ≥ 1.8 % (n=6), a rate error ≥ 4.0 % (n=5) (80 %
+/// power)` for the statements `run` of one run (each observable's parameter in
+/// brackets; the power at the scene's α, Holm, as [`detectable_deviation`]).
+pub fn detectable_text(run: &[&Detectable]) -> String {
+    let parts: Vec<String> = run
+        .iter()
+        .map(|d| {
+            let pct = 100.0 * d.deviation;
+            let v = if pct >= 10.0 {
+                format!("{pct:.0}")
+            } else if pct >= 1.0 {
+                format!("{pct:.1}")
+            } else {
+                format!("{pct:.2}")
+            };
+            let at = d.check.rsplit('/').next().unwrap_or_default();
+            format!("a {} error ≥ {v} % ({at})", d.observable)
+        })
+        .collect();
+    format!("would have caught {} (80 % power)", parts.join(", "))
+}
+
+/// The statements of `all` grouped by run, in order: (run, [`detectable_text`]).
+pub fn detectable_lines(all: &[Detectable]) -> Vec<(String, String)> {
+    let mut runs: Vec<&str> = Vec::new();
+    for d in all {
+        if !runs.contains(&d.run.as_str()) {
+            runs.push(&d.run);
+        }
+    }
+    runs.into_iter()
+        .map(|run| {
+            let of: Vec<&Detectable> = all.iter().filter(|d| d.run == run).collect();
+            (run.to_string(), detectable_text(&of))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::trajectory_rng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// The detectable shift has the power it claims: for a normal statistic exactly
+    /// (Φ, 1e-6); for Student's t at 7 and 30 dof by simulation of the noncentral t
+    /// (40 000 draws, power within 0.8 ± 0.01, 4.5 standard errors), where the naive sum
+    /// of the two t quantiles (power 0.74 at 7 dof) fails the same band. Levels as a
+    /// scene's Holm first step, α/m = 0.01/15.
+    #[test]
+    fn detectable_shift_has_its_power() {
+        let n = Normal::standard();
+        let level = 0.01 / 15.0;
+        let lam = detectable_shift(level, None).unwrap();
+        let zc = n.inverse_cdf(1.0 - level / 2.0);
+        let power = n.cdf(lam - zc) + n.cdf(-lam - zc);
+        assert!((power - POWER).abs() < 1e-6, "{power}");
+        let mut rng = trajectory_rng(20261204, 31);
+        for nu in [7.0, 30.0] {
+            let t = StudentsT::new(0.0, 1.0, nu).unwrap();
+            let tc = t.inverse_cdf(1.0 - level / 2.0);
+            let naive = tc + t.inverse_cdf(POWER);
+            let lam = detectable_shift(level, Some(nu)).unwrap();
+            let mut simulate = |shift: f64| {
+                let draws = 40_000;
+                let mut hits = 0;
+                for _ in 0..draws {
+                    let z: f64 = StandardNormal.sample(&mut rng);
+                    let chi: f64 = (0..nu as usize)
+                        .map(|_| {
+                            let g: f64 = StandardNormal.sample(&mut rng);
+                            g * g
+                        })
+                        .sum();
+                    if ((z + shift) / (chi / nu).sqrt()).abs() > tc {
+                        hits += 1;
+                    }
+                }
+                hits as f64 / draws as f64
+            };
+            let p = simulate(lam);
+            assert!((p - POWER).abs() < 0.01, "dof {nu}: power {p} at {lam}");
+            if nu == 7.0 {
+                let p = simulate(naive);
+                assert!((p - POWER).abs() > 0.01, "naive sum {naive}: power {p}");
+            }
+        }
+        assert!(detectable_shift(0.0, None).is_none());
+    }
+
+    /// The statement per run: the most precise check of each observable, in the run's
+    /// order; a check without a standard error or a reference says nothing.
+    #[test]
+    fn detectable_deviations_take_each_runs_most_precise_check() {
+        let check = |name: &str, se: Option<f64>| {
+            let parts: Vec<&str> = name.split('/').collect();
+            CheckResult {
+                name: name.to_string(),
+                run: parts[0].to_string(),
+                check: parts[1].to_string(),
+                parameter: parts[2].to_string(),
+                kind: "z-test".to_string(),
+                statistic: Some(0.1),
+                dof: None,
+                passed: true,
+                p_value: Some(0.9),
+                p_adjusted: Some(1.0),
+                estimate: Some(2.0),
+                reference: Some(2.0),
+                std_error: se,
+                continuum: None,
+                reference_kind: "discrete".to_string(),
+                unit: String::new(),
+                detail: String::new(),
+                largest_deviation: None,
+            }
+        };
+        let scene = SceneSummary {
+            name: "s".into(),
+            passed: true,
+            wall_seconds: 0.0,
+            figures: vec![],
+            captions: vec![],
+            tables: vec![],
+            notes: vec![],
+            warnings: vec![],
+            skipped: vec![],
+            checks: vec![
+                check("a/mode-variance/n=1", Some(0.2)),
+                check("a/mode-variance/n=2", Some(0.02)),
+                check("a/decay-rate/n=2", Some(0.1)),
+                check("a/decay-rate/n=3", None),
+                check("b/mode-variance/n=1", Some(0.04)),
+            ],
+            detectable: vec![],
+        };
+        let d = detectable_deviations(&scene, 0.01);
+        let lam = detectable_shift(0.01 / 5.0, None).unwrap();
+        let got: Vec<(&str, &str, &str)> = d
+            .iter()
+            .map(|d| (d.run.as_str(), d.observable.as_str(), d.check.as_str()))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("a", "variance", "a/mode-variance/n=2"),
+                ("a", "rate", "a/decay-rate/n=2"),
+                ("b", "variance", "b/mode-variance/n=1")
+            ]
+        );
+        assert!((d[0].deviation - lam * 0.01).abs() < 1e-12);
+        let lines = detectable_lines(&d);
+        assert_eq!(lines.len(), 2);
+        assert!(
+            lines[0].1.starts_with(
+                "would have caught a variance error ≥ 3.9 % (n=2), a rate error ≥ 20 % (n=2)"
+            ),
+            "{}",
+            lines[0].1
+        );
+    }
 
     /// Ratios `values` with standard error `se` each, modes 1, 2, ….
     fn ratios(values: &[f64], se: f64) -> Vec<ModeRatio> {

@@ -15,6 +15,7 @@ pub mod checks;
 pub mod compression;
 pub mod data;
 pub mod diagnosis;
+pub mod fit;
 pub mod oracle;
 pub mod runner;
 pub mod shard;

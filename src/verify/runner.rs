@@ -71,7 +71,7 @@ use crate::verify::summary::{CheckResult, SceneSummary, SkippedCheck, Summary};
 use crate::work::{WorkLimits, WorkProjection};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use subject::Subject;
+use subject::{Subject, Words};
 
 mod subject;
 
@@ -400,9 +400,32 @@ struct SceneOutputs<'r> {
     /// The names of the runs whose checks these are (the scene's, or the data's for
     /// `check`): the first part of a check's name when it is one of them.
     runs: Vec<String>,
+    /// Whether the run being written is referenced to the continuum (`check` of data
+    /// whose discretization this tool does not model): its figures say so
+    /// ([`SceneOutputs::words`]).
+    continuum_references: bool,
 }
 
 impl<'r> SceneOutputs<'r> {
+    /// A figure's words as this run's references are: said of the continuum when they
+    /// are the continuum's ([`Words::continuum_referenced`]).
+    fn words(&self, words: Words) -> Words {
+        if self.continuum_references {
+            words.continuum_referenced()
+        } else {
+            words
+        }
+    }
+
+    /// A figure's caption as this run's references are ([`subject::continuum_caption`]).
+    fn caption(&self, caption: String) -> String {
+        if self.continuum_references {
+            subject::continuum_caption(&caption)
+        } else {
+            caption
+        }
+    }
+
     fn new(scene: &Scene, report: &'r ReportRun) -> Self {
         SceneOutputs {
             report,
@@ -411,6 +434,7 @@ impl<'r> SceneOutputs<'r> {
             tables: Vec::new(),
             skipped: Vec::new(),
             runs: scene.runs.iter().map(|r| r.name.clone()).collect(),
+            continuum_references: false,
             notes: std::iter::once(scene.description.clone())
                 .chain(
                     scene
@@ -1207,6 +1231,7 @@ fn finish_scene(
         notes,
         skipped,
         runs,
+        continuum_references: _,
     } = outputs;
     let runs: Vec<&str> = runs.iter().map(String::as_str).collect();
     for c in &mut checks {
@@ -1242,7 +1267,17 @@ fn finish_scene(
         warnings: Vec::new(),
         skipped,
         checks,
+        detectable: Vec::new(),
     };
+    // Per run and observable, the smallest error the checks would have caught (issue #31).
+    summary.detectable = crate::verify::diagnosis::detectable_deviations(&summary, alpha);
+    for (run, text) in crate::verify::diagnosis::detectable_lines(&summary.detectable) {
+        summary.notes.push(format!(
+            "run {run}: {text}: the smallest relative error of each observable that the \
+             run's most precise check of it detects with 80 % probability at the scene's \
+             alpha (Holm's strictest step), from the measured standard errors"
+        ));
+    }
     // Per run with a failed check, the pattern of its per-mode ratios, if any (issue #31).
     for (run, hint) in crate::verify::diagnosis::run_hints(&summary) {
         summary.notes.push(format!(
@@ -1392,7 +1427,9 @@ pub fn check_data(
             data.dt_sample,
             data.burn_in
         ));
+        outputs.continuum_references = dc.continuum_references;
         write_run_outputs(scene, &dir, &dc.run, &est, &mut outputs)?;
+        outputs.continuum_references = false;
     }
     let summary = finish_check(scene, outputs, start, alpha, out, &report)?;
     Ok((summary, report))
@@ -1702,7 +1739,7 @@ fn write_mode_variances(
         &subject.mode_header(&["predicted_ratio", "simulated_ratio", "std_error"]),
         &rows,
     )?;
-    let words = subject.variance_words(name, refs);
+    let words = outputs.words(subject.variance_words(name, refs));
     let fig = Figure::new(words.title, words.x_label, words.y_label)
         .series(
             Series::line(
@@ -1764,7 +1801,7 @@ fn write_height_spectrum(
         })
         .collect();
     let qs: Vec<f64> = points.iter().map(|p| p[0]).collect();
-    let words = subject.spectrum_words(name, units, refs);
+    let words = outputs.words(subject.spectrum_words(name, units, refs));
     let fig = Figure::new(words.title, words.x_label, words.y_label)
         .log_x()
         .log_y()
@@ -1843,7 +1880,7 @@ fn write_mode_statistics(
         // Each row's mode number, then its columns after the labels: variance (4), rate,
         // its error, discrete rate and continuum rate.
         let at = |r: &Vec<f64>, k: usize| r[label_columns + k - 1];
-        let words = subject.rate_words(name, refs);
+        let words = outputs.words(subject.rate_words(name, refs));
         let fig = Figure::new(words.title, words.x_label, words.y_label)
             .series(
                 Series::line(
@@ -1896,7 +1933,7 @@ fn write_profile(
         &["x", "variance", "std_error", "discrete", "continuum"],
         &rows,
     )?;
-    let words = subject.profile_words(&run.spec.name, units);
+    let words = outputs.words(subject.profile_words(&run.spec.name, units));
     let fig = Figure::new(words.title, words.x_label, words.y_label)
         .series(
             Series::line(words.continuum, subject.profile_curve())
@@ -1956,21 +1993,16 @@ fn write_two_time(
         ],
         &rows,
     )?;
-    let fig = two_time_figure(scene.tau1(), subject, units, &run.spec.name, &rows);
+    let words = outputs.words(subject.two_time_words(&run.spec.name, units));
+    let fig = two_time_figure(scene.tau1(), subject, words, &rows);
     outputs.write_figure(&fig, dir.join(format!("{}-two-time.svg", run.spec.name)))
 }
 
-/// The two-time figure of [`write_two_time`] from the rows of `<run>-two-time.csv`.
-fn two_time_figure(
-    tau1: f64,
-    subject: &Subject,
-    units: AxisUnits,
-    name: &str,
-    rows: &[Vec<f64>],
-) -> Figure {
+/// The two-time figure of [`write_two_time`] from the rows of `<run>-two-time.csv`, in
+/// `words` (the subject's two-time words).
+fn two_time_figure(tau1: f64, subject: &Subject, words: Words, rows: &[Vec<f64>]) -> Figure {
     let (length, unit, equation) = subject.two_time_legend();
     let eta_max = 1.25 * rows.iter().map(|r| r[3]).fold(0.0, f64::max);
-    let words = subject.two_time_words(name, units);
     let mut fig = Figure::new(words.title, words.x_label, words.y_label).caption(words.caption);
     for (k, r) in rows.iter().enumerate() {
         let (x, y, t, eta) = (r[0], r[1], r[2], r[3]);
@@ -2047,7 +2079,7 @@ fn write_spectra(
     )
     .log_x()
     .log_y()
-    .caption(subject.welch_caption(&SPECTRUM_MODES, &run.reference.modes));
+    .caption(outputs.caption(subject.welch_caption(&SPECTRUM_MODES, &run.reference.modes)));
     let mut hue = 0;
     for (n, (f, p, e)) in &spectra {
         for k in 1..f.len() {

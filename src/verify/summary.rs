@@ -245,6 +245,12 @@ pub struct SceneSummary {
     pub skipped: Vec<SkippedCheck>,
     /// The checks.
     pub checks: Vec<CheckResult>,
+    /// Per run and observable, the smallest relative error its checks would have
+    /// detected at the scene's α with 80 % power (issue #31,
+    /// [`crate::verify::diagnosis::detectable_deviations`]); empty where no check
+    /// states a ratio with a standard error.
+    #[serde(default)]
+    pub detectable: Vec<crate::verify::diagnosis::Detectable>,
 }
 
 /// The result of a verification run.

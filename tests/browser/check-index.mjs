@@ -1,7 +1,9 @@
 // Renders a langevin-fem report (index.html) in headless Chromium and checks what a reader
 // sees: no console errors, failed requests or broken links; the verdict and the failures
 // first; the page of a run under 10 screen heights before anything is expanded; every
-// figure loads, with a caption. Keeps screenshots as CI artefacts.
+// figure loads, with a caption; a `check` report of external data leads with the data's
+// description and labels continuum references as such; every run states the smallest
+// errors it would have caught. Keeps screenshots as CI artefacts.
 //
 // Usage: node check-index.mjs --report DIR --expect passed|failed --shots DIR --name NAME
 // Chromium: $CHROMIUM or /usr/bin/chromium (Debian's package; `make browser-check`
@@ -84,8 +86,30 @@ const order = await page.evaluate(() => {
     openDetails: document.querySelectorAll("details[open]").length,
     checkTables: document.querySelectorAll("section.scene details.checks").length,
     height: document.documentElement.scrollHeight,
+    firstNote: document.querySelector("#scenes tbody tr td.detail")?.innerText ?? "",
+    referenceCells: [...document.querySelectorAll("section.scene details.checks table.checks tbody tr.check")].map(
+      (r) => r.querySelectorAll("td")[9]?.textContent ?? "",
+    ),
+    detectable: [...document.querySelectorAll("section.scene details.notes li")]
+      .map((li) => li.textContent)
+      .filter((t) => t.includes("would have caught")),
   };
 });
+// A `check` report of external data (issue #31): the data's own description leads; every
+// reference that is the continuum's says so in the table; a run whose every reference is
+// the continuum's says so in every caption (below); every run states (in its scene's
+// notes) the smallest errors it would have caught.
+const checked = summary.scenes.length === 1 && (summary.scenes[0].notes[0] ?? "").startsWith("checked data:");
+const allChecks = summary.scenes.flatMap((s) => s.checks);
+if (checked) {
+  if (!order.firstNote.startsWith("checked data:")) fail(`first note: expected the data's description, got "${order.firstNote.slice(0, 80)}"`);
+  const continuum = allChecks.filter((c) => c.reference_kind === "continuum" && c.reference !== null).length;
+  const marked = order.referenceCells.filter((t) => t.includes("(continuum)")).length;
+  if (marked !== continuum) fail(`${marked} reference cells say (continuum), summary.json has ${continuum} continuum references`);
+}
+const statedRuns = summary.scenes.flatMap((s) => [...new Set(s.detectable.map((d) => d.run))]);
+if (order.detectable.length !== statedRuns.length)
+  fail(`${order.detectable.length} detectable-deviation notes shown for ${statedRuns.length} runs with one in summary.json`);
 const word = args.expect === "passed" ? "PASSED" : "FAILED";
 if (!order.verdictText.startsWith(word)) fail(`verdict: expected ${word}, the page says "${order.verdictText.slice(0, 80)}"`);
 if (order.verdict === null || order.verdict > VIEWPORT.height / 2) fail(`verdict not in the top half of the first screen (at ${order.verdict} px)`);
@@ -146,6 +170,12 @@ if (figures.length !== expectedFigures) fail(`${figures.length} figures on the p
 for (const f of figures) {
   if (!f.loaded) fail(`figure ${f.src} did not load`);
   if (f.caption.length < 20) fail(`figure ${f.src} has no caption (a caption says what is plotted)`);
+}
+if (checked && allChecks.length > 0 && allChecks.every((c) => c.reference_kind === "continuum")) {
+  for (const f of figures) {
+    if (!f.caption.startsWith("References: the continuum")) fail(`figure ${f.src}: a continuum-referenced caption must say so first: "${f.caption.slice(0, 80)}"`);
+    if (/discretized|discrete update|discrete process/.test(f.caption)) fail(`figure ${f.src}: its caption speaks of a discrete reference there is none of`);
+  }
 }
 const expandedHeight = await page.evaluate(() => document.documentElement.scrollHeight);
 const shown = await page.$$("figure");

@@ -10,6 +10,7 @@
 
 use crate::error::Result;
 use crate::fem::beam::BeamModel;
+use crate::fem::chain::ChainModel;
 use crate::fem::modal::{GeneralizedModes, generalized_modes};
 use crate::fem::plate::PlateModel;
 use crate::fem::plate_modes::PlateModes;
@@ -135,6 +136,9 @@ fn midline(membrane: &Membrane) -> f64 {
 pub(crate) enum FemObject {
     /// Hermite-cubic beam elements.
     Beam(Box<BeamModel>),
+    /// The hinged filament as a chain of nodes: another program's finite-difference or
+    /// bead-spring discretization (issue #31).
+    Chain(Box<ChainModel>),
     /// Bogner–Fox–Schmit plate elements on a uniform mesh, with their separable modes
     /// and the continuum modes that are checked (their acoustic modes come first in
     /// [`FemObject::modes`]).
@@ -156,6 +160,7 @@ impl FemObject {
     pub(crate) fn system(&self) -> &LinearSystem {
         match self {
             FemObject::Beam(b) => b,
+            FemObject::Chain(c) => c,
             FemObject::Plate { plate, .. } => plate,
         }
     }
@@ -206,6 +211,7 @@ impl FemObject {
     pub(crate) fn max_rate(&self) -> Result<f64> {
         match self {
             FemObject::Beam(b) => b.max_rate(),
+            FemObject::Chain(c) => Ok(c.max_rate()),
             FemObject::Plate { plate, .. } => plate.max_rate(),
         }
     }
@@ -218,6 +224,7 @@ impl FemObject {
     pub(crate) fn modes(&self) -> Result<GeneralizedModes> {
         match self {
             FemObject::Beam(b) => generalized_modes(b),
+            FemObject::Chain(c) => c.modes(),
             FemObject::Plate { modes, checked, .. } => {
                 let all = modes.generalized_modes()?;
                 // The checked modes' acoustic columns first, in the continuum's order,
@@ -250,6 +257,7 @@ impl FemObject {
         match self {
             // The rigid motion of free ends is projected out, as the continuum's.
             FemObject::Beam(b) => b.elastic_deflection_at(state, x),
+            FemObject::Chain(c) => c.value_at(state, x),
             FemObject::Plate { plate, mean, .. } => {
                 let h = plate.height_at(state, x, 0.5 * plate.params().height);
                 // Periodic: the height relative to the spatial mean (the q = 0 mode, a
@@ -267,6 +275,7 @@ impl FemObject {
     pub(crate) fn line_nodes(&self) -> Vec<f64> {
         match self {
             FemObject::Beam(b) => b.mesh().nodes().to_vec(),
+            FemObject::Chain(c) => c.nodes(),
             FemObject::Plate { plate, .. } => {
                 let (nx, _) = plate.elements();
                 let a = plate.params().width;
@@ -279,7 +288,7 @@ impl FemObject {
     pub(crate) fn beam(&self) -> Option<&BeamModel> {
         match self {
             FemObject::Beam(b) => Some(b),
-            FemObject::Plate { .. } => None,
+            FemObject::Chain(_) | FemObject::Plate { .. } => None,
         }
     }
 }

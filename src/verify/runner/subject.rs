@@ -48,6 +48,85 @@ pub(super) struct Words {
     pub caption: String,
 }
 
+/// What a figure whose references are all the continuum's says first (data whose
+/// discretization this tool does not model, issue #31).
+pub(super) const CONTINUUM_PREFIX: &str = "References: the continuum (eqs. 2-4, or (M3)-(M5) of \
+     the membrane), since the data declare no discretization this tool models; the data's own \
+     mesh and time-step errors are part of what the markers' distance from the references \
+     shows. ";
+
+/// The caption phrases that describe an exact discrete reference, and what they say of a
+/// continuum reference.
+const DISCRETE_PHRASES: [(&str, &str); 8] = [
+    ("kT/λᵢ of the discrete mode", "kT/λᵢ of the continuum mode"),
+    (
+        "the exact variance of the discretized system and integrator",
+        "the continuum variance",
+    ),
+    (
+        "the exact rate −ln(m)/Δt of the discrete update, m its one-step multiplier",
+        "the continuum rate",
+    ),
+    (
+        "the exact rate −ln(ρ)/Δt of the discrete update, ρ its one-step multiplier",
+        "the continuum rate",
+    ),
+    (
+        "the exact value of the discretized filament",
+        "the continuum value",
+    ),
+    (
+        "the exact value of the discretized membrane",
+        "the continuum value",
+    ),
+    (
+        "the exact value of the discretized system and integrator",
+        "the continuum value",
+    ),
+    (
+        "its exact expectation for the sampled discrete process",
+        "the continuum's expectation for the sampled process",
+    ),
+];
+
+/// The caption sentences (or clauses) about the distance between the exact discrete
+/// reference and the continuum: left out when the reference is the continuum.
+const DISCRETE_CLAUSES: [&str; 6] = [
+    " The solid line's distance from 1 is the time step's exact bias, the dashed line's the mesh's.",
+    " The solid line's distance from 1 is the time step's exact bias.",
+    "; its distance from 1 is the discretization's (mesh and time step) effect on the dynamics",
+    "; the discs lie on the curve up to the discretization error",
+    ", and the discs on their curves up to the discretization error",
+    ", and the discs on the curve up to the discretization error",
+];
+
+/// A caption of a figure whose references are the continuum's: [`CONTINUUM_PREFIX`],
+/// then `caption` with its discrete-reference phrases said of the continuum and its
+/// clauses on the discretization error left out.
+pub(super) fn continuum_caption(caption: &str) -> String {
+    let mut c = caption.to_string();
+    for (from, to) in DISCRETE_PHRASES {
+        c = c.replace(from, to);
+    }
+    for clause in DISCRETE_CLAUSES {
+        c = c.replace(clause, "");
+    }
+    format!("{CONTINUUM_PREFIX}{c}")
+}
+
+impl Words {
+    /// The words of a figure whose references are all the continuum's (data whose
+    /// discretization this tool does not model): the legend of the exact discrete
+    /// reference says "continuum", the caption [`continuum_caption`].
+    pub(super) fn continuum_referenced(mut self) -> Words {
+        if !self.discrete.is_empty() {
+            self.discrete = "reference: the continuum (discretization not modelled)".to_string();
+        }
+        self.caption = continuum_caption(&self.caption);
+        self
+    }
+}
+
 /// The object of a linear scene, as its tables and figures describe it.
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Subject {
@@ -712,5 +791,64 @@ mod tests {
         assert!(two_time.title.contains("(M4)") && two_time.caption.contains("spatial mean"));
         let rates = hinged.rate_words("cn", &[]);
         assert!(!rates.continuum.contains('⁴') && rates.caption.contains("c_q/ξ"));
+    }
+
+    /// Issue #31: every figure of a run referenced to the continuum says so — its legend
+    /// and its caption, which keeps nothing of the discrete reference or of its distance
+    /// from the continuum (for each object's every figure; a new caption phrase about the
+    /// discrete reference fails here until `DISCRETE_PHRASES` knows it).
+    #[test]
+    fn continuum_referenced_figures_say_continuum() {
+        let units = AxisUnits::new(false);
+        for path in [
+            "tests/scenes/good/tiny-linear.toml",
+            "tests/scenes/good/membrane-hinged.toml",
+            "tests/scenes/good/membrane-pbc.toml",
+        ] {
+            let sc = scene(path);
+            let subject = Subject::of(&sc).expect(path);
+            let run = LinearRun::prepare(&sc, &sc.runs[0]).expect("prepares");
+            let refs = &run.reference.modes;
+            let mut all = vec![
+                subject.variance_words("r", refs),
+                subject.rate_words("r", refs),
+                subject.profile_words("r", units),
+                subject.two_time_words("r", units),
+                Words {
+                    caption: subject.welch_caption(&[1, 3, 6], refs),
+                    ..Words::default()
+                },
+            ];
+            if subject.is_membrane() {
+                all.push(subject.spectrum_words("r", units, refs));
+            }
+            for w in all {
+                let before = w.caption.clone();
+                let w = w.continuum_referenced();
+                let body = w.caption.strip_prefix(CONTINUUM_PREFIX).expect("prefix");
+                for word in [
+                    "discretized",
+                    "discrete mode",
+                    "discrete update",
+                    "discrete process",
+                    "discretization",
+                ] {
+                    assert!(
+                        !body.contains(word),
+                        "{path}: {word:?} left in {body:?} (from {before:?})"
+                    );
+                }
+                assert!(body.contains("continuum"), "{path}: {body:?}");
+                assert!(w.discrete.is_empty() || w.discrete.contains("continuum"));
+            }
+        }
+        // Said of the discrete reference, the same caption is unchanged.
+        let plain = Subject::of(&scene("tests/scenes/good/tiny-linear.toml")).unwrap();
+        assert!(
+            plain
+                .variance_words("r", &[])
+                .caption
+                .contains("discretized system")
+        );
     }
 }

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Coverage of `langevin-fem fit`'s 95 % intervals over seeds (issue #31).
+
+For seeds 1..N: `langevin-fem run` of a scene's run at that seed, then `langevin-fem fit`
+on its output; counts how often each interval covers the true parameter (the sidecar's:
+EI and xi with kT known, kT with EI known) and compares the count with the binomial law
+of the nominal level: the exact two-sided 99 % range of covered counts. Pure Python
+(standard library only). Exit 0 when every parameter's count is in its range.
+
+Usage: coverage.py BIN WORKDIR [--scene S] [--run R] [--seeds N]
+"""
+
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+
+def binomial_range(n, p, alpha=0.01):
+    """The smallest and largest k with P(X <= k) > alpha/2 and P(X >= k) > alpha/2."""
+    pmf = [math.comb(n, k) * p**k * (1 - p) ** (n - k) for k in range(n + 1)]
+    cdf, lo = 0.0, 0
+    for k in range(n + 1):
+        cdf += pmf[k]
+        if cdf > alpha / 2:
+            lo = k
+            break
+    sf, hi = 0.0, n
+    for k in range(n, -1, -1):
+        sf += pmf[k]
+        if sf > alpha / 2:
+            hi = k
+            break
+    return lo, hi
+
+
+def main():
+    a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    a.add_argument("bin")
+    a.add_argument("work")
+    a.add_argument("--scene", default="hinged-linear-2d")
+    a.add_argument("--run", default="crank-nicolson")
+    a.add_argument("--seeds", type=int, default=100)
+    args = a.parse_args()
+    shutil.rmtree(args.work, ignore_errors=True)
+    os.makedirs(args.work)
+    covered = {"bending_rigidity": 0, "drag": 0, "kt_given_bending_rigidity": 0}
+    truth = None
+    rows = []
+    for seed in range(1, args.seeds + 1):
+        data = os.path.join(args.work, f"data-{seed}")
+        out = os.path.join(args.work, f"fit-{seed}")
+        subprocess.run([args.bin, "-q", "run", "--scene", args.scene, "--run", args.run,
+                        "--seed", str(seed), "--out", data], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([args.bin, "-q", "fit", "--scene", args.scene, "--data", data, "--out", out],
+                       check=True, stdout=subprocess.DEVNULL)
+        side = json.load(open(os.path.join(data, "data.json")))
+        f = side["filament"]
+        truth = {"bending_rigidity": f["bending_rigidity"], "drag": f["drag"],
+                 "kt_given_bending_rigidity": f["kt"]}
+        fit = json.load(open(os.path.join(out, "fit.json")))["runs"][0]
+        row = [seed]
+        for k in covered:
+            lo, hi = fit[k]["interval"]
+            ok = lo <= truth[k] <= hi
+            covered[k] += ok
+            row += [fit[k]["value"], lo, hi, int(ok)]
+        rows.append(row)
+        shutil.rmtree(data)
+        shutil.rmtree(out)
+    lo, hi = binomial_range(args.seeds, 0.95)
+    with open(os.path.join(args.work, "coverage.csv"), "w") as fh:
+        fh.write("seed," + ",".join(f"{k},{k}_lo,{k}_hi,{k}_covered" for k in covered) + "\n")
+        for r in rows:
+            fh.write(",".join(str(v) for v in r) + "\n")
+    ok = True
+    for k, c in covered.items():
+        inside = lo <= c <= hi
+        ok &= inside
+        print(f"{k}: {c}/{args.seeds} intervals cover the truth {truth[k]} "
+              f"(nominal 95 %: {lo}-{hi} of {args.seeds} at the 99 % binomial range) "
+              f"{'ok' if inside else 'OUT OF RANGE'}")
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
