@@ -12,7 +12,8 @@
 //!   against the reference, per skipped check the reason, and the seed of each scene;
 //! - per run without a failed check, the smallest relative error of each observable it
 //!   would have caught with 80 % power ([`diagnosis::detectable_deviations`]): `check`
-//!   at normal verbosity, `verify` at verbose.
+//!   at normal verbosity, `verify` at verbose; `verify` at normal verbosity prints one such
+//!   line per passing scene (per observable, its most sensitive run).
 //!
 //! The last line of stdout is always `N passed, N failed, N skipped in T s` (checks
 //! summed over the scenes; T the command's wall time), for a person and for a script.
@@ -76,8 +77,9 @@ fn failed_name(c: &CheckResult) -> String {
 
 /// Prints the scenes of `summary` at `verbosity`: failures and per-scene lines on
 /// stdout, warnings on stderr (`wall`: print each scene's wall time; `detectable`: at
-/// normal verbosity too, per run without a failed check, the smallest errors it would
-/// have caught — `check`'s default; `verify` prints them with `--verbose`).
+/// normal verbosity, per run without a failed check, the smallest errors it would have
+/// caught — `check`'s default; otherwise, as `verify` does, one such line per passing
+/// scene, per observable its most sensitive run, and per run with `--verbose`).
 pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool, detectable: bool) {
     for s in &summary.scenes {
         let t = Totals::of([s]);
@@ -110,6 +112,13 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool, detecta
             for (run, hint) in diagnosis::run_hints(s) {
                 println!("    {run}: {}", hint.text);
             }
+        }
+        if verbosity == Verbosity::Normal
+            && !detectable
+            && s.passed
+            && let Some(text) = diagnosis::scene_detectable_text(&s.detectable)
+        {
+            println!("    {text}");
         }
         if verbosity == Verbosity::Verbose || (detectable && verbosity == Verbosity::Normal) {
             for (run, text) in diagnosis::detectable_lines(&s.detectable) {

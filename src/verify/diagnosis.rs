@@ -604,6 +604,26 @@ pub fn detectable_text(run: &[&Detectable]) -> String {
     format!("would have caught {} (80 % power)", parts.join(", "))
 }
 
+/// The scene-wide statement of `all`: per observable the smallest deviation over the
+/// runs, naming its run — `would have caught a variance error ≥ 0.84 % (crank-nicolson,
+/// n=6), … (80 % power)` — for `verify`'s line under a passing scene; `None` if there is
+/// none.
+pub fn scene_detectable_text(all: &[Detectable]) -> Option<String> {
+    let best: Vec<Detectable> = DETECTABLE
+        .iter()
+        .filter_map(|(_, observable)| {
+            all.iter()
+                .filter(|d| d.observable == *observable)
+                .min_by(|a, b| a.deviation.total_cmp(&b.deviation))
+                .map(|d| Detectable {
+                    check: format!("{}, {}", d.run, d.check.rsplit('/').next().unwrap_or("")),
+                    ..d.clone()
+                })
+        })
+        .collect();
+    (!best.is_empty()).then(|| detectable_text(&best.iter().collect::<Vec<_>>()))
+}
+
 /// The statements of `all` grouped by run, in order: (run, [`detectable_text`]).
 pub fn detectable_lines(all: &[Detectable]) -> Vec<(String, String)> {
     let mut runs: Vec<&str> = Vec::new();
@@ -733,6 +753,15 @@ mod tests {
             ]
         );
         assert!((d[0].deviation - lam * 0.01).abs() < 1e-12);
+        // Scene-wide (verify's line): per observable the most sensitive run, named.
+        let scene_line = scene_detectable_text(&d).unwrap();
+        assert!(
+            scene_line.starts_with(
+                "would have caught a variance error ≥ 3.9 % (a, n=2), a rate error ≥ 20 % (a, n=2)"
+            ),
+            "{scene_line}"
+        );
+        assert!(scene_detectable_text(&[]).is_none());
         let lines = detectable_lines(&d);
         assert_eq!(lines.len(), 2);
         assert!(
