@@ -67,10 +67,22 @@ fn failure_detail(c: &CheckResult) -> String {
 }
 
 /// The failed line's name with the ratio estimate/reference where it means something:
-/// `run/mode-variance/n=3 (ratio 1.099 ± 0.013)`.
-fn failed_name(c: &CheckResult) -> String {
-    match diagnosis::ratio_of(c) {
-        Some((r, se)) => format!("{} ({})", c.name, diagnosis::ratio_text(r, se)),
+/// `run/mode-variance/n=3 (ratio 1.099 ± 0.013)`. A check of a mode without a ratio of
+/// its own (a KS or χ² test of its distribution, its mean against 0) shows the ratio of
+/// the same mode's `mode-variance` check among `checks`, named so:
+/// `run/mode-ks/n=4 (variance ratio 1.344 ± 0.007)`.
+fn failed_name(c: &CheckResult, checks: &[CheckResult]) -> String {
+    if let Some((r, se)) = diagnosis::ratio_of(c) {
+        return format!("{} ({})", c.name, diagnosis::ratio_text(r, se));
+    }
+    let sibling = checks.iter().find(|v| {
+        c.check.starts_with("mode-")
+            && v.check == "mode-variance"
+            && v.run == c.run
+            && v.parameter == c.parameter
+    });
+    match sibling.and_then(diagnosis::ratio_of) {
+        Some((r, se)) => format!("{} (variance {})", c.name, diagnosis::ratio_text(r, se)),
         None => c.name.clone(),
     }
 }
@@ -101,8 +113,10 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool, detecta
         }
         for c in s.checks.iter().filter(|c| !c.passed) {
             match verbosity {
-                Verbosity::Quiet => println!("{}  failed: {}", s.name, failed_name(c)),
-                Verbosity::Normal => println!("    failed: {}", failed_name(c)),
+                Verbosity::Quiet => {
+                    println!("{}  failed: {}", s.name, failed_name(c, &s.checks))
+                }
+                Verbosity::Normal => println!("    failed: {}", failed_name(c, &s.checks)),
                 Verbosity::Verbose => {
                     println!("    failed: {}: {}", c.name, failure_detail(c));
                 }
@@ -226,12 +240,32 @@ mod tests {
     #[test]
     fn failed_lines_show_the_ratio_where_it_means_something() {
         let c = check("r/mode-variance/n=3", false);
-        assert_eq!(failed_name(&c), "r/mode-variance/n=3 (ratio 1.100 ± 0.030)");
+        assert_eq!(
+            failed_name(&c, &[]),
+            "r/mode-variance/n=3 (ratio 1.100 ± 0.030)"
+        );
         let mut zero = check("r/mode-mean/n=3", false);
         zero.reference = Some(0.0);
-        assert_eq!(failed_name(&zero), "r/mode-mean/n=3");
+        assert_eq!(failed_name(&zero, &[]), "r/mode-mean/n=3");
         let mut residual = check("r/axial-equilibrium", false);
         residual.p_value = None;
-        assert_eq!(failed_name(&residual), "r/axial-equilibrium");
+        assert_eq!(failed_name(&residual, &[]), "r/axial-equilibrium");
+        // A mode's distribution test borrows its mode-variance check's ratio, named so.
+        let at = |name: &str, check_name: &str| CheckResult {
+            run: "r".into(),
+            check: check_name.into(),
+            parameter: "n=3".into(),
+            ..check(name, false)
+        };
+        let variance = at("r/mode-variance/n=3", "mode-variance");
+        let mut ks = at("r/mode-ks/n=3", "mode-ks");
+        ks.estimate = None;
+        assert_eq!(
+            failed_name(&ks, &[variance.clone(), ks.clone()]),
+            "r/mode-ks/n=3 (variance ratio 1.100 ± 0.030)"
+        );
+        let mut other = variance;
+        other.parameter = "n=4".into();
+        assert_eq!(failed_name(&ks, &[other]), "r/mode-ks/n=3");
     }
 }
