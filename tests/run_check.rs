@@ -33,8 +33,14 @@ fn simulate(out: &str, format: &str) {
 }
 
 fn check(data: &str, out: &str) -> (std::process::Output, Vec<&'static str>) {
+    on_data("check", data, out)
+}
+
+/// `langevin-fem COMMAND --scene hinged-linear-2d --data DATA --out OUT` (`check` or
+/// `fit`): its output and arguments.
+fn on_data(command: &str, data: &str, out: &str) -> (std::process::Output, Vec<&'static str>) {
     let args: Vec<&'static str> = [
-        "check",
+        command,
         "--scene",
         "hinged-linear-2d",
         "--data",
@@ -853,16 +859,7 @@ fn fit_recovers_the_parameters_with_intervals() {
     let data = dir.join_str("data");
     simulate(&data, "csv");
     let fit = |data: &str, out: &str| {
-        let args = [
-            "fit",
-            "--scene",
-            "hinged-linear-2d",
-            "--data",
-            data,
-            "--out",
-            out,
-        ];
-        let o = run(&args);
+        let (o, args) = on_data("fit", data, out);
         let d = describe(&args, &o);
         (o, d)
     };

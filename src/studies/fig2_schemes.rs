@@ -33,6 +33,7 @@
 //! reproducible bit for bit, every estimate is.
 
 use super::output::StudyReport;
+use super::work_precision::{require_methods, require_steps, require_trajectories};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
@@ -288,13 +289,7 @@ fn validate(opts: &Fig2SchemesOptions) -> Result<()> {
             "a compression scene of a filament (e.g. fig2-paper-2d, compression-2d)",
         ));
     }
-    if opts.methods.is_empty() {
-        return Err(Error::invalid(
-            "--methods",
-            "(empty)",
-            "at least one method",
-        ));
-    }
+    require_methods(&opts.methods)?;
     for &(k, _) in &opts.methods {
         if k == IntegratorKind::ExactModal || k == IntegratorKind::BackwardEuler {
             return Err(Error::invalid(
@@ -304,18 +299,7 @@ fn validate(opts: &Fig2SchemesOptions) -> Result<()> {
             ));
         }
     }
-    for &d in &opts.dt_tau1 {
-        crate::error::require_in_range("--dt-tau1", d, 1e-7, 1.0)?;
-    }
-    for &f in &opts.em_fractions {
-        if !(f > 0.0 && f < 1.0) {
-            return Err(Error::invalid(
-                "--em-fractions",
-                f,
-                "fractions of the stability limit in (0, 1)",
-            ));
-        }
-    }
+    require_steps(&opts.dt_tau1, 1e-7, &opts.em_fractions)?;
     if opts.strain_ratios.is_empty() {
         return Err(Error::invalid(
             "--strain-ratios",
@@ -326,13 +310,7 @@ fn validate(opts: &Fig2SchemesOptions) -> Result<()> {
     for &r in &opts.strain_ratios {
         crate::error::require_in_range("--strain-ratios", r, -100.0, 100.0)?;
     }
-    if !(2..=1024).contains(&opts.trajectories) {
-        return Err(Error::invalid(
-            "--trajectories",
-            opts.trajectories,
-            "an integer in [2, 1024]",
-        ));
-    }
+    require_trajectories(opts.trajectories)?;
     crate::error::require_in_range("--duration-tau1", opts.duration_tau1, 1.0, 1e5)?;
     crate::error::require_in_range("--sample-every-tau1", opts.sample_every_tau1, 1e-5, 1.0)?;
     if opts.duration_tau1 < 100.0 * opts.sample_every_tau1 {

@@ -254,6 +254,48 @@ pub struct WorkPrecisionSummary {
     pub wall_seconds: f64,
 }
 
+/// `--methods` names at least one method (both work–precision studies).
+pub(super) fn require_methods(methods: &[(IntegratorKind, NoiseModel)]) -> Result<()> {
+    if methods.is_empty() {
+        return Err(Error::invalid(
+            "--methods",
+            "(empty)",
+            "at least one method",
+        ));
+    }
+    Ok(())
+}
+
+/// Every `--dt-tau1` in [dt_min, 1] and every `--em-fractions` in (0, 1) (both
+/// work–precision studies).
+pub(super) fn require_steps(dt_tau1: &[f64], dt_min: f64, em_fractions: &[f64]) -> Result<()> {
+    for &d in dt_tau1 {
+        crate::error::require_in_range("--dt-tau1", d, dt_min, 1.0)?;
+    }
+    for &f in em_fractions {
+        if !(f > 0.0 && f < 1.0) {
+            return Err(Error::invalid(
+                "--em-fractions",
+                f,
+                "fractions of the stability limit in (0, 1)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `--trajectories` in [2, 1024] (both work–precision studies).
+pub(super) fn require_trajectories(trajectories: usize) -> Result<()> {
+    if !(2..=1024).contains(&trajectories) {
+        return Err(Error::invalid(
+            "--trajectories",
+            trajectories,
+            "an integer in [2, 1024]",
+        ));
+    }
+    Ok(())
+}
+
 fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
     if opts.scene.model != ModelKind::Fem {
         return Err(Error::invalid(
@@ -262,13 +304,7 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
             "a linear finite-element scene (model = \"fem\", e.g. hinged-linear-2d)",
         ));
     }
-    if opts.methods.is_empty() {
-        return Err(Error::invalid(
-            "--methods",
-            "(empty)",
-            "at least one method",
-        ));
-    }
+    require_methods(&opts.methods)?;
     for &(k, _) in &opts.methods {
         if k == IntegratorKind::MetropolisCrankNicolson {
             return Err(Error::invalid(
@@ -281,25 +317,8 @@ fn validate(opts: &WorkPrecisionOptions) -> Result<()> {
             ));
         }
     }
-    for &d in &opts.dt_tau1 {
-        crate::error::require_in_range("--dt-tau1", d, 1e-12, 1.0)?;
-    }
-    for &f in &opts.em_fractions {
-        if !(f > 0.0 && f < 1.0) {
-            return Err(Error::invalid(
-                "--em-fractions",
-                f,
-                "fractions of the stability limit in (0, 1)",
-            ));
-        }
-    }
-    if !(2..=1024).contains(&opts.trajectories) {
-        return Err(Error::invalid(
-            "--trajectories",
-            opts.trajectories,
-            "an integer in [2, 1024]",
-        ));
-    }
+    require_steps(&opts.dt_tau1, 1e-12, &opts.em_fractions)?;
+    require_trajectories(opts.trajectories)?;
     crate::error::require_in_range("--duration-tau1", opts.duration_tau1, 1.0, 1e6)?;
     crate::error::require_in_range("--em-duration-tau1", opts.em_duration_tau1, 1.0, 1e6)?;
     crate::error::require_in_range("--tolerance", opts.tolerance, 1e-6, 1.0)?;

@@ -406,27 +406,36 @@ pub(crate) fn mode_ratios(checks: &[CheckResult], run: &str, check: &str) -> Vec
         .collect()
 }
 
+/// The distinct non-empty run names of `runs`, in the order of their first appearance
+/// (a scene's checks name their run; a check of the scene names none).
+pub(crate) fn first_seen<'a>(runs: impl IntoIterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for run in runs {
+        if !run.is_empty() && !out.contains(&run) {
+            out.push(run);
+        }
+    }
+    out
+}
+
 /// The hint of every run of `scene` with a failed check, in the order of their first
 /// failure: [`diagnose`] on its `mode-variance` and `decay-rate` checks (passed and
 /// failed: a pattern needs every mode).
 pub fn run_hints(scene: &SceneSummary) -> Vec<(String, Hint)> {
-    let mut runs: Vec<&str> = Vec::new();
-    for c in scene
-        .checks
-        .iter()
-        .filter(|c| !c.passed && !c.run.is_empty())
-    {
-        if !runs.contains(&c.run.as_str()) {
-            runs.push(&c.run);
-        }
-    }
-    runs.into_iter()
-        .filter_map(|run| {
-            let v = mode_ratios(&scene.checks, run, "mode-variance");
-            let r = mode_ratios(&scene.checks, run, "decay-rate");
-            diagnose(&v, &r).map(|h| (run.to_string(), h))
-        })
-        .collect()
+    first_seen(
+        scene
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.run.as_str()),
+    )
+    .into_iter()
+    .filter_map(|run| {
+        let v = mode_ratios(&scene.checks, run, "mode-variance");
+        let r = mode_ratios(&scene.checks, run, "decay-rate");
+        diagnose(&v, &r).map(|h| (run.to_string(), h))
+    })
+    .collect()
 }
 
 /// The power at which [`detectable_deviations`] states the smallest detectable error.
@@ -554,14 +563,8 @@ pub fn detectable_deviations(scene: &SceneSummary, alpha: f64) -> Vec<Detectable
         };
         Some(shift? * se)
     };
-    let mut runs: Vec<&str> = Vec::new();
-    for c in scene.checks.iter().filter(|c| !c.run.is_empty()) {
-        if !runs.contains(&c.run.as_str()) {
-            runs.push(&c.run);
-        }
-    }
     let mut out = Vec::new();
-    for run in runs {
+    for run in first_seen(scene.checks.iter().map(|c| c.run.as_str())) {
         for (check, observable) in DETECTABLE {
             let best = scene
                 .checks
@@ -626,13 +629,8 @@ pub fn scene_detectable_text(all: &[Detectable]) -> Option<String> {
 
 /// The statements of `all` grouped by run, in order: (run, [`detectable_text`]).
 pub fn detectable_lines(all: &[Detectable]) -> Vec<(String, String)> {
-    let mut runs: Vec<&str> = Vec::new();
-    for d in all {
-        if !runs.contains(&d.run.as_str()) {
-            runs.push(&d.run);
-        }
-    }
-    runs.into_iter()
+    first_seen(all.iter().map(|d| d.run.as_str()))
+        .into_iter()
         .map(|run| {
             let of: Vec<&Detectable> = all.iter().filter(|d| d.run == run).collect();
             (run.to_string(), detectable_text(&of))

@@ -28,7 +28,7 @@
 //! the interval's coverage does not depend on it (measured in statistics.md).
 
 use crate::data::DataFilament;
-use crate::verify::diagnosis::{ModeRatio, mode_ratios};
+use crate::verify::diagnosis::{ModeRatio, first_seen, mode_ratios};
 use crate::verify::summary::SceneSummary;
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
@@ -134,13 +134,8 @@ pub struct RunFit {
 /// The fits of every run of `scene` (the summary of `check` of filament data with the
 /// sidecar's `filament`), in the order of the runs' first checks (see the module docs).
 pub fn fit_runs(scene: &SceneSummary, filament: &DataFilament) -> Vec<RunFit> {
-    let mut runs: Vec<&str> = Vec::new();
-    for c in scene.checks.iter().filter(|c| !c.run.is_empty()) {
-        if !runs.contains(&c.run.as_str()) {
-            runs.push(&c.run);
-        }
-    }
-    runs.into_iter()
+    first_seen(scene.checks.iter().map(|c| c.run.as_str()))
+        .into_iter()
         .map(|run| {
             let variance = Pooled::of(&mode_ratios(&scene.checks, run, "mode-variance"));
             let rate = Pooled::of(&mode_ratios(&scene.checks, run, "decay-rate"));
