@@ -7,7 +7,11 @@ EI and xi with kT known, kT with EI known) and compares the count with the binom
 of the nominal level: the exact two-sided 99 % range of covered counts. Pure Python
 (standard library only). Exit 0 when every parameter's count is in its range.
 
-Usage: coverage.py BIN WORKDIR [--scene S] [--run R] [--seeds N]
+Usage: coverage.py BIN WORKDIR [--scene S] [--run R] [--seeds N] [--first-seed S]
+
+Seeds S .. S+N-1 (default 1 .. N). Besides the counts it prints, per parameter, the
+variance of the normal scores ln(value/truth)/s.e.(ln) over the seeds (1 for honest
+errors), with its approximate 99 % range 1 +- 2.58 sqrt(2/(N-1)).
 """
 
 import argparse
@@ -44,13 +48,15 @@ def main():
     a.add_argument("--scene", default="hinged-linear-2d")
     a.add_argument("--run", default="crank-nicolson")
     a.add_argument("--seeds", type=int, default=100)
+    a.add_argument("--first-seed", type=int, default=1)
     args = a.parse_args()
     shutil.rmtree(args.work, ignore_errors=True)
     os.makedirs(args.work)
     covered = {"bending_rigidity": 0, "drag": 0, "kt_given_bending_rigidity": 0}
     truth = None
     rows = []
-    for seed in range(1, args.seeds + 1):
+    scores = {k: [] for k in covered}
+    for seed in range(args.first_seed, args.first_seed + args.seeds):
         data = os.path.join(args.work, f"data-{seed}")
         out = os.path.join(args.work, f"fit-{seed}")
         subprocess.run([args.bin, "-q", "run", "--scene", args.scene, "--run", args.run,
@@ -67,6 +73,7 @@ def main():
             lo, hi = fit[k]["interval"]
             ok = lo <= truth[k] <= hi
             covered[k] += ok
+            scores[k].append(math.log(fit[k]["value"] / truth[k]) / fit[k]["log_std_error"])
             row += [fit[k]["value"], lo, hi, int(ok)]
         rows.append(row)
         shutil.rmtree(data)
@@ -83,6 +90,12 @@ def main():
         print(f"{k}: {c}/{args.seeds} intervals cover the truth {truth[k]} "
               f"(nominal 95 %: {lo}-{hi} of {args.seeds} at the 99 % binomial range) "
               f"{'ok' if inside else 'OUT OF RANGE'}")
+    band = 2.576 * math.sqrt(2.0 / max(args.seeds - 1, 1))
+    for k, z in scores.items():
+        m = sum(z) / len(z)
+        v = sum((x - m) ** 2 for x in z) / max(len(z) - 1, 1)
+        print(f"{k}: normal scores ln(value/truth)/s.e. have mean {m:.3f}, variance {v:.3f} "
+              f"(honest errors: 1, about {1 - band:.2f}-{1 + band:.2f})")
     sys.exit(0 if ok else 1)
 
 
