@@ -819,3 +819,71 @@ fn membrane_bad_values_exit_2() {
         assert!(needles.iter().all(|n| err.contains(n)), "{a:?}: {err}");
     }
 }
+
+/// `converge --coupled` on the paper's scheme (fig2-paper-2d, ε = 0, 6 pairs × 0.02 τ₁
+/// per step at 0.5, 0.25, 0.125 and 0.0625 of the stability limit): the three differences
+/// are resolved
+/// (beyond 3 s.e.), the observed order has a 95 % interval containing a value within
+/// [0.8, 1.4] (the first order of the explicit step, pre-asymptotic near the limit), the
+/// output set and the index are written; `--over elements`, `--shard` and steps that are
+/// not halvings exit 2 naming the flag.
+#[test]
+fn coupled_study_resolves_the_paper_schemes_order() {
+    let v = study_json(
+        &[
+            "--scene",
+            "fig2-paper-2d",
+            "--over",
+            "dt",
+            "--coupled",
+            "--strain-ratios",
+            "0",
+            "--trajectories",
+            "6",
+            "--duration-tau1",
+            "0.02",
+        ],
+        "coupled",
+    );
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 3, "{v}");
+    for p in pts {
+        let (d, se) = (
+            p["difference"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+        );
+        assert!(d.abs() > 3.0 * se, "{p}");
+    }
+    let o = &v["orders"][0];
+    let (lo, hi) = (o["ci"][0].as_f64().unwrap(), o["ci"][1].as_f64().unwrap());
+    assert!(lo < hi && hi > 0.8 && lo < 1.4, "{o}");
+    assert_eq!(o["expected"].as_f64(), Some(1.0));
+
+    let tmp = TempDir::new("converge-coupled-bad");
+    let out = tmp.join_str("out");
+    for (extra, flag) in [
+        (&["--over", "elements"][..], "--over"),
+        (&["--over", "dt", "--shard", "1/2"][..], "--shard"),
+        (
+            &["--over", "dt", "--values", "4e-6,3e-6,1e-6"][..],
+            "--values",
+        ),
+        (
+            &["--over", "dt", "--integrator", "metropolis-crank-nicolson"][..],
+            "--integrator",
+        ),
+    ] {
+        let mut a = vec![
+            "converge",
+            "--scene",
+            "fig2-paper-2d",
+            "--coupled",
+            "--out",
+            &out,
+        ];
+        a.extend_from_slice(extra);
+        let (code, err) = run_cli(&a);
+        assert_eq!(code, 2, "{a:?}: {err}");
+        assert!(err.contains(flag), "{a:?}: {err}");
+    }
+}

@@ -13,7 +13,9 @@ use langevin_fem::shard::{Shard, ShardSet};
 use langevin_fem::studies::converge::shard::{ConvergeSettings, write_convergence_shard};
 use langevin_fem::studies::converge::{
     ConvergeOptions, ConvergeSummary, ObservableSummary, OrderFit, Over, run_convergence,
+    select_run,
 };
+use langevin_fem::studies::coupled_dt::{self, CoupledDtOptions, run_coupled_dt};
 use langevin_fem::work::WorkLimits;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -26,6 +28,7 @@ Examples:
   langevin-fem converge -s compression-2d --over elements --values 5,10,20 --strain-ratios 0 \\
       --trajectories 16 --duration-tau1 200 -o reports/convergence
   langevin-fem converge -s my-membrane.toml --over elements --values 4,8,12,16
+  langevin-fem converge -s fig2-paper-2d --over dt --coupled   the paper's scheme's order
   langevin-fem converge -s hinged-linear-2d --over dt --shard 1/2 -o cv/1   (and 2/2), then:
   langevin-fem merge cv/1 cv/2 -o reports/convergence
 
@@ -83,6 +86,16 @@ pub struct ConvergeArgs {
     /// writes the whole study, byte for byte (see the guide, docs/src/tutorials/cluster.md).
     #[arg(long, value_name = "I/N")]
     shard: Option<Shard>,
+    /// With --over dt on a compression scene (a θ-scheme: euler-maruyama, crank-nicolson):
+    /// the differences of <F> between each step and its half, from pairs of trajectories
+    /// driven by the same Brownian path, and the order of the time-step error with its
+    /// 95 % interval. --values are the steps, each half the previous (default 0.5, 0.25,
+    /// 0.125, 0.0625 of the explicit stability limit for euler-maruyama, else
+    /// 4e-3,2e-3,1e-3,5e-4); --trajectories the pairs per step and strain (default 16);
+    /// --duration-tau1 each pair's sampled time (default 0.05); --strain-ratios default
+    /// 0,2,6; --budget is not used.
+    #[arg(long)]
+    coupled: bool,
     #[command(flatten)]
     limits: super::LimitArgs,
     #[command(flatten)]
@@ -106,6 +119,9 @@ enum OverArg {
 /// orders on stdout and rebuilds the index page of the output directory; exit code 0,
 /// or 3 if every value failed (diverged or too short for its correlation time).
 pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
+    if args.coupled {
+        return run_coupled(args, verbosity);
+    }
     let out = args.out.clone();
     let shard = args.shard;
     let (opts, seed_note) = options(args, verbosity)?;
@@ -121,6 +137,105 @@ pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
         return Ok(0);
     }
     finish(&run_convergence(&opts)?, &out)
+}
+
+/// `converge --coupled`: the coupled time-step study ([`coupled_dt`]); its orders on
+/// stdout, exit code 0.
+fn run_coupled(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
+    if !matches!(args.over, OverArg::Dt) {
+        return Err(Error::invalid(
+            "--over",
+            "elements",
+            "dt with --coupled (the pairs couple a time step and its half)",
+        ));
+    }
+    if let Some(s) = args.shard {
+        return Err(Error::invalid(
+            "--shard",
+            s,
+            "no shard with --coupled (its pairs run on one machine)",
+        ));
+    }
+    let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
+    let seed_note = args.sim.apply(&mut scene);
+    let run = select_run(&scene, args.run.as_deref())?;
+    if let Some(k) = args
+        .integrator
+        .as_deref()
+        .map(parse_integrator)
+        .transpose()?
+    {
+        scene.runs[run].integrator = k;
+    }
+    let dt_tau1 = match args.values.as_deref() {
+        Some(t) => parse_list("--values", t, "a comma-separated list of numbers")?,
+        None => coupled_dt::default_steps(&scene, run)?,
+    };
+    let strain_ratios = match args.strain_ratios.as_deref() {
+        Some(t) => parse_list("--strain-ratios", t, "a comma-separated list of numbers")?,
+        None => coupled_dt::DEFAULT_STRAIN_RATIOS.to_vec(),
+    };
+    let opts = CoupledDtOptions {
+        scene,
+        run,
+        dt_tau1,
+        strain_ratios,
+        trajectories: args
+            .trajectories
+            .unwrap_or(coupled_dt::DEFAULT_TRAJECTORIES),
+        duration_tau1: args
+            .duration_tau1
+            .unwrap_or(coupled_dt::DEFAULT_DURATION_TAU1),
+        out: args.out.clone(),
+        progress: verbosity.shows_progress(),
+        limits: args.limits.limits(),
+    };
+    let s = run_coupled_dt(&opts)?;
+    write_convergence_index(&args.out)?;
+    println!(
+        "{} / {} ({} with {} noise, {seed_note}): <F>_dt - <F>_dt/2 from {} coupled pairs x {} tau1 per step and strain",
+        s.scene, s.run, s.integrator, s.noise, s.trajectories, s.duration_tau1
+    );
+    for o in &s.orders {
+        let diffs: Vec<String> = s
+            .points
+            .iter()
+            .filter(|p| p.strain_ratio == o.strain_ratio)
+            .map(|p| {
+                format!(
+                    "{:.3e}: {:+.3e} +- {:.1e} (predicted {:+.3e})",
+                    p.dt_tau1, p.difference, p.std_error, p.predicted
+                )
+            })
+            .collect();
+        println!(
+            "  eps/eps_c0 = {}: D at dt/tau1 {}",
+            o.strain_ratio,
+            diffs.join("; ")
+        );
+        match o.ci {
+            Some((lo, hi)) => println!(
+                "           observed order {:.2} [{lo:.2}, {hi:.2}] (fit p = {:.2}); predicted {}; expected {} as dt -> 0",
+                o.order,
+                o.fit_p_value,
+                if o.predicted_order.is_finite() {
+                    format!("{:.2}", o.predicted_order)
+                } else {
+                    "- (no prediction, or a predicted difference of 0)".to_string()
+                },
+                o.expected
+            ),
+            None => println!("           {}", o.note),
+        }
+    }
+    println!(
+        "wrote {} in {} ({:.1} CPU-s, {:.1} s)",
+        s.files.join(", "),
+        args.out.display(),
+        s.cpu_seconds,
+        s.wall_seconds
+    );
+    Ok(0)
 }
 
 /// `merge` of a study's shards into `out`: the whole study's output set and index.

@@ -298,13 +298,49 @@ impl<'m> NonlinearIntegrator<'m> {
 
     /// One θ-step (see [`NonlinearIntegrator`]).
     fn step_theta(&mut self, w: &mut [Vec<f64>], rng: &mut TrajectoryRng) {
-        let mut buf = std::mem::take(&mut self.theta_buffers);
-        self.evaluate(w, &mut buf);
-        for z in &mut self.zeta {
+        let mut zeta = std::mem::take(&mut self.zeta);
+        self.draw_noise(rng, &mut zeta);
+        self.theta_update(w, &zeta);
+        self.zeta = zeta;
+    }
+
+    /// Draws one step's standardized noise `ζ` into `zeta` (one vector per transverse
+    /// component, covariance C for consistent noise, the element-uniform load of eq. 5
+    /// otherwise): the draw [`NonlinearStep::step`] makes. With
+    /// [`Self::step_theta_with`], two steps of `Δt` and one of `2Δt` can share a Brownian
+    /// path: `ζ_2Δt = (ζ₁ + ζ₂)/√2` (the coupling of [`crate::studies::coupled_dt`]).
+    pub fn draw_noise(&self, rng: &mut TrajectoryRng, zeta: &mut [Vec<f64>]) {
+        for z in zeta {
             self.noise.draw(rng, z);
         }
+    }
+
+    /// One θ-step of `w` with the given standardized noise `zeta` (as drawn by
+    /// [`Self::draw_noise`]): `(C + θΔtK) w' = (C − (1−θ)ΔtK) w + Δt F(w) G w +
+    /// sqrt(2kTΔt) ζ`. For a θ-scheme, [`NonlinearStep::step`] is exactly `draw_noise`
+    /// then this.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for the Metropolis chain (its step also draws the
+    /// acceptance variate, so it has no step of a given noise alone).
+    pub fn step_theta_with(&mut self, w: &mut [Vec<f64>], zeta: &[Vec<f64>]) -> Result<()> {
+        if !matches!(self.scheme, Scheme::Theta(_)) {
+            return Err(Error::invalid(
+                "integrator",
+                self.kind,
+                "a θ-scheme (euler-maruyama, crank-nicolson, backward-euler) for a step with given noise",
+            ));
+        }
+        self.theta_update(w, zeta);
+        Ok(())
+    }
+
+    /// The θ-update of `w` with noise `zeta` (see [`Self::step_theta_with`]).
+    fn theta_update(&mut self, w: &mut [Vec<f64>], zeta: &[Vec<f64>]) {
+        let mut buf = std::mem::take(&mut self.theta_buffers);
+        self.evaluate(w, &mut buf);
         // The new state: (C + θΔtK) w' = explicit(w) + scale ζ, solved in place.
-        for ((wc, rhs), zc) in w.iter_mut().zip(&mut buf.explicit).zip(&self.zeta) {
+        for ((wc, rhs), zc) in w.iter_mut().zip(&mut buf.explicit).zip(zeta) {
             for (v, z) in rhs.iter_mut().zip(zc) {
                 *v += self.scale * z;
             }

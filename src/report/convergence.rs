@@ -13,6 +13,7 @@ use super::html::{CSS, esc, url_path};
 use crate::error::{Error, Result};
 use crate::output::{Manifest, read_manifest, write_atomic};
 use crate::studies::converge::{ConvergeSummary, OrderFit};
+use crate::studies::coupled_dt::{self, CoupledDtSummary};
 use crate::studies::fig2_schemes::{self, Fig2SchemesSummary};
 use crate::studies::output::{INDEX, STUDY_COMMANDS, stem_of_journal, summary_name};
 use crate::studies::stability::{Cell, StabilitySummary, Status};
@@ -289,6 +290,59 @@ fn fig2_schemes_section(h: &mut String, dir: &Path, journal: &str, v: &Fig2Schem
     files(h, dir, &v.files);
 }
 
+/// The coupled time-step study of one run: its orders per strain and differences.
+fn coupled_dt_section(h: &mut String, dir: &Path, journal: &str, v: &CoupledDtSummary) {
+    let _ = writeln!(
+        h,
+        "<h2>Time-step order of &lt;F&gt; from coupled pairs: {} / {} ({}, {} noise, {}D)</h2>\n<p class=\"meta\">Pairs of trajectories at a step and its half driven by the same Brownian path: {} pairs x {} tau1 per step and strain after {} tau1 of burn-in, {} elements, {:.1} CPU-s. D = &lt;F&gt;_dt − &lt;F&gt;_dt/2 (F_c0); the order is the weighted fit of ln|D| against ln dt with its 95 % interval; expected {} as dt → 0; predicted: the linear-response prediction of the scheme's exact discrete stationary covariance.</p>",
+        esc(&v.scene),
+        esc(&v.run),
+        esc(&v.integrator),
+        esc(&v.noise),
+        v.dims,
+        v.trajectories,
+        json(&v.duration_tau1),
+        json(&v.burn_in_tau1),
+        v.elements,
+        v.cpu_seconds,
+        json(&coupled_dt::EXPECTED_ORDER)
+    );
+    run_line(h, journal, &v.run_id);
+    h.push_str("<table><tr><th>eps/eps_c0</th><th>D ± s.e. per coarse dt/tau1 (predicted)</th><th>observed order [95 %]</th><th>fit p</th><th>predicted order</th></tr>\n");
+    for o in &v.orders {
+        let d = v
+            .points
+            .iter()
+            .filter(|p| p.strain_ratio == o.strain_ratio)
+            .map(|p| {
+                format!(
+                    "{}: {} ± {} ({})",
+                    num(p.dt_tau1),
+                    num(p.difference),
+                    num(p.std_error),
+                    num(p.predicted)
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        let observed = match o.ci {
+            Some((lo, hi)) => format!("{} [{}, {}]", num(o.order), num(lo), num(hi)),
+            None => esc(&o.note),
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"num\">{}</td><td class=\"detail\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            json(&o.strain_ratio),
+            esc(&d),
+            observed,
+            num(o.fit_p_value),
+            num(o.predicted_order)
+        );
+    }
+    h.push_str("</table>\n");
+    files(h, dir, &v.files);
+}
+
 /// The run id of a listed study, with a link to its journal.
 fn run_line(h: &mut String, journal: &str, run_id: &str) {
     let _ = writeln!(
@@ -389,6 +443,7 @@ enum Study {
     WorkPrecision(WorkPrecisionSummary),
     Fig2Schemes(Box<Fig2SchemesSummary>),
     Converge(Box<ConvergeSummary>),
+    CoupledDt(Box<CoupledDtSummary>),
 }
 
 impl Study {
@@ -402,7 +457,16 @@ impl Study {
                 Study::Fig2Schemes(Box::new(read(dir, &name)?))
             }
             "work-precision" => Study::WorkPrecision(read(dir, &name)?),
-            "converge" => Study::Converge(Box::new(read(dir, &name)?)),
+            // A coupled study's stem ends so; a convergence study of a run named
+            // "coupled" over dt does too, and reads as the convergence summary it is.
+            "converge" => match stem
+                .ends_with(coupled_dt::STEM_SUFFIX)
+                .then(|| read::<CoupledDtSummary>(dir, &name))
+                .flatten()
+            {
+                Some(v) => Study::CoupledDt(Box::new(v)),
+                None => Study::Converge(Box::new(read(dir, &name)?)),
+            },
             _ => return None,
         };
         let run_id = match &study {
@@ -410,6 +474,7 @@ impl Study {
             Study::WorkPrecision(v) => &v.run_id,
             Study::Fig2Schemes(v) => &v.run_id,
             Study::Converge(v) => &v.run_id,
+            Study::CoupledDt(v) => &v.run_id,
         };
         (*run_id == journal.run_id).then_some(study)
     }
@@ -420,7 +485,7 @@ impl Study {
         match self {
             Study::Stability(_) => 0,
             Study::WorkPrecision(_) | Study::Fig2Schemes(_) => 1,
-            Study::Converge(_) => 2,
+            Study::Converge(_) | Study::CoupledDt(_) => 2,
         }
     }
 }
@@ -489,6 +554,7 @@ pub fn write_convergence_index(dir: &Path) -> Result<()> {
             Study::Stability(v) => stability_section(&mut h, dir, journal, v),
             Study::WorkPrecision(v) => work_precision_section(&mut h, dir, journal, v),
             Study::Fig2Schemes(v) => fig2_schemes_section(&mut h, dir, journal, v),
+            Study::CoupledDt(v) => coupled_dt_section(&mut h, dir, journal, v),
             Study::Converge(v) => {
                 if !converge_heading {
                     h.push_str("<h2>Convergence over element count and time step</h2>\n");

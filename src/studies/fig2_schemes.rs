@@ -33,7 +33,10 @@
 //! reproducible bit for bit, every estimate is.
 
 use super::output::StudyReport;
-use super::work_precision::{require_methods, require_steps, require_trajectories};
+use super::work_precision::{
+    require_filament_compression, require_methods, require_steps, require_strains,
+    require_trajectories,
+};
 use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::beam::BeamModel;
@@ -44,7 +47,7 @@ use crate::output::{Figure, Provenance, Series, SeriesStyle};
 use crate::rng::derive_seed;
 use crate::scene::compression::{CompressionRun, ForceRecord, force_estimates};
 use crate::scene::validate::Num;
-use crate::scene::{ModelKind, RunSpec, Scene};
+use crate::scene::{RunSpec, Scene};
 use crate::stats::{self, holm};
 use crate::studies::converge::nan_if_null;
 use crate::work::{Origin, Part, WorkLimits, WorkProjection};
@@ -262,7 +265,7 @@ pub struct Fig2SchemesSummary {
 }
 
 /// The explicit scheme's stability limit 2/λ_max of the scene's bending (Δt/τ₁).
-fn em_limit_tau1(scene: &Scene) -> Result<f64> {
+pub(crate) fn em_limit_tau1(scene: &Scene) -> Result<f64> {
     let p = scene.filament;
     let beam = BeamModel::new(p, Mesh::uniform(p.length, scene.mesh.elements)?)?;
     Ok(beam.explicit_euler_dt_limit()? / p.tau1())
@@ -281,14 +284,7 @@ fn method_dts(opts: &Fig2SchemesOptions, method: (IntegratorKind, NoiseModel)) -
 }
 
 fn validate(opts: &Fig2SchemesOptions) -> Result<()> {
-    let s = &opts.scene;
-    if s.model != ModelKind::Compression || s.is_membrane() || s.compression.is_none() {
-        return Err(Error::invalid(
-            "--scene",
-            &s.name,
-            "a compression scene of a filament (e.g. fig2-paper-2d, compression-2d)",
-        ));
-    }
+    require_filament_compression(&opts.scene, "")?;
     require_methods(&opts.methods)?;
     for &(k, _) in &opts.methods {
         if k == IntegratorKind::ExactModal || k == IntegratorKind::BackwardEuler {
@@ -300,16 +296,7 @@ fn validate(opts: &Fig2SchemesOptions) -> Result<()> {
         }
     }
     require_steps(&opts.dt_tau1, 1e-7, &opts.em_fractions)?;
-    if opts.strain_ratios.is_empty() {
-        return Err(Error::invalid(
-            "--strain-ratios",
-            "(empty)",
-            "at least one strain",
-        ));
-    }
-    for &r in &opts.strain_ratios {
-        crate::error::require_in_range("--strain-ratios", r, -100.0, 100.0)?;
-    }
+    require_strains(&opts.strain_ratios)?;
     require_trajectories(opts.trajectories)?;
     crate::error::require_in_range("--duration-tau1", opts.duration_tau1, 1.0, 1e5)?;
     crate::error::require_in_range("--sample-every-tau1", opts.sample_every_tau1, 1e-5, 1.0)?;
@@ -399,7 +386,7 @@ fn label((k, n): (IntegratorKind, NoiseModel)) -> String {
 }
 
 /// User + system CPU seconds of this process so far.
-fn process_cpu_seconds() -> f64 {
+pub(crate) fn process_cpu_seconds() -> f64 {
     // SAFETY: getrusage writes into the zeroed struct it is given and reads nothing else.
     let mut u: libc::rusage = unsafe { std::mem::zeroed() };
     // SAFETY: as above; RUSAGE_SELF is a valid `who`.

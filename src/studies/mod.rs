@@ -13,11 +13,15 @@
 //! - [`fig2_schemes`]: the schemes of Fig. 2 (the paper's, Crank–Nicolson with explicit
 //!   stretching, the Metropolis chain) over Δt: the bias of ⟨F⟩, the projected CPU time to
 //!   the figure, and the autocorrelation times of F and of the buckled mode compared.
+//! - [`coupled_dt`]: the order of a θ-scheme's time-step error of ⟨F⟩ from pairs of
+//!   trajectories at a step and its half driven by the same Brownian path (`converge
+//!   --coupled`), resolved where independent runs sit at their sampling floor.
 //! - [`output`]: the shared study folder: one output set and journal per study
 //!   ([`output::StudyReport`]), so that studies keep each other's files and a rerun
 //!   replaces its own.
 
 pub mod converge;
+pub mod coupled_dt;
 pub mod fig2_schemes;
 pub mod output;
 pub mod stability;

@@ -284,6 +284,34 @@ pub(super) fn require_steps(dt_tau1: &[f64], dt_min: f64, em_fractions: &[f64]) 
     Ok(())
 }
 
+/// `scene` is a compression scene of a filament (the Fig. 2 studies: work–precision of
+/// its schemes, the coupled time-step study); `what` names the study in the message.
+pub(super) fn require_filament_compression(scene: &Scene, what: &str) -> Result<()> {
+    if scene.model != ModelKind::Compression || scene.is_membrane() || scene.compression.is_none() {
+        return Err(Error::invalid(
+            "--scene",
+            &scene.name,
+            format!("a compression scene of a filament{what} (e.g. fig2-paper-2d, compression-2d)"),
+        ));
+    }
+    Ok(())
+}
+
+/// `--strain-ratios` names at least one strain, each in [−100, 100] (the Fig. 2 studies).
+pub(super) fn require_strains(strain_ratios: &[f64]) -> Result<()> {
+    if strain_ratios.is_empty() {
+        return Err(Error::invalid(
+            "--strain-ratios",
+            "(empty)",
+            "at least one strain",
+        ));
+    }
+    for &r in strain_ratios {
+        crate::error::require_in_range("--strain-ratios", r, -100.0, 100.0)?;
+    }
+    Ok(())
+}
+
 /// `--trajectories` in [2, 1024] (both work–precision studies).
 pub(super) fn require_trajectories(trajectories: usize) -> Result<()> {
     if !(2..=1024).contains(&trajectories) {
