@@ -613,8 +613,8 @@ fn figure(opts: &CoupledDtOptions, points: &[CoupledPoint]) -> Figure {
     .caption(format!(
         "The difference of ⟨F⟩ between a step and its half ({} with {} noise), measured \
          by {} pairs of trajectories per step and strain driven by the same Brownian path \
-         ({} τ₁ each after a burn-in at the coarse step), ±1 s.e. (log–log; a point within \
-         {RESOLVED_SIGMAS} s.e. of 0 is not drawn below it). Its slope is the order of the \
+         ({} τ₁ each after a burn-in at the coarse step), ±1 s.e. (log–log; a strain with a \
+         difference within {RESOLVED_SIGMAS} s.e. of 0 gets no fitted order). Its slope is the order of the \
          scheme's time-step error of ⟨F⟩ (expected {EXPECTED_ORDER} as Δt → 0). Dashed: the \
          linear-response prediction of the scheme's exact discrete stationary covariance.",
         spec.integrator.name(),
