@@ -67,23 +67,52 @@ fn failure_detail(c: &CheckResult) -> String {
 }
 
 /// The failed line's name with the ratio estimate/reference where it means something:
-/// `run/mode-variance/n=3 (ratio 1.099 ± 0.013)`. A check of a mode without a ratio of
-/// its own (a KS or χ² test of its distribution, its mean against 0) shows the ratio of
-/// the same mode's `mode-variance` check among `checks`, named so:
-/// `run/mode-ks/n=4 (variance ratio 1.344 ± 0.007)`.
+/// `run/mode-variance/n=3 (ratio 1.099 ± 0.013)`. A check without a ratio of its own
+/// borrows that of its sibling, named so: a check of a mode (a KS or χ² test of its
+/// distribution, its mean against 0) the same mode's `mode-variance` check
+/// (`run/mode-ks/n=4 (variance ratio 1.344 ± 0.007)`), a force distribution test the
+/// same strain's `force` check (`run/force-ks/strain_ratio=10 (mean-force ratio 1.04 ±
+/// 0.01)`). Otherwise the estimate against its reference where both exist (a check
+/// against 0, a residual against its bound: `(estimate 3.1e-3 ± 8.0e-4 against 0)`),
+/// else the p-value.
 fn failed_name(c: &CheckResult, checks: &[CheckResult]) -> String {
     if let Some((r, se)) = diagnosis::ratio_of(c) {
         return format!("{} ({})", c.name, diagnosis::ratio_text(r, se));
     }
-    let sibling = checks.iter().find(|v| {
-        c.check.starts_with("mode-")
-            && v.check == "mode-variance"
-            && v.run == c.run
-            && v.parameter == c.parameter
-    });
-    match sibling.and_then(diagnosis::ratio_of) {
-        Some((r, se)) => format!("{} (variance {})", c.name, diagnosis::ratio_text(r, se)),
-        None => c.name.clone(),
+    let sibling = |kind: &str| {
+        checks
+            .iter()
+            .find(|v| v.check == kind && v.run == c.run && v.parameter == c.parameter)
+    };
+    let borrowed = if c.check.starts_with("mode-") {
+        sibling("mode-variance").map(|v| ("variance", v))
+    } else if c.check.starts_with("force-") {
+        sibling("force").map(|v| ("mean-force", v))
+    } else {
+        None
+    };
+    if let Some((what, v)) = borrowed
+        && let Some((r, se)) = diagnosis::ratio_of(v)
+    {
+        return format!("{} ({what} {})", c.name, diagnosis::ratio_text(r, se));
+    }
+    match (c.estimate, c.reference) {
+        (Some(e), Some(r)) if e.is_finite() && r.is_finite() => {
+            let se = c
+                .std_error
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .map_or(String::new(), |s| format!(" ± {s:.1e}"));
+            let r = if r == 0.0 {
+                "0".to_string()
+            } else {
+                format!("{r:.3e}")
+            };
+            format!("{} (estimate {e:.3e}{se} against {r})", c.name)
+        }
+        _ => match c.p_value {
+            Some(p) => format!("{} (p = {p:.1e})", c.name),
+            None => c.name.clone(),
+        },
     }
 }
 
@@ -235,8 +264,8 @@ mod tests {
     }
 
     /// The default failed line: the name with the ratio where the check has an estimate
-    /// and a nonzero reference; the name alone for a check against 0 or without a
-    /// p-value (a residual, an oracle).
+    /// and a nonzero reference, a sibling's ratio, the estimate against 0 or a bound, or
+    /// the p-value: never the name alone.
     #[test]
     fn failed_lines_show_the_ratio_where_it_means_something() {
         let c = check("r/mode-variance/n=3", false);
@@ -244,12 +273,24 @@ mod tests {
             failed_name(&c, &[]),
             "r/mode-variance/n=3 (ratio 1.100 ± 0.030)"
         );
+        // Against 0, or a residual without a p-value: the estimate against its reference.
         let mut zero = check("r/mode-mean/n=3", false);
         zero.reference = Some(0.0);
-        assert_eq!(failed_name(&zero, &[]), "r/mode-mean/n=3");
+        assert_eq!(
+            failed_name(&zero, &[]),
+            "r/mode-mean/n=3 (estimate 1.100e0 ± 3.0e-2 against 0)"
+        );
         let mut residual = check("r/axial-equilibrium", false);
         residual.p_value = None;
-        assert_eq!(failed_name(&residual, &[]), "r/axial-equilibrium");
+        residual.std_error = None;
+        assert_eq!(
+            failed_name(&residual, &[]),
+            "r/axial-equilibrium (estimate 1.100e0 against 1.000e0)"
+        );
+        // Neither ratio nor estimate: the p-value.
+        let mut bare = check("r/two-time", false);
+        bare.estimate = None;
+        assert_eq!(failed_name(&bare, &[]), "r/two-time (p = 4.6e-4)");
         // A mode's distribution test borrows its mode-variance check's ratio, named so.
         let at = |name: &str, check_name: &str| CheckResult {
             run: "r".into(),
@@ -266,6 +307,22 @@ mod tests {
         );
         let mut other = variance;
         other.parameter = "n=4".into();
-        assert_eq!(failed_name(&ks, &[other]), "r/mode-ks/n=3");
+        assert_eq!(failed_name(&ks, &[other]), "r/mode-ks/n=3 (p = 4.6e-4)");
+        // A force distribution test borrows the same strain's mean-force ratio.
+        let force = CheckResult {
+            check: "force".into(),
+            parameter: "strain_ratio=10".into(),
+            ..at("r/force/strain_ratio=10", "force")
+        };
+        let fks = CheckResult {
+            check: "force-ks".into(),
+            parameter: "strain_ratio=10".into(),
+            estimate: None,
+            ..at("r/force-ks/strain_ratio=10", "force-ks")
+        };
+        assert_eq!(
+            failed_name(&fks, &[force, fks.clone()]),
+            "r/force-ks/strain_ratio=10 (mean-force ratio 1.100 ± 0.030)"
+        );
     }
 }
