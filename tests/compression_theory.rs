@@ -1224,7 +1224,7 @@ fn force_ratio_is_continuous_across_the_range() {
             );
             let r_max = STRAIN_RATIO_SCALE * kappa.sqrt();
             let work = th
-                .quadrature_work(r_max * th.params().euler_strain())
+                .quadrature_work(r_max * th.params().expect("built from a filament").euler_strain())
                 .unwrap();
             worst_work = worst_work.max(work);
             assert!(
@@ -1261,7 +1261,7 @@ fn library_caps_refuse_instead_of_hanging() {
         Kind::Continuum(DEFAULT_CONTINUUM_MODES),
     );
     let work = th
-        .quadrature_work(1e8 * th.params().euler_strain())
+        .quadrature_work(1e8 * th.params().expect("built from a filament").euler_strain())
         .unwrap();
     assert!(work > MAX_QUADRATURE_WORK, "{work:e}");
     let err = th.force_ratio(1e8).unwrap_err();

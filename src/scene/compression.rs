@@ -708,18 +708,23 @@ impl CompressionRun {
     /// by up to 0.04 F_c0 (3D, 40 elements, Δt = 0.04 τ1), which the convergence study
     /// over Δt exposed.
     ///
-    /// # Panics
-    /// For a membrane run (its chain starts itself, in modal coordinates).
-    pub fn equilibrium_start(&self, rng: &mut TrajectoryRng) -> Vec<Vec<f64>> {
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a membrane run (its chain starts itself, in modal
+    /// coordinates).
+    pub fn equilibrium_start(&self, rng: &mut TrajectoryRng) -> Result<Vec<Vec<f64>>> {
         let Strained::Filament {
             models, stiffness, ..
         } = &self.object
         else {
-            panic!("the nodal equilibrium start is a filament's");
+            return Err(Error::invalid(
+                "run",
+                "a membrane",
+                "a filament for the nodal equilibrium start (a membrane's chain starts in its modes)",
+            ));
         };
         let model = &models[0];
         let kt_sqrt = model.beam().params().kt.sqrt();
-        (0..model.components())
+        Ok((0..model.components())
             .map(|_| {
                 let mut z: Vec<f64> = (0..model.beam().n_dofs())
                     .map(|_| kt_sqrt * rng.sample::<f64, _>(StandardNormal))
@@ -727,7 +732,7 @@ impl CompressionRun {
                 stiffness.solve_upper_in_place(&mut z);
                 z
             })
-            .collect()
+            .collect())
     }
 
     /// Simulates one trajectory at strain index `point` from an equilibrium start
@@ -784,7 +789,7 @@ impl CompressionRun {
         let n = model.beam().n_dofs();
         let mut z1 = vec![vec![0.0; n]; model.components()];
         let (mut z2, mut zc) = (z1.clone(), z1.clone());
-        let mut wc = self.equilibrium_start(rng);
+        let mut wc = self.equilibrium_start(rng)?;
         let diverged = |step: u64, which: &str| {
             Error::diverged(
                 step,
@@ -859,7 +864,7 @@ impl CompressionRun {
             NonlinearIntegrator::new(model, self.spec.integrator, self.spec.noise, plan.dt)?;
         let mut state = NonlinearState {
             integrator,
-            w: self.equilibrium_start(rng),
+            w: self.equilibrium_start(rng)?,
         };
         let mut recorder = ForceRecorder {
             model,

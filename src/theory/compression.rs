@@ -1352,15 +1352,10 @@ impl CompressionTheory {
         Ok(self)
     }
 
-    /// The filament's physical parameters.
-    ///
-    /// # Panics
-    /// If the theory was built by [`Self::with_constraint`] (no filament): use
-    /// [`Self::constraint`].
-    pub fn params(&self) -> &FilamentParams {
-        self.filament
-            .as_ref()
-            .expect("CompressionTheory::params: built from a GlobalConstraint, not a filament")
+    /// The filament's physical parameters; `None` if the theory was built by
+    /// [`Self::with_constraint`] (no filament: see [`Self::constraint`]).
+    pub fn params(&self) -> Option<&FilamentParams> {
+        self.filament.as_ref()
     }
 
     /// The global constraint (S, X, kT and the reference scales).
