@@ -17,27 +17,9 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$WORK" && mkdir -p "$WORK"
 SCENE=hinged-linear-2d
 
-"$PY" "$HERE/simulate.py" --out "$WORK/declared"
-"$BIN" check --scene $SCENE --data "$WORK/declared" --out "$WORK/declared-report" \
-  || { echo "FAIL: finite-difference data declared as such should pass"; exit 1; }
-"$BIN" fit --scene $SCENE --data "$WORK/declared" --out "$WORK/declared-fit" | grep -A3 "^fit "
-"$PY" - "$WORK/declared-fit/fit.json" <<'PYEOF'
-import json, sys
-fit = json.load(open(sys.argv[1]))["runs"][0]
-lo, hi = fit["bending_rigidity"]["interval"]
-assert lo <= 1.0 <= hi, f"EI interval [{lo}, {hi}] misses the simulator's EI = 1"
-print(f"fit: EI = {fit['bending_rigidity']['value']:.4f} [{lo:.4f}, {hi:.4f}] covers the simulator's EI = 1")
-PYEOF
-
-"$PY" "$HERE/simulate.py" --out "$WORK/noise" --noise-variance-factor 1.05
-set +e
-"$BIN" check --scene $SCENE --data "$WORK/noise" --out "$WORK/noise-report" > "$WORK/noise.txt"
-code=$?
-set -e
-cat "$WORK/noise.txt"
-[ "$code" -eq 1 ] || { echo "FAIL: noise variance x1.05 should fail (exit 1), got $code"; exit 1; }
-grep -Eq "failed: numpy-fd/mode-variance/n=[0-9]+ \(ratio 1\.0[0-9]+ ± " "$WORK/noise.txt" \
-  || { echo "FAIL: noise x1.05 should fail mode-variance checks, naming the mode with its ratio"; exit 1; }
+# Steps 1 and 2 (examples/declared-check.sh).
+source "$HERE/../declared-check.sh"
+declared_check finite-difference numpy-fd
 
 "$PY" "$HERE/simulate.py" --out "$WORK/unknown" --declare my-fd
 set +e

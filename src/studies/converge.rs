@@ -192,22 +192,14 @@ pub fn fit_order(h: &[f64], err: &[f64], std_errors: Option<&[f64]>) -> Option<O
     if n < 2 {
         return None;
     }
-    let sw: f64 = pts.iter().map(|p| p.2).sum();
-    let xm = pts.iter().map(|p| p.2 * p.0).sum::<f64>() / sw;
-    let ym = pts.iter().map(|p| p.2 * p.1).sum::<f64>() / sw;
-    let sxx: f64 = pts.iter().map(|p| p.2 * (p.0 - xm).powi(2)).sum();
-    if not_above(sxx, 0.0) {
-        return None;
-    }
-    let sxy: f64 = pts.iter().map(|p| p.2 * (p.0 - xm) * (p.1 - ym)).sum();
-    let order = sxy / sxx;
-    let intercept = ym - order * xm;
+    let WeightedLine {
+        slope: order,
+        intercept,
+        sxx,
+        rss,
+    } = weighted_line(&pts)?;
     let (std_error, ci) = if n > 2 {
         let dof = (n - 2) as f64;
-        let rss: f64 = pts
-            .iter()
-            .map(|p| p.2 * (p.1 - intercept - order * p.0).powi(2))
-            .sum();
         let se = (rss / dof / sxx).sqrt();
         let t = StudentsT::new(0.0, 1.0, dof)
             .map(|d| d.inverse_cdf(0.5 + CONFIDENCE / 2.0))
@@ -222,6 +214,45 @@ pub fn fit_order(h: &[f64], err: &[f64], std_errors: Option<&[f64]>) -> Option<O
         ci,
         prefactor: intercept.exp(),
         points: n,
+    })
+}
+
+/// A weighted least-squares line `y = intercept + slope·x`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct WeightedLine {
+    /// The slope.
+    pub slope: f64,
+    /// The intercept.
+    pub intercept: f64,
+    /// `Σ w (x − x̄)²` (x̄ the weighted mean): the slope's variance is `1/sxx` when the
+    /// weights are inverse variances.
+    pub sxx: f64,
+    /// The weighted residual sum of squares `Σ w (y − intercept − slope·x)²`.
+    pub rss: f64,
+}
+
+/// The weighted least-squares line through the points `(x, y, w)`; `None` if the x do
+/// not spread (`sxx` not positive). Serves [`fit_order`] and the coupled time-step study.
+pub(crate) fn weighted_line(pts: &[(f64, f64, f64)]) -> Option<WeightedLine> {
+    let sw: f64 = pts.iter().map(|p| p.2).sum();
+    let xm = pts.iter().map(|p| p.2 * p.0).sum::<f64>() / sw;
+    let ym = pts.iter().map(|p| p.2 * p.1).sum::<f64>() / sw;
+    let sxx: f64 = pts.iter().map(|p| p.2 * (p.0 - xm).powi(2)).sum();
+    if not_above(sxx, 0.0) {
+        return None;
+    }
+    let sxy: f64 = pts.iter().map(|p| p.2 * (p.0 - xm) * (p.1 - ym)).sum();
+    let slope = sxy / sxx;
+    let intercept = ym - slope * xm;
+    let rss = pts
+        .iter()
+        .map(|p| p.2 * (p.1 - intercept - slope * p.0).powi(2))
+        .sum();
+    Some(WeightedLine {
+        slope,
+        intercept,
+        sxx,
+        rss,
     })
 }
 

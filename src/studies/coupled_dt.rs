@@ -34,7 +34,8 @@
 //! its differences and their order over the same steps. Near the stability limit both are
 //! pre-asymptotic (the stiff modes' `1/(1 − λΔt/2)` is superlinear there).
 
-use super::fig2_schemes::{em_limit_tau1, process_cpu_seconds};
+use super::converge::weighted_line;
+use super::fig2_schemes::{at_strains, em_limit_tau1, process_cpu_seconds};
 use super::output::StudyReport;
 use super::work_precision::{require_filament_compression, require_strains};
 use crate::dynamics::{Family, IntegratorKind, par_indexed};
@@ -44,12 +45,13 @@ use crate::rng::{derive_seed, trajectory_rng};
 use crate::scene::Scene;
 use crate::scene::compression::{CompressionRun, CoupledRecord};
 use crate::scene::validate::Num;
+use crate::stats;
 use crate::studies::converge::nan_if_null;
 use crate::theory::compression::Dims;
 use crate::theory::scheme_law::scheme_force_ratios;
 use crate::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ChiSquared, ContinuousCDF, StudentsT};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -267,11 +269,7 @@ fn study_scene(opts: &CoupledDtOptions) -> Scene {
     let mut spec = s.runs[opts.run].clone();
     spec.dt_tau1 = opts.dt_tau1[0];
     s.runs = vec![spec];
-    if let Some(c) = s.compression.as_mut() {
-        c.strain_ratios = opts.strain_ratios.clone();
-        c.distribution_strain_ratios.clear();
-        c.halving = None;
-    }
+    at_strains(&mut s, &opts.strain_ratios);
     s
 }
 
@@ -325,16 +323,13 @@ pub fn projected_work(opts: &CoupledDtOptions) -> Result<WorkProjection> {
     })
 }
 
-/// Mean, standard error and two-sided t-test p-value of independent values.
-fn mean_test(values: &[f64]) -> (f64, f64, f64) {
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    let se = (var / n).sqrt();
-    let p = StudentsT::new(0.0, 1.0, n - 1.0)
-        .map(|t| 2.0 * t.sf((mean / se).abs()))
-        .unwrap_or(f64::NAN);
-    (mean, se, p)
+/// Mean, standard error and two-sided t-test p-value (against 0, n − 1 dof) of
+/// independent values ([`stats::ensemble_mean`], [`stats::t_test`]; p is NaN if the values
+/// do not spread).
+fn mean_test(values: &[f64]) -> Result<(f64, f64, f64)> {
+    let m = stats::ensemble_mean(values)?;
+    let p = stats::t_test(m.mean, 0.0, m.std_error, m.n).map_or(f64::NAN, |o| o.p_value);
+    Ok((m.mean, m.std_error, p))
 }
 
 /// Runs the study and writes `<stem>.{csv,json,svg}` in `opts.out` with its journal.
@@ -376,14 +371,14 @@ pub fn run_coupled_dt(opts: &CoupledDtOptions) -> Result<CoupledDtSummary> {
                 .iter()
                 .map(|p| p.difference_sum / p.steps as f64)
                 .collect();
-            let (difference, std_error, p_value) = mean_test(&diffs);
-            let means = |f: fn(&CoupledRecord) -> f64| -> (f64, f64) {
+            let (difference, std_error, p_value) = mean_test(&diffs)?;
+            let means = |f: fn(&CoupledRecord) -> f64| -> Result<(f64, f64)> {
                 let v: Vec<f64> = pairs.iter().map(|p| f(p) / p.steps as f64).collect();
-                let (m, se, _) = mean_test(&v);
-                (m, se)
+                let (m, se, _) = mean_test(&v)?;
+                Ok((m, se))
             };
-            let (coarse_mean, coarse_se) = means(|p| p.coarse_sum);
-            let (_, fine_se) = means(|p| p.fine_sum);
+            let (coarse_mean, coarse_se) = means(|p| p.coarse_sum)?;
+            let (_, fine_se) = means(|p| p.fine_sum)?;
             points.push(CoupledPoint {
                 strain_ratio: r,
                 dt_tau1: dt,
@@ -510,22 +505,17 @@ fn strain_order(strain_ratio: f64, pts: &[&CoupledPoint]) -> CoupledOrder {
             )
         })
         .collect();
-    let sw: f64 = fit.iter().map(|f| f.2).sum();
-    let xm = fit.iter().map(|f| f.2 * f.0).sum::<f64>() / sw;
-    let ym = fit.iter().map(|f| f.2 * f.1).sum::<f64>() / sw;
-    let sxx: f64 = fit.iter().map(|f| f.2 * (f.0 - xm).powi(2)).sum();
-    let sxy: f64 = fit.iter().map(|f| f.2 * (f.0 - xm) * (f.1 - ym)).sum();
-    out.order = sxy / sxx;
-    out.std_error = sxx.sqrt().recip();
+    let Some(line) = weighted_line(&fit) else {
+        out.note = "not resolved: a single step (no spread in dt)".into();
+        return out;
+    };
+    out.order = line.slope;
+    out.std_error = line.sxx.sqrt().recip();
     out.ci = Some((
         out.order - Z95 * out.std_error,
         out.order + Z95 * out.std_error,
     ));
-    let a = ym - out.order * xm;
-    out.chi2 = fit
-        .iter()
-        .map(|f| f.2 * (f.1 - a - out.order * f.0).powi(2))
-        .sum();
+    out.chi2 = line.rss;
     if out.dof > 0 {
         out.fit_p_value = ChiSquared::new(out.dof as f64).map_or(f64::NAN, |c| c.sf(out.chi2));
     }

@@ -328,12 +328,19 @@ fn point_scene(
         opts.trajectories,
         opts.duration_tau1,
     )];
+    at_strains(&mut s, &opts.strain_ratios);
+    s
+}
+
+/// Restricts a compression scene to the study's `strain_ratios` (ε/ε_c0), without the
+/// force-distribution strains and the Δt/2 run's halving: what the Fig. 2 studies (this
+/// one and [`super::coupled_dt`]) measure.
+pub(crate) fn at_strains(s: &mut Scene, strain_ratios: &[f64]) {
     if let Some(c) = s.compression.as_mut() {
-        c.strain_ratios = opts.strain_ratios.clone();
+        c.strain_ratios = strain_ratios.to_vec();
         c.distribution_strain_ratios.clear();
         c.halving = None;
     }
-    s
 }
 
 /// The projected work: one part per method and step.
