@@ -271,6 +271,7 @@ fn check(name: &str, passed: bool, p: Option<f64>) -> CheckResult {
         reference_kind: "discrete".to_string(),
         detail: "n = 4000 samples & 3 lags".to_string(),
         largest_deviation: None,
+        variance_correlation: None,
     }
 }
 

@@ -210,6 +210,7 @@ mod tests {
             unit: "[L]^2".to_string(),
             detail: String::new(),
             largest_deviation: None,
+            variance_correlation: None,
         }
     }
 

@@ -33,6 +33,13 @@
 //! [`MIN_JACKKNIFE_BLOCKS`] blocks are required. The confidence interval is
 //! λ̂ ± t_{B−1, (1+confidence)/2} · SE.
 //!
+//! **Correlation with the variance.** The same replicates give the jackknife correlation
+//! of λ̂ with the series' second moment Ĉ₀ = C_0/N (about the known or pooled mean: the
+//! variance estimate of the same data), cov_J/(SE_λ·SE_C₀) with
+//! cov_J = (B−1)/B Σ_b (λ̂_(b) − λ̄)(Ĉ₀_(b) − C̄₀). The two are not independent: a long
+//! excursion raises Ĉ₀ and slows the measured decay. A parameter estimated from both (the
+//! drag ξ ∝ 1/(Ĉ₀λ̂), `verify::fit`) needs it.
+//!
 //! The estimator is consistent and its bias is O(1/N) (ratio and logarithm
 //! nonlinearities), negligible compared with its standard error for the sample sizes at
 //! which it is used; the validation tests check the coverage of the interval.
@@ -66,6 +73,9 @@ pub struct RateEstimate {
     pub lag: usize,
     /// Number of jackknife blocks B (the interval uses B − 1 degrees of freedom).
     pub n_blocks: usize,
+    /// Jackknife correlation of λ̂ with the second moment Ĉ₀ of the same series (see the
+    /// module documentation); NaN if either has no jackknife spread.
+    pub variance_correlation: f64,
 }
 
 /// Additive sufficient statistics of one block for the lag-k ratio estimator
@@ -125,13 +135,23 @@ impl Sums {
         }
     }
 
-    /// ρ̂(k) about the (shifted) mean: 0 if the mean is known (data shifted by it),
-    /// else the mean of these sums.
+    /// The mean about which moments are taken: 0 if the mean is known (data shifted by
+    /// it), else the mean of these sums.
+    fn mu(&self, known_mean: bool) -> f64 {
+        if known_mean { 0.0 } else { self.sx / self.n }
+    }
+
+    /// The second moment Ĉ₀ = C_0/N about [`Self::mu`].
+    fn c0(&self, known_mean: bool) -> f64 {
+        let mu = self.mu(known_mean);
+        (self.sxx - 2.0 * mu * self.sx + mu * mu * self.n) / self.n
+    }
+
+    /// ρ̂(k) about [`Self::mu`].
     fn rho(&self, known_mean: bool) -> f64 {
-        let mu = if known_mean { 0.0 } else { self.sx / self.n };
-        let c0 = (self.sxx - 2.0 * mu * self.sx + mu * mu * self.n) / self.n;
+        let mu = self.mu(known_mean);
         let ck = (self.sxy - mu * (self.sh + self.st) + mu * mu * self.p) / self.p;
-        ck / c0
+        ck / self.c0(known_mean)
     }
 }
 
@@ -300,10 +320,23 @@ fn jackknife_estimate(
         .iter()
         .map(|b| rate_of(&total.sub(*b)))
         .collect::<Result<Vec<f64>>>()?;
+    let c0s: Vec<f64> = blocks.iter().map(|b| total.sub(*b).c0(known)).collect();
     let bf = n_blocks as f64;
     let rep_mean = reps.iter().sum::<f64>() / bf;
+    let c0_mean = c0s.iter().sum::<f64>() / bf;
     let var = (bf - 1.0) / bf * reps.iter().map(|r| (r - rep_mean).powi(2)).sum::<f64>();
     let std_error = var.sqrt();
+    let var_c0: f64 = c0s.iter().map(|c| (c - c0_mean).powi(2)).sum();
+    let cov: f64 = reps
+        .iter()
+        .zip(&c0s)
+        .map(|(r, c)| (r - rep_mean) * (c - c0_mean))
+        .sum();
+    let variance_correlation = if var > 0.0 && var_c0 > 0.0 {
+        (cov / (var * bf / (bf - 1.0) * var_c0).sqrt()).clamp(-1.0, 1.0)
+    } else {
+        f64::NAN
+    };
     let t = StudentsT::new(0.0, 1.0, bf - 1.0)
         .map_err(|e| numerical(e.to_string()))?
         .inverse_cdf(0.5 + 0.5 * confidence);
@@ -314,6 +347,7 @@ fn jackknife_estimate(
         ci_high: rate + t * std_error,
         lag: k,
         n_blocks,
+        variance_correlation,
     })
 }
 

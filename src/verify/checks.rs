@@ -550,7 +550,7 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
         Ok(re) => {
             m.me.rate = (re.rate, re.std_error);
             let o = stats::z_test(re.rate, rate_ref, re.std_error)?;
-            ctx.out.push(check(
+            let mut c = check(
                 format!("{prefix}/decay-rate/n={}", mr.n),
                 "z-test",
                 (re.rate, rate_ref, re.std_error),
@@ -560,7 +560,12 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
                     "-ln rho(k)/(k dt) at lag {}, {} jackknife blocks, 95% CI [{:.4e}, {:.4e}]",
                     re.lag, re.n_blocks, re.ci_low, re.ci_high
                 ),
-            ));
+            );
+            c.variance_correlation = re
+                .variance_correlation
+                .is_finite()
+                .then_some(re.variance_correlation);
+            ctx.out.push(c);
         }
         Err(e) => ctx.est.skipped.push(SkippedCheck {
             name: format!("{prefix}/decay-rate/n={}", mr.n),

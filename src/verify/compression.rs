@@ -413,6 +413,7 @@ fn residual_result(name: String, worst: f64, tolerance: f64, detail: String) -> 
         reference_kind: "discrete".to_string(),
         detail,
         largest_deviation: None,
+        variance_correlation: None,
     }
 }
 

@@ -715,6 +715,7 @@ mod tests {
                 unit: String::new(),
                 detail: String::new(),
                 largest_deviation: None,
+                variance_correlation: None,
             }
         };
         let scene = SceneSummary {

@@ -15,8 +15,13 @@
 //! ```
 //!
 //! and, with EI known instead, kT = kT₀ · exp(m_var); 95 % intervals exp(±1.96 s.e.) on
-//! the log scale (the errors of m_var and m_rate added in quadrature for ξ: different
-//! estimators of one data set, taken as independent). The modes' scatter about the
+//! the log scale. For ξ the two pooled ratios come from the same series and are
+//! correlated (a long excursion raises a mode's variance and slows its measured decay):
+//! var(m_var + m_rate) = s_var² + s_rate² + 2 Σₙ aₙbₙρₙ s_var,n s_rate,n, with aₙ, bₙ the
+//! normalized weights of mode n in the two pools, s_·,n its log errors and ρₙ its
+//! `decay-rate` check's jackknife correlation with the variance
+//! ([`crate::stats::RateEstimate::variance_correlation`]; 0 where a mode has none, e.g.
+//! in a summary written before it was recorded). The modes' scatter about the
 //! pooled value is tested (χ² of ln r about m, its p-value): a small p says one factor
 //! does not explain every mode (a mesh or a time step the references do not model).
 //!
@@ -129,6 +134,30 @@ pub struct RunFit {
     pub drag: Option<Estimate>,
     /// kT with EI known instead (the sidecar's): from the variances.
     pub kt_given_bending_rigidity: Option<Estimate>,
+    /// The correlation of the pooled log ratios m_var and m_rate that ξ's error takes
+    /// into account (see the module docs); `None` without both.
+    pub variance_rate_correlation: Option<f64>,
+}
+
+/// cov(m_var, m_rate) of the pooled log ratios `var` and `rate` (module docs): over the
+/// modes in both, the product of their normalized inverse-variance weights, log errors
+/// and `correlation(mode)`.
+fn pooled_covariance(
+    var: &[ModeRatio],
+    rate: &[ModeRatio],
+    correlation: impl Fn(&str) -> Option<f64>,
+) -> f64 {
+    let log_se = |m: &ModeRatio| m.std_error / m.ratio;
+    let total = |ms: &[ModeRatio]| ms.iter().map(|m| log_se(m).powi(-2)).sum::<f64>();
+    let (wv, wr) = (total(var), total(rate));
+    var.iter()
+        .filter_map(|v| {
+            let r = rate.iter().find(|r| r.mode == v.mode)?;
+            let rho = correlation(&v.mode)?;
+            // a·s_var·b·s_rate with a = s_var⁻²/Σ, b = s_rate⁻²/Σ.
+            Some(rho / (log_se(v) * log_se(r) * wv * wr))
+        })
+        .sum()
 }
 
 /// The fits of every run of `scene` (the summary of `check` of filament data with the
@@ -137,22 +166,37 @@ pub fn fit_runs(scene: &SceneSummary, filament: &DataFilament) -> Vec<RunFit> {
     first_seen(scene.checks.iter().map(|c| c.run.as_str()))
         .into_iter()
         .map(|run| {
-            let variance = Pooled::of(&mode_ratios(&scene.checks, run, "mode-variance"));
-            let rate = Pooled::of(&mode_ratios(&scene.checks, run, "decay-rate"));
+            let var_ratios = mode_ratios(&scene.checks, run, "mode-variance");
+            let rate_ratios = mode_ratios(&scene.checks, run, "decay-rate");
+            let variance = Pooled::of(&var_ratios);
+            let rate = Pooled::of(&rate_ratios);
+            let correlation = |mode: &str| {
+                scene
+                    .checks
+                    .iter()
+                    .find(|c| c.run == run && c.check == "decay-rate" && c.parameter == mode)
+                    .and_then(|c| c.variance_correlation)
+            };
             let ei = variance.as_ref().map(|v| {
                 Estimate::scaled(filament.bending_rigidity, -1.0, v.log_ratio, v.std_error)
             });
             let kt = variance
                 .as_ref()
                 .map(|v| Estimate::scaled(filament.kt, 1.0, v.log_ratio, v.std_error));
-            let drag = variance.as_ref().zip(rate.as_ref()).map(|(v, r)| {
+            let both = variance.as_ref().zip(rate.as_ref());
+            let cov = both.map(|_| pooled_covariance(&var_ratios, &rate_ratios, correlation));
+            let drag = both.zip(cov).map(|((v, r), cov)| {
+                let var = v.std_error.powi(2) + r.std_error.powi(2) + 2.0 * cov;
                 Estimate::scaled(
                     filament.drag,
                     -1.0,
                     v.log_ratio + r.log_ratio,
-                    v.std_error.hypot(r.std_error),
+                    var.max(0.0).sqrt(),
                 )
             });
+            let variance_rate_correlation = both
+                .zip(cov)
+                .map(|((v, r), cov)| cov / (v.std_error * r.std_error));
             RunFit {
                 run: run.to_string(),
                 variance,
@@ -160,6 +204,7 @@ pub fn fit_runs(scene: &SceneSummary, filament: &DataFilament) -> Vec<RunFit> {
                 bending_rigidity: ei,
                 drag,
                 kt_given_bending_rigidity: kt,
+                variance_rate_correlation,
             }
         })
         .collect()
@@ -221,6 +266,34 @@ mod tests {
         assert!(Pooled::of(&ratios(&[(-1.0, 0.1)])).is_none());
         assert!(Pooled::of(&ratios(&[(1.0, 0.0)])).is_none());
         assert!(Pooled::of(&[]).is_none());
+    }
+
+    /// The covariance of the pooled log ratios: one mode gives ρ·s_var·s_rate; two modes
+    /// give Σ aₙbₙρₙ s_var,n s_rate,n with the normalized inverse-variance weights; a mode
+    /// without a rate, or without a correlation, adds nothing.
+    #[test]
+    fn pooled_covariance_weights_each_modes_correlation() {
+        // Log errors 0.02 and 0.04.
+        let one = pooled_covariance(&ratios(&[(1.0, 0.02)]), &ratios(&[(2.0, 0.08)]), |_| {
+            Some(-0.5)
+        });
+        assert!((one - (-0.5 * 0.02 * 0.04)).abs() < 1e-15, "{one}");
+        let v = ratios(&[(1.0, 0.01), (1.0, 0.02)]);
+        let r = ratios(&[(1.0, 0.03), (1.0, 0.03)]);
+        let rho = |m: &str| Some(if m == "n=1" { -0.6 } else { -0.2 });
+        let a = [1e4 / 12_500.0, 2_500.0 / 12_500.0];
+        let expected = a[0] * 0.5 * -0.6 * 0.01 * 0.03 + a[1] * 0.5 * -0.2 * 0.02 * 0.03;
+        let two = pooled_covariance(&v, &r, rho);
+        assert!((two - expected).abs() < 1e-15, "{two} vs {expected}");
+        // The same weights as Pooled's: var(m_var) = Σ aₙ² s_var,n².
+        let pv = Pooled::of(&v).unwrap();
+        let sum_a2s2 = a[0] * a[0] * 1e-4 + a[1] * a[1] * 4e-4;
+        assert!((pv.std_error.powi(2) - sum_a2s2).abs() < 1e-15);
+        let none = pooled_covariance(&v, &r, |m: &str| (m == "n=1").then_some(-0.6));
+        assert!((none - a[0] * 0.5 * -0.6 * 0.01 * 0.03).abs() < 1e-15);
+        let rate_one = ratios(&[(1.0, 0.03)]);
+        let only_first = pooled_covariance(&v, &rate_one, rho);
+        assert!((only_first - a[0] * -0.6 * 0.01 * 0.03).abs() < 1e-15);
     }
 
     /// The estimates follow the scaling of the module docs: variances × 1/c (EI × c)

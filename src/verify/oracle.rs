@@ -129,6 +129,7 @@ fn oracle_check(
             band.0, band.1
         ),
         largest_deviation: None,
+        variance_correlation: None,
     }
 }
 

@@ -65,6 +65,12 @@ pub struct CheckResult {
     /// (not serialized) for every other check.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub largest_deviation: Option<LargestDeviation>,
+    /// For a `decay-rate` check, the jackknife correlation of its rate estimate with the
+    /// mean square of the same series — the estimate of the mode's `mode-variance` check
+    /// ([`crate::stats::RateEstimate::variance_correlation`]); `fit` needs it for the
+    /// drag, which takes both. Absent (not serialized) for every other check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variance_correlation: Option<f64>,
 }
 
 /// The point of a pooled check farthest from its reference (issue #31): a bias of a few
@@ -154,6 +160,7 @@ impl CheckResult {
             reference_kind: "discrete".to_string(),
             detail,
             largest_deviation: None,
+            variance_correlation: None,
         }
     }
 

@@ -39,6 +39,8 @@ pub const SEED_HOLM: u64 = 0x4013_0009;
 pub const SEED_WELCH: u64 = 0x3E1C_000A;
 /// The exact-null variance test of AR(1) series: p-value uniformity, tails, power.
 pub const SEED_QUADFORM: u64 = 0x0AD_F00B;
+/// The jackknife correlation of a decay rate with the variance of the same series.
+pub const SEED_DECAY_CORRELATION: u64 = 0xDECA_C00C;
 
 // tests/fem_model.rs
 /// Sample covariance of the noise generators.
