@@ -21,7 +21,10 @@
 //! normalized weights of mode n in the two pools, s_·,n its log errors and ρₙ its
 //! `decay-rate` check's jackknife correlation with the variance
 //! ([`crate::stats::RateEstimate::variance_correlation`]; 0 where a mode has none, e.g.
-//! in a summary written before it was recorded). The modes' scatter about the
+//! in a summary written before it was recorded). A rate's error is itself an estimate,
+//! with ν = B − 1 degrees of freedom (its jackknife's): inverse-variance weights 1/ŝ²
+//! are biased high by E[ν/χ²_ν] = ν/(ν − 2), so the pooled error would come out too
+//! small; each rate's error is scaled by √(ν/(ν − 2)) before pooling. The modes' scatter about the
 //! pooled value is tested (χ² of ln r about m, its p-value): a small p says one factor
 //! does not explain every mode (a mesh or a time step the references do not model).
 //!
@@ -139,6 +142,18 @@ pub struct RunFit {
     pub variance_rate_correlation: Option<f64>,
 }
 
+/// The factor √(ν/(ν − 2)) by which `fit` scales an error estimated with ν degrees of
+/// freedom (a decay rate's jackknife error, ν = B − 1) before pooling: the weights
+/// 1/ŝ² of an inverse-variance pool are then unbiased, E[ν/χ²_ν] = ν/(ν − 2), so that the
+/// pooled error and the modes' χ² about it are not understated. 1 without ν or for
+/// ν ≤ 2 (an exact error, e.g. a `quadratic-form` check's, has none).
+fn estimated_error_factor(dof: Option<f64>) -> f64 {
+    match dof {
+        Some(nu) if nu > 2.0 => (nu / (nu - 2.0)).sqrt(),
+        _ => 1.0,
+    }
+}
+
 /// cov(m_var, m_rate) of the pooled log ratios `var` and `rate` (module docs): over the
 /// modes in both, the product of their normalized inverse-variance weights, log errors
 /// and `correlation(mode)`.
@@ -166,17 +181,24 @@ pub fn fit_runs(scene: &SceneSummary, filament: &DataFilament) -> Vec<RunFit> {
     first_seen(scene.checks.iter().map(|c| c.run.as_str()))
         .into_iter()
         .map(|run| {
-            let var_ratios = mode_ratios(&scene.checks, run, "mode-variance");
-            let rate_ratios = mode_ratios(&scene.checks, run, "decay-rate");
-            let variance = Pooled::of(&var_ratios);
-            let rate = Pooled::of(&rate_ratios);
-            let correlation = |mode: &str| {
+            let rate_check = |mode: &str| {
                 scene
                     .checks
                     .iter()
                     .find(|c| c.run == run && c.check == "decay-rate" && c.parameter == mode)
-                    .and_then(|c| c.variance_correlation)
             };
+            let var_ratios = mode_ratios(&scene.checks, run, "mode-variance");
+            let rate_ratios: Vec<ModeRatio> = mode_ratios(&scene.checks, run, "decay-rate")
+                .into_iter()
+                .map(|mut m| {
+                    let dof = rate_check(&m.mode).and_then(|c| c.dof);
+                    m.std_error *= estimated_error_factor(dof);
+                    m
+                })
+                .collect();
+            let variance = Pooled::of(&var_ratios);
+            let rate = Pooled::of(&rate_ratios);
+            let correlation = |mode: &str| rate_check(mode).and_then(|c| c.variance_correlation);
             let ei = variance.as_ref().map(|v| {
                 Estimate::scaled(filament.bending_rigidity, -1.0, v.log_ratio, v.std_error)
             });
@@ -294,6 +316,23 @@ mod tests {
         let rate_one = ratios(&[(1.0, 0.03)]);
         let only_first = pooled_covariance(&v, &rate_one, rho);
         assert!((only_first - a[0] * -0.6 * 0.01 * 0.03).abs() < 1e-15);
+    }
+
+    /// An error estimated with ν degrees of freedom is scaled by √(ν/(ν − 2)) before
+    /// pooling (E[ν/χ²_ν] = ν/(ν − 2)); an exact one, or ν ≤ 2, is not.
+    #[test]
+    fn estimated_errors_are_debiased_before_pooling() {
+        assert!((estimated_error_factor(Some(31.0)) - (31.0f64 / 29.0).sqrt()).abs() < 1e-15);
+        assert_eq!(estimated_error_factor(None), 1.0);
+        assert_eq!(estimated_error_factor(Some(2.0)), 1.0);
+        // The expectation it corrects, by quadrature over the χ²₃₁ law: E[31/χ²] = 31/29.
+        let chi = ChiSquared::new(31.0).unwrap();
+        let n = 20_000;
+        let mean: f64 = (0..n)
+            .map(|k| 31.0 / chi.inverse_cdf((k as f64 + 0.5) / n as f64))
+            .sum::<f64>()
+            / n as f64;
+        assert!((mean - 31.0 / 29.0).abs() < 1e-3, "{mean}");
     }
 
     /// The estimates follow the scaling of the module docs: variances × 1/c (EI × c)
