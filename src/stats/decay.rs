@@ -316,11 +316,16 @@ fn jackknife_estimate(
     };
     let total = blocks.iter().copied().fold(Sums::default(), Sums::add);
     let rate = rate_of(&total)?;
-    let reps = blocks
+    // Each delete-one-block replicate: its rate and its second moment.
+    let (reps, c0s): (Vec<f64>, Vec<f64>) = blocks
         .iter()
-        .map(|b| rate_of(&total.sub(*b)))
-        .collect::<Result<Vec<f64>>>()?;
-    let c0s: Vec<f64> = blocks.iter().map(|b| total.sub(*b).c0(known)).collect();
+        .map(|b| {
+            let rest = total.sub(*b);
+            Ok((rate_of(&rest)?, rest.c0(known)))
+        })
+        .collect::<Result<Vec<(f64, f64)>>>()?
+        .into_iter()
+        .unzip();
     let bf = n_blocks as f64;
     let rep_mean = reps.iter().sum::<f64>() / bf;
     let c0_mean = c0s.iter().sum::<f64>() / bf;
