@@ -25,13 +25,13 @@ mod common;
 
 use common::seeds::{
     SEED_AR1_MOMENTS, SEED_AR1_POOLED_TAU, SEED_AR1_TAU, SEED_BLOCKING, SEED_DECAY,
-    SEED_DECAY_CORRELATION, SEED_DECAY_POWER, SEED_HOLM, SEED_IID_MEAN, SEED_NULL, SEED_POWER,
-    SEED_QUADFORM, SEED_WELCH,
+    SEED_DECAY_CORRELATION, SEED_DECAY_POWER, SEED_GOF_BINS, SEED_HOLM, SEED_IID_MEAN, SEED_NULL,
+    SEED_POWER, SEED_QUADFORM, SEED_WELCH,
 };
 use langevin_fem::rng::trajectory_rng;
 use langevin_fem::stats::{
     Ar1SquareSum, TestOutcome, ar1_square_sum_test, blocking_std_error, chi2_gof_normal,
-    chi2_sum_test, chi2_variance_test, decay_rate, ensemble_mean, holm,
+    chi2_sum_test, chi2_variance_test, decay_rate, ensemble_mean, gof_bins, holm,
     integrated_autocorrelation_time, ks_normal, mean_with_error,
     pooled_integrated_autocorrelation_time, variance_with_error, welch, welch_pooled, z_test,
 };
@@ -480,6 +480,47 @@ fn hypothesis_tests_have_power_against_five_percent_misfit() {
     for (name, r) in ["chi2_variance", "ks", "chi2_gof"].iter().zip(rejections) {
         assert!(r >= 90, "{name}: power {r}/{N_SEEDS} < 90 %");
     }
+}
+
+/// The χ² goodness of fit at [`gof_bins`]: with its bins growing with the sample it keeps
+/// its nominal size (300 seeds of n = 20 000 i.i.d. N(0.3, 2²), 105 bins: rejection rate
+/// at α = 0.05 in the binomial band, p-values uniform), and a sample whose every value
+/// appears twice (a second component that copies the first) is rejected more surely the
+/// larger the sample: the duplicates double every count, so X² is exactly twice that of
+/// the distinct values (2χ²(k − 1)), which exceeds the α = 1e-4 quantile of χ²(k − 1)
+/// with probability 0.14 at the fixed 20 bins and 0.985 at k = 138 (n = 40 000). 50 seeds: at least 45 rejections with the grown bins, at most
+/// 20 with 20 bins.
+#[test]
+fn gof_bins_keep_the_size_and_reject_duplicated_samples_more_surely() {
+    let (mu, sd) = (0.3, 2.0);
+    let n = 20_000;
+    assert_eq!(gof_bins(n), 105);
+    let p: Vec<f64> = (0..300)
+        .map(|s| {
+            let x = gauss(SEED_GOF_BINS, s, n, mu, sd);
+            chi2_gof_normal(&x, mu, sd, gof_bins(n)).unwrap().p_value
+        })
+        .collect();
+    assert_rate(
+        "chi2_gof at gof_bins false rejections",
+        p.iter().filter(|&&q| q < 0.05).count(),
+        p.len(),
+        0.05,
+    );
+    assert_uniform("chi2_gof at gof_bins", &p);
+    let (mut grown, mut fixed) = (0, 0);
+    for s in 0..50 {
+        let x = gauss(SEED_GOF_BINS, 1000 + s, 20_000, 0.0, 1.0);
+        let twice: Vec<f64> = x.iter().chain(&x).copied().collect();
+        assert_eq!(gof_bins(twice.len()), 138);
+        grown += (chi2_gof_normal(&twice, 0.0, 1.0, gof_bins(twice.len()))
+            .unwrap()
+            .p_value
+            < 1e-4) as usize;
+        fixed += (chi2_gof_normal(&twice, 0.0, 1.0, 20).unwrap().p_value < 1e-4) as usize;
+    }
+    assert!(grown >= 45, "grown bins rejected duplicates in {grown}/50");
+    assert!(fixed <= 20, "20 bins rejected duplicates in {fixed}/50");
 }
 
 /// Power of the decay-rate z-test: AR(1), ρ = 0.9, one series of 4·10^5 samples per seed,

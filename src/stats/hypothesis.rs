@@ -105,6 +105,20 @@ fn ks_against<D: ContinuousCDF<f64, f64>>(samples: &[f64], dist: &D) -> Result<T
     })
 }
 
+/// The number of equiprobable bins for a χ² goodness-of-fit test of `n` samples.
+///
+/// Moore's rule k = ⌊2 n^{2/5}⌋ (D. S. Moore, "Tests of chi-squared type", ch. 3 of
+/// D'Agostino & Stephens, *Goodness-of-Fit Techniques*, 1986; the Mann–Wald n^{2/5}
+/// growth), but never fewer than 20 bins while every bin can expect at least 10 samples,
+/// and never fewer than 4: k = max(4, min(⌊n/10⌋, max(20, ⌊2 n^{2/5}⌋))). Up to
+/// n ≈ 316 this is the fixed rule min(⌊n/10⌋, 20) the checks used before; beyond, the bins
+/// grow with the data, so a larger sample resolves the distribution more finely instead
+/// of pooling it into the same 20 bins (at n = 4·10⁵, 357 bins of about 1 200 samples).
+pub fn gof_bins(n: usize) -> usize {
+    let moore = (2.0 * (n as f64).powf(0.4)).floor() as usize;
+    (n / 10).min(moore.max(20)).max(4)
+}
+
 /// Pearson χ² goodness-of-fit test of independent `samples` against N(mean, std_dev²)
 /// with `n_bins` equiprobable bins.
 ///
@@ -373,6 +387,21 @@ mod tests {
         assert!(t.statistic.abs() < 1e-12);
         assert!((t.p_value - 1.0).abs() < 1e-12);
         assert_eq!(t.dof, Some(7.0));
+    }
+
+    #[test]
+    fn gof_bins_is_the_fixed_rule_up_to_316_samples_then_moore() {
+        for n in 0..=316 {
+            assert_eq!(gof_bins(n), (n / 10).clamp(4, 20), "n = {n}");
+        }
+        // 2·1000^0.4 = 31.70, 2·10⁴^0.4 = 79.62, 2·426 688^0.4 = 357.2.
+        assert_eq!(gof_bins(1000), 31);
+        assert_eq!(gof_bins(10_000), 79);
+        assert_eq!(gof_bins(426_688), 357);
+        // At least 10 expected per bin wherever there are 40 samples or more.
+        for n in (40..200_000).step_by(997) {
+            assert!(n / gof_bins(n) >= 10, "n = {n}");
+        }
     }
 
     #[test]

@@ -46,8 +46,8 @@ pub mod spectrum;
 pub use acf::{autocorrelation, autocovariance};
 pub use decay::{RateEstimate, decay_rate};
 pub use hypothesis::{
-    TestOutcome, chi2_gof_normal, chi2_sum_test, chi2_variance_test, equivalent_z, holm, ks_normal,
-    ks_test, t_test, z_test,
+    TestOutcome, chi2_gof_normal, chi2_sum_test, chi2_variance_test, equivalent_z, gof_bins, holm,
+    ks_normal, ks_test, t_test, z_test,
 };
 pub use moments::{
     IatEstimate, MeanEstimate, blocking_std_error, combine_independent, ensemble_mean,

@@ -501,7 +501,8 @@ fn mode_variance_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Res
 }
 
 /// [`CheckKind::ModeDistribution`]: the amplitude distribution of a mode against the
-/// normal law of the exact discrete variance (KS and χ² goodness of fit, thinned samples).
+/// normal law of the exact discrete variance (KS and χ² goodness of fit, thinned samples;
+/// the χ² bins grow with the sample as [`stats::gof_bins`] says).
 fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result<()> {
     let mr = &ctx.run.reference.modes[m.i];
     let prefix = &ctx.run.spec.name;
@@ -520,7 +521,7 @@ fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) ->
             thinned.len()
         ),
     ));
-    let bins = (thinned.len() / 10).clamp(4, 20);
+    let bins = stats::gof_bins(thinned.len());
     let o = stats::chi2_gof_normal(thinned, 0.0, sd, bins)?;
     ctx.out.push(check(
         format!("{prefix}/mode-chi2-gof/n={}", mr.n),

@@ -41,6 +41,8 @@ pub const SEED_WELCH: u64 = 0x3E1C_000A;
 pub const SEED_QUADFORM: u64 = 0x0AD_F00B;
 /// The jackknife correlation of a decay rate with the variance of the same series.
 pub const SEED_DECAY_CORRELATION: u64 = 0xDECA_C00C;
+/// The χ² goodness of fit with bins growing with the sample: null and duplicated samples.
+pub const SEED_GOF_BINS: u64 = 0x0B1D_500D;
 
 // tests/fem_model.rs
 /// Sample covariance of the noise generators.
