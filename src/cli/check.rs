@@ -4,6 +4,7 @@
 use super::Verbosity;
 use super::terminal::{print_scenes, totals_line};
 use clap::Args;
+use langevin_fem::data::DataSidecar;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::output::ReportRun;
 use langevin_fem::report::write_report;
@@ -57,7 +58,8 @@ pub struct CheckArgs {
 /// and the totals on stdout at `verbosity` ([`super::terminal`]).
 pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
-    let (_, summary, report) = evaluate(&args)?;
+    let sidecar = load_data(&args)?;
+    let (_, summary, report) = evaluate(&args, &sidecar)?;
     write_report(report, &summary)?;
     print_verdict(&args, &summary, verbosity, start, &[]);
     Ok(if summary.passed { 0 } else { 1 })
@@ -91,12 +93,12 @@ pub(super) fn print_verdict(
     );
 }
 
-/// The checks of `args`: the scene, the summary and the report (its files written, its
-/// index and summary not yet).
+/// The flags of `args` validated and the data's sidecar (`data.json`) read, once: what
+/// [`evaluate`] checks and `fit` reads the filament's parameters from.
 ///
 /// # Errors
-/// Invalid flags, scene or data; the checks' errors.
-pub(super) fn evaluate(args: &CheckArgs) -> Result<(Scene, Summary, ReportRun)> {
+/// Invalid flags (`--alpha`, `--data` not a directory or inside `--out`) or sidecar.
+pub(super) fn load_data(args: &CheckArgs) -> Result<DataSidecar> {
     if !(args.alpha.is_finite() && args.alpha > 0.0 && args.alpha < 0.5) {
         return Err(Error::invalid("--alpha", args.alpha, "in (0, 0.5)"));
     }
@@ -108,9 +110,22 @@ pub(super) fn evaluate(args: &CheckArgs) -> Result<(Scene, Summary, ReportRun)> 
         ));
     }
     langevin_fem::input::refuse_input_in_output(&args.out, &args.data, "--data")?;
+    DataSidecar::load(&args.data)
+}
+
+/// The checks of `args` on the data `sidecar` describes (from [`load_data`]): the scene,
+/// the summary and the report (its files written, its index and summary not yet).
+///
+/// # Errors
+/// An invalid scene or data; the checks' errors (as [`check_data`]).
+pub(super) fn evaluate(
+    args: &CheckArgs,
+    sidecar: &DataSidecar,
+) -> Result<(Scene, Summary, ReportRun)> {
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     let (summary, report) = check_data(
         &scene,
+        sidecar,
         &args.data,
         &args.out,
         args.alpha,

@@ -3,9 +3,8 @@
 //! ([`langevin_fem::verify::fit`]), from the checks `check` applies to the same data.
 
 use super::Verbosity;
-use super::check::{CheckArgs, evaluate, print_verdict};
+use super::check::{CheckArgs, evaluate, load_data, print_verdict};
 use clap::Args;
-use langevin_fem::data::DataSidecar;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::verify::fit::{RunFit, estimate_text, fit_runs};
@@ -45,15 +44,15 @@ struct FitFile<'a> {
 pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
     let args = args.check;
-    let sidecar = DataSidecar::load(&args.data)?;
-    let Some(filament) = sidecar.filament else {
+    let sidecar = load_data(&args)?;
+    let Some(filament) = &sidecar.filament else {
         return Err(Error::invalid(
             "--data",
             args.data.display(),
             "filament data (a `filament` table in data.json): fit estimates EI and xi of a filament",
         ));
     };
-    let (scene, mut summary, report) = evaluate(&args)?;
+    let (scene, mut summary, report) = evaluate(&args, &sidecar)?;
     if scene.compression.is_some() {
         return Err(Error::invalid(
             "--scene",
@@ -61,7 +60,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             "a linear scene (mode variances and decay rates): a compression scene's force data do not fit EI this way",
         ));
     }
-    let fits = fit_runs(&summary.scenes[0], &filament);
+    let fits = fit_runs(&summary.scenes[0], filament);
     let mut lines = Vec::new();
     for f in &fits {
         let (Some(v), Some(ei), Some(kt)) = (

@@ -1366,8 +1366,10 @@ fn apply_linear_checks(
     Ok(est)
 }
 
-/// Applies `scene`'s checks to the trajectory data in `data_dir` (any program's, in the
-/// format of [`crate::data`]; see [`crate::verify::data`]) and writes the report to
+/// Applies `scene`'s checks to the trajectory data in `data_dir`, described by its
+/// `sidecar` (`data.json`, read once by the caller: [`crate::data::DataSidecar::load`];
+/// any program's data, in the format of [`crate::data`]; see [`crate::verify::data`])
+/// and writes the report to
 /// `out` as `verify` does (summary, index, per-run tables and figures, journal); returns
 /// the summary (budget `data`) and the report run, to be finished by
 /// [`crate::report::write_report`]. The trajectory files listed may hold at most
@@ -1379,25 +1381,25 @@ fn apply_linear_checks(
 /// (exit 3): an estimator that finds no answer in the data.
 pub fn check_data(
     scene: &Scene,
+    sidecar: &crate::data::DataSidecar,
     data_dir: &Path,
     out: &Path,
     alpha: f64,
     max_bytes: u64,
 ) -> Result<(Summary, ReportRun)> {
-    let sidecar = crate::data::DataSidecar::load(data_dir)?;
-    crate::verify::data::check_data_kind(scene, &sidecar, data_dir)?;
-    crate::verify::data::require_data_size(&sidecar, data_dir, max_bytes)?;
+    crate::verify::data::check_data_kind(scene, sidecar, data_dir)?;
+    crate::verify::data::require_data_size(sidecar, data_dir, max_bytes)?;
     if scene.compression.is_some() {
-        return check_compression_data(scene, &sidecar, data_dir, out, alpha, max_bytes);
+        return check_compression_data(scene, sidecar, data_dir, out, alpha, max_bytes);
     }
     let prepared = (0..sidecar.runs.len())
-        .map(|k| crate::verify::data::prepare_data_check(scene, &sidecar, data_dir, k, max_bytes))
+        .map(|k| crate::verify::data::prepare_data_check(scene, sidecar, data_dir, k, max_bytes))
         .collect::<Result<Vec<_>>>()?;
     let report = begin_check(scene, out)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
-    lead_with_data(&mut outputs, scene, data_note(&sidecar, data_dir));
+    lead_with_data(&mut outputs, scene, data_note(sidecar, data_dir));
     for (data, dc) in sidecar.runs.iter().zip(&prepared) {
         outputs.runs.push(data.name.clone());
         let first_check = outputs.checks.len();
