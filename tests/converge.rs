@@ -872,6 +872,7 @@ fn coupled_study_resolves_the_paper_schemes_order() {
             &["--over", "dt", "--integrator", "metropolis-crank-nicolson"][..],
             "--integrator",
         ),
+        (&["--over", "dt", "--budget", "standard"][..], "--budget"),
     ] {
         let mut a = vec![
             "converge",

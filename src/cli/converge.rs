@@ -93,7 +93,7 @@ pub struct ConvergeArgs {
     /// 0.125, 0.0625 of the explicit stability limit for euler-maruyama, else
     /// 4e-3,2e-3,1e-3,5e-4); --trajectories the pairs per step and strain (default 16);
     /// --duration-tau1 each pair's sampled time (default 0.05); --strain-ratios default
-    /// 0,2,6; --budget is not used.
+    /// 0,2,6; a --budget other than quick is refused (size it with those two flags).
     #[arg(long)]
     coupled: bool,
     #[command(flatten)]
@@ -154,6 +154,18 @@ fn run_coupled(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
             "--shard",
             s,
             "no shard with --coupled (its pairs run on one machine)",
+        ));
+    }
+    if !matches!(args.budget, BudgetArg::Quick) {
+        return Err(Error::invalid(
+            "--budget",
+            args.budget.budget().name(),
+            format!(
+                "quick (the default) with --coupled: the coupled study is sized by --trajectories \
+                 (pairs per step and strain, default {}) and --duration-tau1 (default {})",
+                coupled_dt::DEFAULT_TRAJECTORIES,
+                coupled_dt::DEFAULT_DURATION_TAU1
+            ),
         ));
     }
     let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
