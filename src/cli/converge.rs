@@ -142,6 +142,20 @@ pub fn run(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
 /// `converge --coupled`: the coupled time-step study ([`coupled_dt`]); its orders on
 /// stdout, exit code 0.
 fn run_coupled(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
+    let out = args.out.clone();
+    let (opts, seed_note) = coupled_options(args, verbosity)?;
+    let s = run_coupled_dt(&opts)?;
+    write_convergence_index(&out)?;
+    print_coupled(&s, &seed_note, &out);
+    Ok(0)
+}
+
+/// The options of `converge --coupled` from its flags, and the note on the seed.
+///
+/// # Errors
+/// Exit 2 for flags the coupled study does not take (`--over elements`, `--shard`, a
+/// `--budget` other than quick) or that do not parse, and for a scene or run refused.
+fn coupled_options(args: ConvergeArgs, verbosity: Verbosity) -> Result<(CoupledDtOptions, String)> {
     if !matches!(args.over, OverArg::Dt) {
         return Err(Error::invalid(
             "--over",
@@ -202,8 +216,12 @@ fn run_coupled(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
         progress: verbosity.shows_progress(),
         limits: args.limits.limits(),
     };
-    let s = run_coupled_dt(&opts)?;
-    write_convergence_index(&args.out)?;
+    Ok((opts, seed_note))
+}
+
+/// Prints the coupled study `s` (written to `out`): per strain the differences and the
+/// observed order with its interval, then the files written.
+fn print_coupled(s: &coupled_dt::CoupledDtSummary, seed_note: &str, out: &Path) {
     println!(
         "{} / {} ({} with {} noise, {seed_note}): <F>_dt - <F>_dt/2 from {} coupled pairs x {} tau1 per step and strain",
         s.scene, s.run, s.integrator, s.noise, s.trajectories, s.duration_tau1
@@ -243,11 +261,10 @@ fn run_coupled(args: ConvergeArgs, verbosity: Verbosity) -> Result<i32> {
     println!(
         "wrote {} in {} ({:.1} CPU-s, {:.1} s)",
         s.files.join(", "),
-        args.out.display(),
+        out.display(),
         s.cpu_seconds,
         s.wall_seconds
     );
-    Ok(0)
 }
 
 /// `merge` of a study's shards into `out`: the whole study's output set and index.
