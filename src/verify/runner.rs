@@ -1368,12 +1368,12 @@ fn apply_linear_checks(
 
 /// Applies `scene`'s checks to the trajectory data in `data_dir`, described by its
 /// `sidecar` (`data.json`, read once by the caller: [`crate::data::DataSidecar::load`];
-/// any program's data, in the format of [`crate::data`]; see [`crate::verify::data`])
-/// and writes the report to
-/// `out` as `verify` does (summary, index, per-run tables and figures, journal); returns
-/// the summary (budget `data`) and the report run, to be finished by
-/// [`crate::report::write_report`]. The trajectory files listed may hold at most
-/// `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is read.
+/// any program's data, in the format of [`crate::data`]; see [`crate::verify::data`]),
+/// and writes the report to `out` as `verify` does (summary, index, per-run tables and
+/// figures, journal); returns the summary (budget `data`) and the report run, to be
+/// finished by [`crate::report::write_report`]. The trajectory files listed may hold at
+/// most `max_bytes` together (the memory cap, `--max-memory-gib`): above it nothing is
+/// read.
 ///
 /// # Errors
 /// Input (exit 2): a bad sidecar or trajectory file, data of the other kind or object
