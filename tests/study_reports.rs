@@ -3,7 +3,7 @@
 //!
 //! What: (1) `stability` and `converge` killed (SIGKILL) at seeded-random moments — some
 //! spread over the whole run, some just after the study starts writing (its journal turns
-//! incomplete) — and rerun to completion leave a consistent folder: no temporary file;
+//! incomplete; chased with immediate kills until one lands while it writes) — and rerun to completion leave a consistent folder: no temporary file;
 //! `index.html` lists exactly the studies whose journal (`<stem>.manifest.json`) is
 //! complete, each with its journal's run id; every file of the folder is named by a
 //! complete journal (verify's `extreme/` report apart); every file a complete journal
@@ -32,6 +32,8 @@ use std::time::{Duration, Instant};
 const KILLS: u64 = 4;
 /// Seed of the kill moments.
 const KILL_SEED: u64 = 0x5eed_0512;
+/// At most this many immediate kills chase the writing window if no seeded kill hit it.
+const CHASES: u64 = 40;
 
 /// `stability`: 10 elements, below and above the explicit limit, 20000 steps.
 fn stability_args(out: &Path, integrators: &str) -> Vec<String> {
@@ -285,7 +287,9 @@ fn kill_during(args: &[String], delay: Duration, at_writing: Option<&str>, out: 
         }
         Some(journal) => loop {
             if writing(out, journal, &before) {
-                std::thread::sleep(delay);
+                if !delay.is_zero() {
+                    std::thread::sleep(delay);
+                }
                 break format!("killed {delay:?} after writing started");
             }
             if child.try_wait().expect("wait").is_some() {
@@ -294,7 +298,11 @@ fn kill_during(args: &[String], delay: Duration, at_writing: Option<&str>, out: 
             if start.elapsed() > Duration::from_secs(30) {
                 break "killed after 30 s without writing".to_string();
             }
-            std::thread::sleep(Duration::from_micros(200));
+            if delay.is_zero() {
+                std::thread::yield_now();
+            } else {
+                std::thread::sleep(Duration::from_micros(200));
+            }
         },
     };
     let _ = child.kill();
@@ -302,9 +310,34 @@ fn kill_during(args: &[String], delay: Duration, at_writing: Option<&str>, out: 
     format!("{} {what} (status {status})", args[0])
 }
 
+/// Kills `args` ([`kill_during`]), checks that every file left is attributable, reruns
+/// it to completion and checks the folder is consistent. Returns what happened and what
+/// the kill left of the study's journal `journal`.
+fn kill_check_rerun(
+    args: &[String],
+    journal: &str,
+    delay: Duration,
+    at_writing: Option<&str>,
+    out: &Path,
+) -> String {
+    let what = kill_during(args, delay, at_writing, out);
+    let left = match journals(out).iter().find(|j| j.name == journal) {
+        Some(j) if j.complete => "its journal complete",
+        Some(_) => "its journal incomplete",
+        None => "no journal",
+    };
+    let what = format!("{what}, leaving {left}");
+    eprintln!("{what}");
+    assert_attributable(out, &what);
+    run_ok(args);
+    assert_consistent(out, &format!("{what}, then rerun"));
+    what
+}
+
 /// (1) Killed at seeded-random moments and rerun: always a consistent folder. The first
 /// half of each study's kills are spread over its whole run, the second half land within
-/// a millisecond after it starts writing (at least one of them while it writes).
+/// a millisecond after it starts writing; if none of them landed while it writes, further
+/// immediate kills chase that window until one does.
 #[test]
 fn studies_killed_at_random_moments_and_rerun_leave_a_consistent_folder() {
     let dir = TempDir::new("study-kill");
@@ -319,42 +352,40 @@ fn studies_killed_at_random_moments_and_rerun_leave_a_consistent_folder() {
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("extreme/index.html"), "verify's link kept");
 
+    let studies = [
+        (&stability, "stability.manifest.json"),
+        (
+            &converge,
+            "compression-2d-metropolis-elements.manifest.json",
+        ),
+    ];
     let mut state = KILL_SEED;
     let mut outcomes = Vec::new();
     for i in 0..KILLS {
-        for (k, (args, journal)) in [
-            (&stability, "stability.manifest.json"),
-            (
-                &converge,
-                "compression-2d-metropolis-elements.manifest.json",
-            ),
-        ]
-        .into_iter()
-        .enumerate()
-        {
+        for (k, &(args, journal)) in studies.iter().enumerate() {
             let u = uniform(&mut state);
-            let what = if i < KILLS / 2 {
-                kill_during(args, full[k].mul_f64(u), None, &out)
+            let (delay, at_writing) = if i < KILLS / 2 {
+                (full[k].mul_f64(u), None)
             } else {
-                let delay = Duration::from_micros((u * 1000.0) as u64);
-                kill_during(args, delay, Some(journal), &out)
+                (Duration::from_micros((u * 1000.0) as u64), Some(journal))
             };
-            let left = match journals(&out).iter().find(|j| j.name == journal) {
-                Some(j) if j.complete => "its journal complete",
-                Some(_) => "its journal incomplete",
-                None => "no journal",
-            };
-            let what = format!("{what}, leaving {left}");
-            eprintln!("{what}");
-            let ctx = format!("kill {i}: {what}");
-            assert_attributable(&out, &ctx);
-            run_ok(args);
-            assert_consistent(&out, &format!("{ctx}, then rerun"));
-            outcomes.push(what);
+            let what = kill_check_rerun(args, journal, delay, at_writing, &out);
+            outcomes.push(format!("kill {i}: {what}"));
         }
     }
-    // The targeted kills (within 1 ms of the first journal write) exercised the window
-    // in which a study's files and journal are half-written.
+    // The window in which a study's files and journal are half-written lasts a few
+    // hundred microseconds, so the seeded delays may all miss it on a fast disk. Until a
+    // kill has landed in it, chase it: kill as soon as the journal turns incomplete
+    // (polled without sleeping), alternating the studies, at most CHASES times.
+    let mut chases = 0;
+    while !outcomes.iter().any(|w| w.ends_with("journal incomplete")) && chases < CHASES {
+        let (args, journal) = studies[(chases % 2) as usize];
+        let what = kill_check_rerun(args, journal, Duration::ZERO, Some(journal), &out);
+        outcomes.push(format!("chase {chases}: {what}"));
+        chases += 1;
+    }
+    // The targeted kills exercised the window in which a study's files and journal are
+    // half-written.
     assert!(
         outcomes.iter().any(|w| w.ends_with("journal incomplete")),
         "no kill landed while a study was writing: {outcomes:#?}"
