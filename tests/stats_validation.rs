@@ -26,14 +26,17 @@ mod common;
 use common::seeds::{
     SEED_AR1_MOMENTS, SEED_AR1_POOLED_TAU, SEED_AR1_TAU, SEED_BLOCKING, SEED_DECAY,
     SEED_DECAY_CORRELATION, SEED_DECAY_POWER, SEED_GOF_BINS, SEED_HOLM, SEED_IID_MEAN, SEED_NULL,
-    SEED_POWER, SEED_QUADFORM, SEED_WELCH,
+    SEED_POWER, SEED_PRODUCTS, SEED_QUADFORM, SEED_WELCH, SEED_WHITTLE,
 };
 use langevin_fem::rng::trajectory_rng;
+use langevin_fem::scene::Scene;
+use langevin_fem::scene::linear::LinearRun;
 use langevin_fem::stats::{
-    Ar1SquareSum, TestOutcome, ar1_square_sum_test, blocking_std_error, chi2_gof_normal,
-    chi2_sum_test, chi2_variance_test, decay_rate, ensemble_mean, gof_bins, holm,
-    integrated_autocorrelation_time, ks_normal, mean_with_error,
-    pooled_integrated_autocorrelation_time, variance_with_error, welch, welch_pooled, z_test,
+    Ar1SquareSum, SquareSumLaw, TestOutcome, WeightedChiSquares, ar1_square_sum_test,
+    blocking_std_error, chi2_gof_normal, chi2_sum_test, chi2_variance_test, decay_rate,
+    ensemble_mean, gof_bins, holm, integrated_autocorrelation_time, ks_normal, mean_with_error,
+    pooled_integrated_autocorrelation_time, square_sum_test, sum_test, variance_with_error, welch,
+    welch_pooled, z_test,
 };
 use rand::RngExt;
 use rand_distr::StandardNormal;
@@ -819,4 +822,264 @@ fn ar1_square_sum_test_rejects_wrong_variances_without_saturating() {
         "10 % variance error: p = {:e}",
         ten.p_value
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// The null law of the profile check: a field that is a sum of correlated AR(1) modes.
+// ---------------------------------------------------------------------------------------
+
+/// A field `x_t = q₁ + q₂` of two AR(1) modes with lag correlations `rho` and innovations
+/// of unit variance correlated by `c` (as a finite-element field under the paper's
+/// element-uniform noise: the modes share their driving), started in the stationary law;
+/// `count` series of `len` samples. Returns the series and the exact autocovariance terms
+/// `(u_i, ρ_i)`, `u_i = (S·1)_i`, `S_ij = Q_ij/(1 − ρ_iρ_j)`.
+#[allow(clippy::type_complexity)]
+fn two_mode_field(
+    index0: u64,
+    count: usize,
+    len: usize,
+    rho: [f64; 2],
+    c: f64,
+) -> (Vec<Vec<f64>>, Vec<(f64, f64)>) {
+    let s = |i: usize, j: usize| {
+        let q = if i == j { 1.0 } else { c };
+        q / (1.0 - rho[i] * rho[j])
+    };
+    let terms = vec![(s(0, 0) + s(0, 1), rho[0]), (s(1, 0) + s(1, 1), rho[1])];
+    // Cholesky factors of the stationary covariance S and the innovation covariance Q.
+    let chol = |a: f64, b: f64, d: f64| {
+        let l11 = a.sqrt();
+        let l21 = b / l11;
+        (l11, l21, (d - l21 * l21).sqrt())
+    };
+    let (s11, s21, s22) = chol(s(0, 0), s(0, 1), s(1, 1));
+    let (q11, q21, q22) = chol(1.0, c, 1.0);
+    let series = (0..count)
+        .map(|k| {
+            let mut rng = trajectory_rng(SEED_WHITTLE, index0 + k as u64);
+            let mut z = || rng.sample::<f64, _>(StandardNormal);
+            let (e1, e2) = (z(), z());
+            let (mut a, mut b) = (s11 * e1, s21 * e1 + s22 * e2);
+            (0..len)
+                .map(|_| {
+                    let v = a + b;
+                    let (e1, e2) = (z(), z());
+                    a = rho[0] * a + q11 * e1;
+                    b = rho[1] * b + q21 * e1 + q22 * e2;
+                    v
+                })
+                .collect()
+        })
+        .collect();
+    (series, terms)
+}
+
+#[test]
+fn whittle_square_sum_p_values_are_uniform_for_correlated_modes() {
+    // A slow and a fast mode, positively and negatively correlated driving, few and many
+    // series (8 series of 320 samples: a quick-budget profile), a slow mode of lag
+    // correlation e^{-1/8} as the profile is sampled.
+    let slow = (-0.125f64).exp();
+    for (case, &(c, count, len)) in [(0.5, 8, 320), (-0.6, 4, 600), (0.0, 32, 160)]
+        .iter()
+        .enumerate()
+    {
+        let mut p = Vec::new();
+        let (mut rejected_05, mut rejected_01) = (0, 0);
+        for rep in 0..1000u64 {
+            let (series, terms) =
+                two_mode_field(((case as u64) << 32) + rep * 64, count, len, [slow, 0.3], c);
+            let refs: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
+            let law = WeightedChiSquares::whittle(&terms, &vec![len; count]).unwrap();
+            let (o, _, _) = square_sum_test(&refs, &law).unwrap();
+            rejected_05 += usize::from(o.p_value < 0.05);
+            rejected_01 += usize::from(o.p_value < 0.01);
+            p.push(o.p_value);
+        }
+        let label = format!("c {c}, {count} x {len}");
+        assert_uniform(&label, &p);
+        assert_rate(&format!("{label}: p < 0.05"), rejected_05, 1000, 0.05);
+        assert_rate(&format!("{label}: p < 0.01"), rejected_01, 1000, 0.01);
+    }
+}
+
+#[test]
+fn whittle_square_sum_test_rejects_a_wrong_profile_without_saturating() {
+    // 8 series of 320 samples (a quick budget): the truth passes; the reference's variance
+    // scaled by 1/10 (a field 10× too variable) is rejected with p < 1e-12, where a t-test
+    // over the 8 series' averages keeps its scale from the data (7 dof). The null sd of
+    // the estimate is 6.4 % (some 500 effective samples of w²: the squares of the slow
+    // mode decorrelate over (1 + ρ²)/(1 − ρ²) ≈ 8 samples, the fast mode's at once); a
+    // 30 % error is rejected at p < 0.01.
+    let slow = (-0.125f64).exp();
+    let (series, terms) = two_mode_field(1 << 44, 8, 320, [slow, 0.3], 0.5);
+    let refs: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
+    let lengths = [320; 8];
+    let scaled = |f: f64| {
+        let t: Vec<(f64, f64)> = terms.iter().map(|&(u, r)| (u * f, r)).collect();
+        WeightedChiSquares::whittle(&t, &lengths).unwrap()
+    };
+    let (truth, estimate, se) = square_sum_test(&refs, &scaled(1.0)).unwrap();
+    let variance: f64 = terms.iter().map(|t| t.0).sum();
+    assert!(
+        truth.p_value > 0.01,
+        "truth rejected: p = {}",
+        truth.p_value
+    );
+    assert!((estimate - variance).abs() < 4.0 * se);
+    let (tenfold, _, _) = square_sum_test(&refs, &scaled(0.1)).unwrap();
+    assert!(tenfold.p_value < 1e-12, "10x: p = {:e}", tenfold.p_value);
+    let (tenth, _, _) = square_sum_test(&refs, &scaled(10.0)).unwrap();
+    assert!(tenth.p_value < 1e-12, "1/10: p = {:e}", tenth.p_value);
+    assert!(
+        (0.055..0.075).contains(&(se / variance)),
+        "null sd {}",
+        se / variance
+    );
+    let (off, _, _) = square_sum_test(&refs, &scaled(1.3)).unwrap();
+    assert!(off.p_value < 0.01, "30 %: p = {:e}", off.p_value);
+}
+
+#[test]
+fn the_profile_law_matches_the_simulator() {
+    // The profile check's null law on the simulator's own fields: hinged-linear-2d's
+    // Crank–Nicolson run (consistent noise: independent modes) and its element-uniform
+    // run (the paper's noise: modes driven by correlated noise, some weights u_k < 0), 160
+    // independent ensembles of 8 trajectories of 40 τ₁ each. The z-scores of the sum of
+    // w² (null mean and sd from the law) must have mean 0 and variance 1: |mean| < 0.25
+    // and variance in [0.75, 1.3] at both profile points (the two points are correlated;
+    // a law 1.6× too wide, or too narrow, gives a variance near 0.62 or 1.6). Measured:
+    // Crank–Nicolson 1.24 and 1.21 (the sd of a variance over 160 values is 0.11; 400
+    // other ensembles of the same run gave 0.95 and 0.99), element-uniform 0.99 and 0.95.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("verification")
+        .join("hinged-linear-2d.toml");
+    let scene = Scene::load(&path).unwrap();
+    for name in ["crank-nicolson", "element-uniform"] {
+        let spec = scene.runs.iter().find(|s| s.name == name).unwrap();
+        let run = LinearRun::prepare(&scene, spec).unwrap();
+        let r = &run.reference;
+        let tau1 = 1.0 / r.modes[0].rate_discrete.unwrap();
+        let steps = run.sampled_steps(40.0 * tau1);
+        let k = i32::try_from(run.profile_every).unwrap();
+        let mut z = vec![Vec::new(); r.profile_x.len()];
+        for rep in 0..160u64 {
+            let recs = run
+                .simulate_ensemble(SEED_WHITTLE ^ (rep << 8), 0, 8, steps, |_| {})
+                .unwrap();
+            for (j, zj) in z.iter_mut().enumerate() {
+                let series: Vec<&[f64]> = recs.iter().map(|t| t.profile[j].as_slice()).collect();
+                let terms: Vec<(f64, f64)> = r.profile_terms[j]
+                    .iter()
+                    .map(|&(u, m)| (u, m.powi(k)))
+                    .collect();
+                let lengths: Vec<usize> = series.iter().map(|s| s.len()).collect();
+                let law = WeightedChiSquares::whittle(&terms, &lengths).unwrap();
+                zj.push(square_sum_test(&series, &law).unwrap().0.statistic);
+            }
+        }
+        for (j, zj) in z.iter().enumerate() {
+            let n = zj.len() as f64;
+            let mean = zj.iter().sum::<f64>() / n;
+            let var = zj.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            eprintln!("{name}, profile point {j}: z mean {mean:.3}, variance {var:.3}");
+            assert!(
+                mean.abs() < 0.25 && (0.75..1.3).contains(&var),
+                "{name}, profile point {j}: z mean {mean:.3}, variance {var:.3}"
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The null law of the two-time check: a sum of products of correlated normals.
+// ---------------------------------------------------------------------------------------
+
+/// `n` independent products `X·Y` of zero-mean normals with variances `vx`, `vy` and
+/// correlation `corr`.
+fn products(index: u64, n: usize, vx: f64, vy: f64, corr: f64) -> Vec<f64> {
+    let mut rng = trajectory_rng(SEED_PRODUCTS, index);
+    (0..n)
+        .map(|_| {
+            let (a, b): (f64, f64) = (rng.sample(StandardNormal), rng.sample(StandardNormal));
+            let x = vx.sqrt() * a;
+            let y = vy.sqrt() * (corr * a + (1.0 - corr * corr).sqrt() * b);
+            x * y
+        })
+        .collect()
+}
+
+#[test]
+fn product_sum_p_values_are_uniform_under_the_null() {
+    // Few and many pairs (24: the paper run's quick budget; 400: the other runs'), weak,
+    // negative and strong correlation; 2 000 sums each.
+    for (case, &(n, vx, vy, corr)) in [
+        (24_usize, 1.0_f64, 2.5_f64, 0.3_f64),
+        (400, 0.7, 0.2, -0.5),
+        (24, 1.0, 1.0, 0.9),
+        (400, 3.0, 1.0, 0.05),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let cov = corr * (vx * vy).sqrt();
+        let law = WeightedChiSquares::product_sum(vx, vy, cov, n).unwrap();
+        let mut p = Vec::new();
+        let (mut r05, mut r01) = (0, 0);
+        for rep in 0..2000u64 {
+            let v = products(((case as u64) << 32) + rep, n, vx, vy, corr);
+            let (o, _, _) = sum_test(v.iter().sum(), n, &law).unwrap();
+            r05 += usize::from(o.p_value < 0.05);
+            r01 += usize::from(o.p_value < 0.01);
+            p.push(o.p_value);
+        }
+        let label = format!("{n} pairs, corr {corr}");
+        assert_uniform(&label, &p);
+        assert_rate(&format!("{label}: p < 0.05"), r05, 2000, 0.05);
+        assert_rate(&format!("{label}: p < 0.01"), r01, 2000, 0.01);
+    }
+}
+
+#[test]
+fn product_sum_test_rejects_a_wrong_correlation_without_saturating() {
+    // 400 pairs at variances 1 and correlation 0.4: the truth passes; a reference
+    // covariance of 0.2 (half the truth, 3.7 null sd of the mean 0.054) fails at p < 0.01,
+    // and data whose deflections are 3× too large (products 9×) at p < 1e-12, where a
+    // t-test takes its error from the inflated spread of the same products.
+    let v = products(1 << 45, 400, 1.0, 1.0, 0.4);
+    let s: f64 = v.iter().sum();
+    let (truth, estimate, se) = sum_test(
+        s,
+        400,
+        &WeightedChiSquares::product_sum(1.0, 1.0, 0.4, 400).unwrap(),
+    )
+    .unwrap();
+    assert!(
+        truth.p_value > 0.01,
+        "truth rejected: p = {}",
+        truth.p_value
+    );
+    assert!((estimate - 0.4).abs() < 4.0 * se);
+    assert!(
+        (se - (1.16f64 / 400.0).sqrt()).abs() < 1e-12,
+        "null sd {se}"
+    );
+    let (low, _, _) = sum_test(
+        s,
+        400,
+        &WeightedChiSquares::product_sum(1.0, 1.0, 0.2, 400).unwrap(),
+    )
+    .unwrap();
+    assert!(
+        low.p_value < 0.01,
+        "half: p = {:e}, estimate {estimate}",
+        low.p_value
+    );
+    let (nine, _, _) = sum_test(
+        9.0 * s,
+        400,
+        &WeightedChiSquares::product_sum(1.0, 1.0, 0.4, 400).unwrap(),
+    )
+    .unwrap();
+    assert!(nine.p_value < 1e-12, "9x: p = {:e}", nine.p_value);
 }

@@ -569,7 +569,8 @@ fn reading_guide(h: &mut String, summary: &Summary) {
          own tolerance and are outside the family.</p>\n<ul>\
          <li><b>Test</b>: t-test, z-test, band-t-test and band-z-test (against the nearest \
          point of a tolerance band, p = 1 inside it; band-chi2-sum their sum of squared scores), chi2-variance (χ² test of a variance), quadratic-form \
-         (a sum of squares of AR(1) series against its exact null law, scale from the \
+         (a Gaussian quadratic form — a mode's squared AR(1) amplitudes, the squared field at \
+         a profile point, the two-time products — against its null law, scale from the \
          reference), chi2-gof \
          (χ² goodness of fit of a distribution), chi2-sum (sum of squared scores), ks \
          (Kolmogorov–Smirnov), oracle (a discrete reference against closed forms of the \

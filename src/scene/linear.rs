@@ -81,6 +81,10 @@ pub struct TwoTimeReference {
     pub eta_step: u64,
     /// ⟨w(x,t) w(y,η)⟩ for the discrete system from rest.
     pub discrete: f64,
+    /// ⟨w(x,t)²⟩ and ⟨w(y,η)²⟩ for the discrete system from rest: with `discrete`, the
+    /// whole law of the product (the null law of the two-time check); NaN for data of an
+    /// unknown discretization.
+    pub variances: (f64, f64),
     /// Eq. (4).
     pub continuum: f64,
 }
@@ -94,6 +98,11 @@ pub struct LinearReference {
     pub profile_x: Vec<f64>,
     /// ⟨w²(x)⟩ of the discrete system at `profile_x`.
     pub profile_discrete: Vec<f64>,
+    /// Per profile point, the terms `(u_k, m_k)` of the discrete field's autocovariance
+    /// after `k` steps, `⟨w(x, t) w(x, t + kΔt)⟩ = Σ u_k m_k^k` (`m_k` the one-step
+    /// multiplier of mode k, `Σ u_k` = `profile_discrete`): the null law of the profile
+    /// check. Empty for data of an unknown discretization.
+    pub profile_terms: Vec<Vec<(f64, f64)>>,
     /// ⟨w²(x)⟩ of the continuum (closed form).
     pub profile_continuum: Vec<f64>,
     /// Two-time points.
@@ -697,22 +706,29 @@ fn tangent_references(
         let a = probe_of(n_dofs, &gm.vectors, |e| {
             f.iter().zip(e).map(|(x, y)| x * y).sum()
         });
-        let sa = &law.stationary * &a;
-        let terms = a
-            .iter()
-            .zip(sa.iter())
-            .zip(&law.multipliers)
-            .map(|((ai, si), &m)| (ai * si, m))
-            .collect();
+        let terms = autocovariance_terms(law, &a);
         let q = n as f64 * std::f64::consts::PI / p.length;
         refs.push(TangentReference {
             n,
-            variance_discrete: a.dot(&sa),
+            variance_discrete: a.dot(&(&law.stationary * &a)),
             variance_continuum: p.kt / (p.bending_rigidity * q * q),
             terms,
         });
     }
     (refs, Some(rows))
+}
+
+/// The terms `(u_i, m_i)`, `u_i = a_i (S a)_i`, of the autocovariance after `k` steps of
+/// the functional with modal image `a` under `law`: `aᵀ diag(m^k) S a = Σ u_i m_i^k` (the
+/// modal propagator is diagonal; the noise may correlate the modes, so a `u_i` may be
+/// negative).
+fn autocovariance_terms(law: &DiscreteLaw, a: &DVector<f64>) -> Vec<(f64, f64)> {
+    let sa = &law.stationary * a;
+    a.iter()
+        .zip(sa.iter())
+        .zip(&law.multipliers)
+        .map(|((ai, si), &m)| (ai * si, m))
+        .collect()
 }
 
 /// `rates` × `factor` (the rates themselves, bit for bit, at factor 1).
@@ -835,6 +851,7 @@ struct Prepared {
     amplitude_scale: Vec<f64>,
     modes: Vec<ModeReference>,
     profile_discrete: Vec<f64>,
+    profile_terms: Vec<Vec<(f64, f64)>>,
     two_time: Vec<TwoTimeReference>,
     max_rate: f64,
     rigid: Vec<RigidReference>,
@@ -884,11 +901,26 @@ impl Setup<'_> {
                 label: None,
             });
         }
-        // The simulator carries n_modes modes: its exact profile is the truncated sum.
+        // The simulator carries n_modes modes: its exact profile is the truncated sum, of
+        // independent AR(1) modes (scale · sin²(nπx/L)/n⁴ each).
         let profile_discrete = self
             .profile_x
             .iter()
             .map(|&x| continuum.profile_variance_series(x, n_modes).value)
+            .collect();
+        let profile_terms = self
+            .profile_x
+            .iter()
+            .map(|&x| {
+                let u = x / continuum.params.length;
+                (1..=n_modes)
+                    .map(|n| {
+                        let s = crate::spectral::sin_pi(n as f64 * u);
+                        let weight = continuum.variance_scale() * s * s / (n as f64).powi(4);
+                        (weight, (-continuum.mode_rate(n) * dt).exp())
+                    })
+                    .collect()
+            })
             .collect();
         let length = self.scene.filament.length;
         let mut tt = Vec::new();
@@ -906,6 +938,12 @@ impl Setup<'_> {
                 discrete: continuum
                     .correlation_truncated(x, y, t, eta, n_modes)?
                     .value,
+                variances: (
+                    continuum.correlation_truncated(x, x, t, t, n_modes)?.value,
+                    continuum
+                        .correlation_truncated(y, y, eta, eta, n_modes)?
+                        .value,
+                ),
                 continuum: continuum.correlation(x, y, t, eta, 1e-12)?.value,
             });
         }
@@ -919,6 +957,7 @@ impl Setup<'_> {
             },
             modes: refs,
             profile_discrete,
+            profile_terms,
             two_time: tt,
             max_rate: continuum.mode_rate(n_modes),
         })
@@ -971,6 +1010,11 @@ impl Setup<'_> {
             .iter()
             .map(|&x| simulator.covariance((x, y), (x, y)))
             .collect();
+        let profile_terms = self
+            .profile_x
+            .iter()
+            .map(|&x| simulator.point_terms((x, y)))
+            .collect();
         let length = membrane.params.width;
         let mut two_time = Vec::new();
         for q in &self.scene.sampling.two_time {
@@ -985,6 +1029,10 @@ impl Setup<'_> {
                 t_step: ts,
                 eta_step: es,
                 discrete: simulator.correlation_from_rest((x, y), (x2, y), t, eta)?,
+                variances: (
+                    simulator.correlation_from_rest((x, y), (x, y), t, t)?,
+                    simulator.correlation_from_rest((x2, y), (x2, y), eta, eta)?,
+                ),
                 continuum: self.continuum.correlation(x, x2, t, eta)?,
             });
         }
@@ -1003,6 +1051,7 @@ impl Setup<'_> {
             },
             modes: refs,
             profile_discrete,
+            profile_terms,
             two_time,
             max_rate,
         })
@@ -1035,14 +1084,15 @@ impl Setup<'_> {
         let refs = self.fem_mode_references(&law, system.kt());
         // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
         let probe = |x: f64| probe_of(system.n_dofs(), &gm.vectors, |e| object.value_at(e, x));
-        let profile_discrete = self
+        // ⟨w²(x)⟩ = aᵀSa, and the terms of its autocovariance.
+        let (profile_discrete, profile_terms) = self
             .profile_x
             .iter()
             .map(|&x| {
                 let a = probe(x);
-                law.point_covariance(&a, &a)
+                (law.point_covariance(&a, &a), autocovariance_terms(&law, &a))
             })
-            .collect();
+            .unzip();
         let two_time = self.fem_two_time(&law, &probe)?;
         let modal = self.modal_path(&object, &gm, &two_time, &probe);
         let projector = gm.projector(system, self.scene.sampling.modes);
@@ -1102,6 +1152,7 @@ impl Setup<'_> {
             },
             modes: refs,
             profile_discrete,
+            profile_terms,
             two_time,
             max_rate,
         })
@@ -1202,6 +1253,7 @@ impl Setup<'_> {
                 self.steps(q[3] * tau1).max(1),
             );
             let (t, eta) = (ts as f64 * dt, es as f64 * dt);
+            let (ax, ay) = (probe(x), probe(y));
             tt.push(TwoTimeReference {
                 x,
                 y,
@@ -1209,7 +1261,11 @@ impl Setup<'_> {
                 eta,
                 t_step: ts,
                 eta_step: es,
-                discrete: law.two_time(ts, es, &probe(x), &probe(y)),
+                discrete: law.two_time(ts, es, &ax, &ay),
+                variances: (
+                    law.two_time(ts, ts, &ax, &ax),
+                    law.two_time(es, es, &ay, &ay),
+                ),
                 continuum: self.continuum.correlation(x, y, t, eta)?,
             });
         }
@@ -1275,6 +1331,7 @@ impl LinearRun {
                 modes,
                 profile_x: setup.profile_x,
                 profile_discrete: prepared.profile_discrete,
+                profile_terms: prepared.profile_terms,
                 profile_continuum,
                 two_time: prepared.two_time,
                 dt,

@@ -20,9 +20,10 @@
 //! - [`hypothesis`]: KS and χ² goodness-of-fit tests against a normal law, the χ² test of
 //!   a variance, z-tests, the χ² combination of z-scores, and the Holm–Bonferroni
 //!   family-wise correction.
-//! - [`quadform`]: the exact null law of a sum of squares of stationary Gaussian AR(1)
-//!   series (a modal amplitude of a linear scheme) and the variance test built on it,
-//!   whose scale comes from the reference instead of the data under test.
+//! - [`quadform`]: the null law of a sum of squares of stationary Gaussian series — exact
+//!   for AR(1) series (a modal amplitude of a linear scheme), by the Whittle approximation
+//!   for a sum of correlated AR(1) modes (the field at a point) — and the variance test
+//!   built on it, whose scale comes from the reference instead of the data under test.
 //!
 //! # Pitfall: correlated samples
 //! The goodness-of-fit tests ([`ks_normal`], [`chi2_gof_normal`], [`chi2_variance_test`])
@@ -54,7 +55,9 @@ pub use moments::{
     integrated_autocorrelation_time, mean_with_error, mean_with_error_at,
     pooled_integrated_autocorrelation_time, variance_with_error,
 };
-pub use quadform::{Ar1SquareSum, ar1_square_sum_test};
+pub use quadform::{
+    Ar1SquareSum, SquareSumLaw, WeightedChiSquares, ar1_square_sum_test, square_sum_test, sum_test,
+};
 pub use spectrum::{
     Psd, ar1_density, welch, welch_expectation, welch_expectation_ar1, welch_pooled,
 };

@@ -53,7 +53,10 @@ pub struct LinearEstimates {
     pub skipped: Vec<SkippedCheck>,
 }
 
-/// The kind of the exact-null test of a sum of squares ([`stats::ar1_square_sum_test`]).
+/// The kind of the tests of a Gaussian quadratic form against its null law from the
+/// reference: [`stats::ar1_square_sum_test`] for a mode,
+/// [`stats::WeightedChiSquares::whittle`] for the profile,
+/// [`stats::WeightedChiSquares::product_sum`] for the two-time products.
 const QUADRATIC_FORM: &str = "quadratic-form";
 
 /// A check result before the family-wise correction (see [`CheckResult::statistical`]).
@@ -353,25 +356,34 @@ fn mode_data<'a>(run: &LinearRun, records: &'a [TrajectoryRecord], i: usize) -> 
 }
 
 /// [`CheckKind::Profile`]: ⟨w²(x)⟩ at every profile point against the exact discrete
-/// profile (z-test).
+/// profile: the sum of w² over every sample of every series against its null law where
+/// the reference knows the field's autocovariance ([`profile_square_sum_test`]), else
+/// (data of an unknown discretization) a t-test over the series' averages.
 fn profile_check(ctx: &mut LinearContext<'_>) -> Result<()> {
     let r = &ctx.run.reference;
     let prefix = &ctx.run.spec.name;
     let c = ctx.run.components;
     let np = r.profile_x.len();
     for j in 0..np {
-        // Per series the squares w²; the series are independent.
-        let squares: Vec<Vec<f64>> = ctx
+        let series: Vec<&[f64]> = ctx
             .records
             .iter()
-            .flat_map(|t| {
-                (0..c).map(move |k| t.profile[k * np + j].iter().map(|w| w * w).collect())
-            })
+            .flat_map(|t| (0..c).map(move |k| t.profile[k * np + j].as_slice()))
             .collect();
-        // The error from the spread of the independent series' averages where there are
-        // enough: an error estimated within short series (IAT) is itself uncertain and
-        // correlated with the estimate, which makes z-tails heavier than normal.
-        let (mean, se, o, kind, how) = series_average_test(&squares, r.profile_discrete[j])?;
+        let (mean, se, o, kind, how) = match r.profile_terms.get(j).filter(|t| !t.is_empty()) {
+            Some(terms) => profile_square_sum_test(&series, terms, ctx.run.profile_every)?,
+            None => {
+                // Per series the squares w²; the series are independent. The error from
+                // the spread of the independent series' averages where there are enough:
+                // an error estimated within short series (IAT) is itself uncertain and
+                // correlated with the estimate, which makes z-tails heavier than normal.
+                let squares: Vec<Vec<f64>> = series
+                    .iter()
+                    .map(|s| s.iter().map(|w| w * w).collect())
+                    .collect();
+                series_average_test(&squares, r.profile_discrete[j])?
+            }
+        };
         let x = r.profile_x[j];
         ctx.out.push(check(
             format!("{prefix}/profile/x={x:.4}"),
@@ -387,6 +399,37 @@ fn profile_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         time_reversal_checks(ctx)?;
     }
     Ok(())
+}
+
+/// The sum of w² over every sample of `series` (independent, sampled every `every` steps)
+/// against its null law: each series is a stationary Gaussian sequence whose
+/// autocovariance after `k` samples is `Σ u_i m_i^{k·every}` (`terms` = `(u_i, m_i)`), so
+/// the sum is a Gaussian quadratic form ([`stats::WeightedChiSquares::whittle`],
+/// saddle-point tail) whose scale comes from the reference, not from the data under test
+/// (issue #30: a wrong profile cannot pass by inflating its own error). Returns what
+/// [`series_average_test`] returns.
+fn profile_square_sum_test(
+    series: &[&[f64]],
+    terms: &[(f64, f64)],
+    every: u64,
+) -> Result<(f64, f64, TestOutcome, &'static str, String)> {
+    for (i, s) in series.iter().enumerate() {
+        stats::require_samples(&format!("profile series {i}"), s, 1)?;
+    }
+    let k = every.min(i32::MAX as u64) as i32;
+    let sampled: Vec<(f64, f64)> = terms.iter().map(|&(u, m)| (u, m.powi(k))).collect();
+    let lengths: Vec<usize> = series.iter().map(|s| s.len()).collect();
+    let law = stats::WeightedChiSquares::whittle(&sampled, &lengths)?;
+    let (o, mean, se) = stats::square_sum_test(series, &law)?;
+    let how = format!(
+        "{} series ({} samples), against its null law (Gaussian quadratic form of the \
+         {}-term autocovariance, Whittle eigenvalues; saddle-point tail), error from the \
+         reference",
+        series.len(),
+        lengths.iter().sum::<usize>(),
+        terms.len()
+    );
+    Ok((mean, se, o, QUADRATIC_FORM, how))
 }
 
 /// Time-reversal symmetry of the stationary process (detailed balance, which holds
@@ -621,16 +664,33 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         // deflection: n·mean/reference is exactly χ²(n). A t-test on such skewed values
         // has heavy tails with few samples (the calibration saw 3 % below p = 0.01).
         let diagonal = q.x == q.y && q.t_step == q.eta_step;
+        // Elsewhere the sum of the products against its null law where the reference
+        // knows the product's law (the two variances from rest beside the covariance);
+        // the t-test, whose error comes from the data, for data of an unknown
+        // discretization.
+        let law = (!diagonal)
+            .then(|| {
+                let (vx, vy) = q.variances;
+                stats::WeightedChiSquares::product_sum(vx, vy, q.discrete, values.len()).ok()
+            })
+            .flatten();
         let (o, kind, se) = if diagonal {
             let w: Vec<f64> = values.iter().map(|v| v.max(0.0).sqrt()).collect();
             let o = stats::chi2_variance_test(&w, q.discrete, Some(0.0))?;
             let se = q.discrete * (2.0 / values.len() as f64).sqrt();
             (o, "chi2-variance", se)
+        } else if let Some(law) = &law {
+            let (o, _, se) = stats::sum_test(values.iter().sum(), values.len(), law)?;
+            (o, QUADRATIC_FORM, se)
         } else {
             let o = stats::t_test(m.mean, q.discrete, m.std_error, values.len())?;
             (o, "t-test", m.std_error)
         };
-        ctx.est.two_time.push((m.mean, m.std_error));
+        // The error beside the estimate: the check's own where it comes from the
+        // reference, else the spread over the samples.
+        ctx.est
+            .two_time
+            .push((m.mean, if law.is_some() { se } else { m.std_error }));
         ctx.out.push(check(
             format!(
                 "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
@@ -645,6 +705,8 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
                 values.len(),
                 if diagonal {
                     " (squares of a normal deflection: chi2 test of n*mean/reference, n dof)"
+                } else if law.is_some() {
+                    " (the sum of the products against its exact null law: a weighted sum of two chi2(n), from the discrete variances at (x,t) and (y,eta) and the reference; saddle-point tail, error from the reference)"
                 } else {
                     " (t-test)"
                 }

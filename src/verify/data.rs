@@ -113,6 +113,7 @@ pub fn prepare_data_check(
         modes,
         profile_x: profile.0,
         profile_discrete: profile.1,
+        profile_terms: profile.4,
         profile_continuum: profile.2,
         two_time,
         dt: dts,
@@ -537,8 +538,10 @@ fn profile_references(
     notes: &mut Vec<String>,
 ) -> Result<ProfileRefs> {
     let length = continuum.line_length();
+    // The discrete terms are per step of the discrete run; a data row is `per_row` steps.
+    let per_row = discrete.map(|d| (data.dt_sample / d.reference.dt).round());
     // Profile points present in the data.
-    let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (j, f) in scene.sampling.profile_points.iter().enumerate() {
         let x = f * length;
         match column_of(data, length, x) {
@@ -551,6 +554,13 @@ fn profile_references(
                 });
                 profile.2.push(exact);
                 profile.3.push(col);
+                profile.4.push(match (discrete, per_row) {
+                    (Some(d), Some(r)) => d.reference.profile_terms[j]
+                        .iter()
+                        .map(|&(u, m)| (u, m.powf(r)))
+                        .collect(),
+                    _ => Vec::new(),
+                });
             }
             None => notes.push(format!(
                 "run {}: profile point x/L = {f} is not among the data's positions: not checked",
@@ -561,8 +571,15 @@ fn profile_references(
     Ok(profile)
 }
 
-/// Profile points: x, discrete and continuum references, and their columns.
-type ProfileRefs = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<usize>);
+/// Profile points: x, discrete and continuum references, their columns, and the
+/// discrete autocovariance terms per data row (empty without a discrete reference).
+type ProfileRefs = (
+    Vec<f64>,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<usize>,
+    Vec<Vec<(f64, f64)>>,
+);
 
 /// The scene's two-time points on the data's rows and positions, from rest only: the
 /// references (with row indices as steps) and the columns of x and y; the others are
@@ -610,6 +627,8 @@ fn two_time_references(
                             Some(d) => d.reference.two_time[j].discrete,
                             None => continuum.correlation(x, y, t, eta)?,
                         },
+                        variances: discrete
+                            .map_or((f64::NAN, f64::NAN), |d| d.reference.two_time[j].variances),
                         continuum: continuum.correlation(x, y, t, eta)?,
                     });
                     tt_cols.push((cx, cy));

@@ -39,6 +39,10 @@ pub const SEED_HOLM: u64 = 0x4013_0009;
 pub const SEED_WELCH: u64 = 0x3E1C_000A;
 /// The exact-null variance test of AR(1) series: p-value uniformity, tails, power.
 pub const SEED_QUADFORM: u64 = 0x0AD_F00B;
+/// The profile's null law (sums of correlated AR(1) modes): uniformity, power.
+pub const SEED_WHITTLE: u64 = 0x0AD_F00C;
+/// The two-time check's null law (sums of products of correlated normals).
+pub const SEED_PRODUCTS: u64 = 0x0AD_F00D;
 /// The jackknife correlation of a decay rate with the variance of the same series.
 pub const SEED_DECAY_CORRELATION: u64 = 0xDECA_C00C;
 /// The χ² goodness of fit with bins growing with the sample: null and duplicated samples.

@@ -233,6 +233,18 @@ impl MembraneSimulator {
         Ok(self.mode_sum(r, r2, |rate| kernel.factor(rate)))
     }
 
+    /// The terms `(⟨a²⟩φ(r)², e^{−λΔt})` of the height's autocovariance at `r` after `k`
+    /// steps, `⟨h(r, t) h(r, t + kΔt)⟩ = Σ ⟨a²⟩φ(r)² e^{−λkΔt}` (the modes are independent
+    /// AR(1) sequences): their weights sum to [`Self::covariance`] at `(r, r)`.
+    pub fn point_terms(&self, r: (f64, f64)) -> Vec<(f64, f64)> {
+        let mb = &self.membrane;
+        self.modes
+            .iter()
+            .zip(self.variance.iter().zip(&self.decay))
+            .map(|(m, (v, d))| (v * mb.mode_shape(*m, r.0, r.1).powi(2), *d))
+            .collect()
+    }
+
     fn mode_sum(&self, r: (f64, f64), r2: (f64, f64), factor: impl Fn(f64) -> f64) -> f64 {
         let mb = &self.membrane;
         self.modes
