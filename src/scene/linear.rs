@@ -99,7 +99,7 @@ pub struct LinearReference {
     /// ⟨w²(x)⟩ of the discrete system at `profile_x`.
     pub profile_discrete: Vec<f64>,
     /// Per profile point, the terms `(u_k, m_k)` of the discrete field's autocovariance
-    /// after `k` steps, `⟨w(x, t) w(x, t + kΔt)⟩ = Σ u_k m_k^k` (`m_k` the one-step
+    /// after `s` steps, `⟨w(x, t) w(x, t + sΔt)⟩ = Σ_k u_k m_k^s` (`m_k` the one-step
     /// multiplier of mode k, `Σ u_k` = `profile_discrete`): the null law of the profile
     /// check. Empty for data of an unknown discretization.
     pub profile_terms: Vec<Vec<(f64, f64)>>,
@@ -718,8 +718,8 @@ fn tangent_references(
     (refs, Some(rows))
 }
 
-/// The terms `(u_i, m_i)`, `u_i = a_i (S a)_i`, of the autocovariance after `k` steps of
-/// the functional with modal image `a` under `law`: `aᵀ diag(m^k) S a = Σ u_i m_i^k` (the
+/// The terms `(u_i, m_i)`, `u_i = a_i (S a)_i`, of the autocovariance after `s` steps of
+/// the functional with modal image `a` under `law`: `aᵀ diag(m^s) S a = Σ u_i m_i^s` (the
 /// modal propagator is diagonal; the noise may correlate the modes, so a `u_i` may be
 /// negative).
 fn autocovariance_terms(law: &DiscreteLaw, a: &DVector<f64>) -> Vec<(f64, f64)> {
