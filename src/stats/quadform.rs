@@ -42,9 +42,10 @@ const FIXED_POINT_TOLERANCE: f64 = 1e-15;
 /// within about 1e-4 of 1).
 const CENTRE_W: f64 = 1e-4;
 
-/// The law of a sum of squares `S ≥ 0` of zero-mean Gaussian variables, given by its
-/// cumulant generating function `K(u) = ln E e^{uS}`; its tails come from the
-/// Lugannani–Rice saddle-point formula (module docs).
+/// The law of a quadratic form `S` in zero-mean Gaussian variables — a sum of squares
+/// (`S ≥ 0`), or an indefinite form such as a sum of products (with a
+/// [`Self::lower_bound`]) — given by its cumulant generating function `K(u) = ln E e^{uS}`;
+/// its tails come from the Lugannani–Rice saddle-point formula (module docs).
 pub trait SquareSumLaw {
     /// `K(u)`, `K′(u)`, `K″(u)`, or `None` past the first singularity of `K`.
     fn cumulants(&self, u: f64) -> Option<Cumulants>;
@@ -65,8 +66,9 @@ pub trait SquareSumLaw {
         None
     }
 
-    /// The saddle point `û` with `K′(û) = s` (`s > 0`), by safeguarded Newton iteration on a
-    /// bracket ([`Self::cumulants`] is `None` past the first singularity, `K′` increases).
+    /// The saddle point `û` with `K′(û) = s` (`s > 0` for a sum of squares, any `s` for an
+    /// indefinite form), by safeguarded Newton iteration on a bracket ([`Self::cumulants`]
+    /// is `None` past a singularity, `K′` increases).
     fn saddle_point(&self, s: f64) -> Option<(f64, Cumulants)> {
         let at = |u: f64| self.cumulants(u);
         let mean = self.mean();
