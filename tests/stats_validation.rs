@@ -57,6 +57,21 @@ fn assert_rate(label: &str, hits: usize, trials: usize, p0: f64) {
     );
 }
 
+/// Asserts that null p-values are uniform ([`assert_uniform`]) and that the rates below
+/// 0.05 and 0.01 are within their binomial bands ([`assert_rate`]).
+fn assert_null_p_values(label: &str, p_values: &[f64]) {
+    assert_uniform(label, p_values);
+    for level in [0.05, 0.01] {
+        let hits = p_values.iter().filter(|&&p| p < level).count();
+        assert_rate(
+            &format!("{label}: p < {level}"),
+            hits,
+            p_values.len(),
+            level,
+        );
+    }
+}
+
 /// Asserts that p-values are consistent with U(0, 1) (KS test, p > 1e-3).
 fn assert_uniform(label: &str, p_values: &[f64]) {
     let (d, p) = ks_onesample(
@@ -885,21 +900,15 @@ fn whittle_square_sum_p_values_are_uniform_for_correlated_modes() {
         .enumerate()
     {
         let mut p = Vec::new();
-        let (mut rejected_05, mut rejected_01) = (0, 0);
         for rep in 0..1000u64 {
             let (series, terms) =
                 two_mode_field(((case as u64) << 32) + rep * 64, count, len, [slow, 0.3], c);
             let refs: Vec<&[f64]> = series.iter().map(|s| s.as_slice()).collect();
             let law = WeightedChiSquares::whittle(&terms, &vec![len; count]).unwrap();
             let (o, _, _) = square_sum_test(&refs, &law).unwrap();
-            rejected_05 += usize::from(o.p_value < 0.05);
-            rejected_01 += usize::from(o.p_value < 0.01);
             p.push(o.p_value);
         }
-        let label = format!("c {c}, {count} x {len}");
-        assert_uniform(&label, &p);
-        assert_rate(&format!("{label}: p < 0.05"), rejected_05, 1000, 0.05);
-        assert_rate(&format!("{label}: p < 0.01"), rejected_01, 1000, 0.01);
+        assert_null_p_values(&format!("c {c}, {count} x {len}"), &p);
     }
 }
 
@@ -1025,18 +1034,12 @@ fn product_sum_p_values_are_uniform_under_the_null() {
         let cov = corr * (vx * vy).sqrt();
         let law = WeightedChiSquares::product_sum(vx, vy, cov, n).unwrap();
         let mut p = Vec::new();
-        let (mut r05, mut r01) = (0, 0);
         for rep in 0..2000u64 {
             let v = products(((case as u64) << 32) + rep, n, vx, vy, corr);
             let (o, _, _) = sum_test(v.iter().sum(), n, &law).unwrap();
-            r05 += usize::from(o.p_value < 0.05);
-            r01 += usize::from(o.p_value < 0.01);
             p.push(o.p_value);
         }
-        let label = format!("{n} pairs, corr {corr}");
-        assert_uniform(&label, &p);
-        assert_rate(&format!("{label}: p < 0.05"), r05, 2000, 0.05);
-        assert_rate(&format!("{label}: p < 0.01"), r01, 2000, 0.01);
+        assert_null_p_values(&format!("{n} pairs, corr {corr}"), &p);
     }
 }
 

@@ -191,21 +191,10 @@ impl Ar1SquareSum {
         if !(rho.is_finite() && rho.abs() < 1.0) {
             return Err(Error::invalid("rho", rho, "finite, in (-1, 1)"));
         }
-        let mut grouped: Vec<(usize, usize)> = Vec::new();
-        for &t in lengths.iter().filter(|&&t| t > 0) {
-            match grouped.iter_mut().find(|(len, _)| *len == t) {
-                Some((_, count)) => *count += 1,
-                None => grouped.push((t, 1)),
-            }
-        }
-        if grouped.is_empty() {
-            return Err(Error::invalid("series", 0, "at least one sample"));
-        }
-        grouped.sort_unstable();
         Ok(Ar1SquareSum {
             variance,
             rho,
-            lengths: grouped,
+            lengths: grouped_lengths(lengths)?,
         })
     }
 
@@ -275,6 +264,26 @@ impl SquareSumLaw for Ar1SquareSum {
     fn bracket_scale(&self) -> f64 {
         1.0 / (2.0 * self.variance)
     }
+}
+
+/// The series lengths as `(T, count)`, ascending in `T`, lengths 0 ignored: independent
+/// series of one length share their cumulant terms.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] if no series has a sample.
+fn grouped_lengths(lengths: &[usize]) -> Result<Vec<(usize, usize)>> {
+    let mut grouped: Vec<(usize, usize)> = Vec::new();
+    for &t in lengths.iter().filter(|&&t| t > 0) {
+        match grouped.iter_mut().find(|(len, _)| *len == t) {
+            Some((_, count)) => *count += 1,
+            None => grouped.push((t, 1)),
+        }
+    }
+    if grouped.is_empty() {
+        return Err(Error::invalid("series", 0, "at least one sample"));
+    }
+    grouped.sort_unstable();
+    Ok(grouped)
 }
 
 /// `ln det(M − cI)` and its first two derivatives in `c`, for the `t × t` tridiagonal `M`
@@ -475,17 +484,7 @@ impl WeightedChiSquares {
             }
         }
         crate::error::require_positive("variance", terms.iter().map(|t| t.0).sum())?;
-        let mut counts: Vec<(usize, usize)> = Vec::new();
-        for &t in lengths.iter().filter(|&&t| t > 0) {
-            match counts.iter_mut().find(|(len, _)| *len == t) {
-                Some((_, count)) => *count += 1,
-                None => counts.push((t, 1)),
-            }
-        }
-        if counts.is_empty() {
-            return Err(Error::invalid("series", 0, "at least one sample"));
-        }
-        counts.sort_unstable();
+        let counts = grouped_lengths(lengths)?;
         let density = |omega: f64| -> f64 {
             let c = omega.cos();
             terms
