@@ -19,7 +19,11 @@
 //! large-sample relative variance of λ̂ is dominated by e^{2λkdt}/(λkdt)², which is
 //! smallest near λ k dt = 1: shorter lags lose resolution (ρ(k) close to 1), longer lags
 //! drown ρ(k) in noise. For a series that is not a single exponential the estimate is the
-//! effective rate at that lag.
+//! effective rate at that lag. Where the rate is known beforehand (a test against an
+//! exact reference) the lag is taken from it instead ([`LagRule::Expected`]), so that the
+//! lag, and whether the series are long enough for it, do not depend on the data: a lag
+//! from the data would make a test that is skipped when its series are too short run
+//! only on data whose pilot decay looked fast, and its p-values would be biased.
 //!
 //! **Error.** Delete-one-block jackknife (Quenouille 1956; Tukey 1958; Efron & Stein
 //! 1981; for blocks of a dependent series Künsch, Ann. Stat. 17, 1217 (1989)): the sums
@@ -183,6 +187,37 @@ pub fn decay_rate(
     known_mean: Option<f64>,
     confidence: f64,
 ) -> Result<RateEstimate> {
+    decay_rate_with_lag(series, dt, known_mean, confidence, LagRule::Pilot)
+}
+
+/// How [`decay_rate_with_lag`] chooses the lag k at which ρ̂(k) is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LagRule {
+    /// From the data: the pooled pilot ρ̂(1) gives k = max(1, round(−1/ln ρ̂(1))) (module
+    /// documentation). Whether the estimate can be made (enough blocks at that lag) then
+    /// depends on the data, so a caller that tests the estimate must not skip on failure
+    /// without biasing the tests it does run.
+    Pilot,
+    /// From a rate λ known before the data are seen (the exact reference's rate, in the
+    /// inverse time units of `dt`): k = max(1, round(1/(λ dt))), lowered to the longest
+    /// lag at which the series still give [`MIN_JACKKNIFE_BLOCKS`] blocks. The lag, and
+    /// whether an estimate is made at all, then depend on the sampling plan only.
+    Expected(f64),
+}
+
+/// [`decay_rate`] with the lag chosen by `lag` ([`LagRule`]).
+///
+/// # Errors
+/// Those of [`decay_rate`]; also [`Error::InvalidParameter`] if an expected rate is not
+/// finite and positive, and [`Error::Numerical`] if the series are too short for
+/// [`MIN_JACKKNIFE_BLOCKS`] blocks even at lag 1.
+pub fn decay_rate_with_lag(
+    series: &[&[f64]],
+    dt: f64,
+    known_mean: Option<f64>,
+    confidence: f64,
+    lag: LagRule,
+) -> Result<RateEstimate> {
     validate_input(series, dt, known_mean, confidence)?;
     let n_total: usize = series.iter().map(|s| s.len()).sum();
     let shift = match known_mean {
@@ -190,7 +225,13 @@ pub fn decay_rate(
         None => series.iter().flat_map(|s| s.iter()).sum::<f64>() / n_total as f64,
     };
     let known = known_mean.is_some();
-    let k = choose_lag(series, n_total, shift, known)?;
+    let k = match lag {
+        LagRule::Pilot => choose_lag(series, n_total, shift, known)?,
+        LagRule::Expected(rate) => {
+            crate::error::require_positive("expected rate", rate)?;
+            expected_lag(series, n_total, rate * dt)?
+        }
+    };
     let blocks = jackknife_blocks(series, n_total, k, shift)?;
     jackknife_estimate(&blocks, k, dt, known, confidence)
 }
@@ -250,6 +291,27 @@ fn choose_lag(series: &[&[f64]], n_total: usize, shift: f64, known: bool) -> Res
         return Err(too_short());
     }
     Ok(k)
+}
+
+/// The lag k = max(1, round(1/(λ dt))) for the expected `rate_dt` = λ dt, lowered to the
+/// longest lag at which [`jackknife_blocks`] finds [`MIN_JACKKNIFE_BLOCKS`] blocks and at
+/// least half the samples start a lag-k pair (the conditions [`choose_lag`] and
+/// [`jackknife_blocks`] impose); an error if even lag 1 is too long.
+fn expected_lag(series: &[&[f64]], n_total: usize, rate_dt: f64) -> Result<usize> {
+    let target = (1.0 / rate_dt).round().clamp(1.0, n_total as f64) as usize;
+    let fits = |k: usize| {
+        let n_pairs: usize = series.iter().map(|s| s.len().saturating_sub(k)).sum();
+        let blocks_fit = series.len() >= WHOLE_SERIES_BLOCKS
+            || n_total / (MIN_SEGMENT_LAGS * k) >= MIN_JACKKNIFE_BLOCKS;
+        2 * n_pairs >= n_total && blocks_fit
+    };
+    (1..=target).rev().find(|&k| fits(k)).ok_or_else(|| {
+        numerical(format!(
+            "{n_total} samples in {} series are too short for {MIN_JACKKNIFE_BLOCKS} \
+             jackknife blocks even at lag 1",
+            series.len()
+        ))
+    })
 }
 
 /// The jackknife blocks' sums: groups of whole series when there are at least
@@ -406,6 +468,43 @@ mod tests {
         let est = decay_rate(&refs, 1.0, Some(0.0), 0.9).unwrap();
         assert_eq!(est.n_blocks, TARGET_BLOCKS);
         assert_eq!(est.lag, 1);
+    }
+
+    #[test]
+    fn expected_lag_comes_from_the_rate_and_the_plan() {
+        let rho: f64 = 0.8;
+        let x = ar1(rho, 100_000, 0);
+        let lambda = -rho.ln();
+        let e = decay_rate_with_lag(&[&x], 1.0, None, 0.95, LagRule::Expected(lambda)).unwrap();
+        assert_eq!(e, decay_rate(&[&x], 1.0, None, 0.95).unwrap());
+        // 1/(λ dt) = 4.48 but 1 000 samples allow 10 segments of 20 lags only up to lag 5,
+        // 400 samples only lag 2: the lag shrinks to fit whatever the data.
+        let rule = LagRule::Expected(lambda);
+        assert_eq!(
+            decay_rate_with_lag(&[&x[..1000]], 1.0, None, 0.95, rule)
+                .unwrap()
+                .lag,
+            4
+        );
+        assert_eq!(
+            decay_rate_with_lag(&[&x[..400]], 1.0, None, 0.95, rule)
+                .unwrap()
+                .lag,
+            2
+        );
+        let slow = LagRule::Expected(0.01 * lambda);
+        assert_eq!(
+            decay_rate_with_lag(&[&x[..400]], 1.0, None, 0.95, slow)
+                .unwrap()
+                .lag,
+            2
+        );
+        // Too short for 10 segments even at lag 1; invalid expected rates.
+        assert!(decay_rate_with_lag(&[&x[..199]], 1.0, None, 0.95, rule).is_err());
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let r = LagRule::Expected(bad);
+            assert!(decay_rate_with_lag(&[&x], 1.0, None, 0.95, r).is_err());
+        }
     }
 
     #[test]

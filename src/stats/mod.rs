@@ -45,7 +45,7 @@ pub mod quadform;
 pub mod spectrum;
 
 pub use acf::{autocorrelation, autocovariance};
-pub use decay::{RateEstimate, decay_rate};
+pub use decay::{LagRule, RateEstimate, decay_rate, decay_rate_with_lag};
 pub use hypothesis::{
     TestOutcome, chi2_gof_normal, chi2_sum_test, chi2_variance_test, equivalent_z, gof_bins, holm,
     ks_normal, ks_test, t_test, z_test,

@@ -592,8 +592,10 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
     let Some(rate_ref) = mr.rate_discrete else {
         return Ok(());
     };
-    // The series has about two samples per relaxation time.
-    match stats::decay_rate(&m.series, m.dt_sample, Some(0.0), CONFIDENCE) {
+    // The lag comes from the reference's rate, not from the data: whether the check runs
+    // must not depend on how fast this sample happens to decay (statistics.md).
+    let lag = stats::LagRule::Expected(rate_ref);
+    match stats::decay_rate_with_lag(&m.series, m.dt_sample, Some(0.0), CONFIDENCE, lag) {
         Ok(re) => {
             m.me.rate = (re.rate, re.std_error);
             let o = stats::t_test(re.rate, rate_ref, re.std_error, re.n_blocks)?;

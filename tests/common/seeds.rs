@@ -45,6 +45,8 @@ pub const SEED_WHITTLE: u64 = 0x0AD_F00C;
 pub const SEED_PRODUCTS: u64 = 0x0AD_F00D;
 /// The jackknife correlation of a decay rate with the variance of the same series.
 pub const SEED_DECAY_CORRELATION: u64 = 0xDECA_C00C;
+/// Short AR(1) ensembles of the decay-rate lag rule (expected lag against pilot lag).
+pub const SEED_DECAY_LAG: u64 = 0xDECA_01A6;
 /// The χ² goodness of fit with bins growing with the sample: null and duplicated samples.
 pub const SEED_GOF_BINS: u64 = 0x0B1D_500D;
 
