@@ -311,3 +311,58 @@ fn error_classes_map_to_their_exit_codes() {
     let io = Error::run_failed("r", "obs", Error::io("f", std::io::Error::other("x")));
     assert!(matches!(io, Error::Io { .. }) && io.exit_code() == 3);
 }
+
+/// (4) One writer per output folder: while another process holds the folder's lock
+/// (this test, through [`OutputLock`], as a running command does), `verify` pointed at
+/// it exits 2 naming `--out` and the folder, at once, and leaves the earlier report
+/// exactly as it was; `calibrate` pointed at a folder that is being created is refused
+/// the same way and leaves nothing behind. Once the lock is released the same command
+/// runs. (A study's shared folder is not locked: several studies write one folder by
+/// design.)
+#[test]
+fn a_folder_another_command_is_writing_to_is_refused_and_left_intact() {
+    use langevin_fem::output::OutputLock;
+    let dir = TempDir::new("locked");
+    let tiny = write_scene(&dir, "tiny", tiny_with_duration("40.0").as_bytes());
+    let out = dir.join("out");
+    verify_ok(&[&tiny], &out);
+    let snapshot = || -> Vec<(String, Vec<u8>)> {
+        all_files(&out)
+            .into_iter()
+            .map(|f| {
+                let bytes = std::fs::read(out.join(&f)).unwrap();
+                (f, bytes)
+            })
+            .collect()
+    };
+    let before = snapshot();
+    let refused = |args: &[String], folder: &Path| {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let started = Instant::now();
+        let o = run(&args);
+        let err = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+        let named = err.contains("--out") && err.contains(&folder.display().to_string());
+        assert!(named && err.contains("no other running"), "{err}");
+        assert!(started.elapsed() < Duration::from_secs(5));
+    };
+    let lock = OutputLock::acquire("--out", &out).unwrap();
+    refused(&verify_args(&[&tiny], &out), &out);
+    assert_eq!(snapshot(), before);
+    // A folder being created by another process: refused, and nothing left beside it.
+    let fresh = dir.join("fresh/cal");
+    let held = OutputLock::acquire("--out", &fresh).unwrap();
+    let calibrate: Vec<String> = ["calibrate", "--scene", &tiny.display().to_string()]
+        .into_iter()
+        .map(String::from)
+        .chain(["--seeds", "2", "--out"].map(String::from))
+        .chain([fresh.display().to_string()])
+        .collect();
+    refused(&calibrate, &fresh);
+    drop(held);
+    assert!(!dir.join("fresh").exists());
+    // Released: the same command runs.
+    drop(lock);
+    verify_ok(&[&tiny], &out);
+    assert_consistent(&out, "after the lock was released");
+}

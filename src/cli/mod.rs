@@ -19,6 +19,7 @@ mod work_precision;
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use langevin_fem::Result;
 use langevin_fem::error::Error;
+use langevin_fem::output::OutputLock;
 use langevin_fem::output::manifest::{OutputKind, refuse_occupied};
 use langevin_fem::progress::ProgressOptions;
 use langevin_fem::scene::Scene;
@@ -157,51 +158,51 @@ pub fn run() -> Result<i32> {
     match cli.command {
         Command::Theory(args) => theory::run(args),
         Command::Verify(args) => {
-            check_out_dir(&args.out, shard_or(args.is_shard(), "verify", false))?;
+            let _lock = check_out_dir(&args.out, shard_or(args.is_shard(), "verify", false))?;
             args.sim.start()?;
             verify::run(args, v)
         }
         Command::Calibrate(args) => {
-            check_out_dir(&args.out, report("calibrate", false))?;
+            let _lock = check_out_dir(&args.out, report("calibrate", false))?;
             args.start()?;
             calibrate::run(args, v)
         }
         Command::Converge(args) => {
-            check_out_dir(&args.out, shard_or(args.is_shard(), "converge", true))?;
+            let _lock = check_out_dir(&args.out, shard_or(args.is_shard(), "converge", true))?;
             args.sim.start()?;
             converge::run(args, v)
         }
         Command::Stability(args) => {
-            check_out_dir(&args.out, report("stability", true))?;
+            let _lock = check_out_dir(&args.out, report("stability", true))?;
             args.sim.start()?;
             stability::run(args, v)
         }
         Command::WorkPrecision(args) => {
-            check_out_dir(&args.out, report("work-precision", true))?;
+            let _lock = check_out_dir(&args.out, report("work-precision", true))?;
             args.sim.start()?;
             work_precision::run(args, v)
         }
         Command::Run(args) => {
-            check_out_dir(&args.out, shard_or(args.is_shard(), "run", false))?;
+            let _lock = check_out_dir(&args.out, shard_or(args.is_shard(), "run", false))?;
             run::run(args, v)
         }
         Command::Merge(args) => {
-            check_out_dir(&args.out, None)?;
+            let _lock = check_out_dir(&args.out, None)?;
             merge::run(args, v)
         }
         Command::Check(args) => {
-            check_out_dir(&args.out, report("check", false))?;
+            let _lock = check_out_dir(&args.out, report("check", false))?;
             check::run(args, v)
         }
         Command::Fit(args) => {
-            check_out_dir(&args.check.out, report("check", false))?;
+            let _lock = check_out_dir(&args.check.out, report("check", false))?;
             fit::run(args, v)
         }
         Command::List(args) => list::run(args),
         Command::Scene(args) => scene::run(args),
         #[cfg(feature = "faults")]
         Command::Power(args) => {
-            check_out_dir(&args.out, None)?;
+            let _lock = check_out_dir(&args.out, None)?;
             power::run(args, v)
         }
         Command::Completions { shell } => {
@@ -243,8 +244,11 @@ fn shard_or(shard: bool, command: &str, shared: bool) -> Option<OutputKind<'_>> 
 /// if known before the inputs are read) would replace or remove
 /// ([`langevin_fem::output::manifest::refuse_occupied`]). The temporary files and staging
 /// directories that interrupted runs left in an existing `out` are removed
-/// ([`langevin_fem::output::remove_stale_temporaries`]).
-fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<()> {
+/// ([`langevin_fem::output::remove_stale_temporaries`]). Then `out` is locked for the
+/// command's life ([`OutputLock`], created if missing), so that a second command writing
+/// there at the same time is refused (exit 2) — except a study's folder, which several
+/// studies share by design (`kind` shared).
+fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<Option<OutputLock>> {
     let fail = |why: String| {
         Error::invalid(
             "--out",
@@ -284,7 +288,11 @@ fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<()> {
             "cannot remove a file in {}: {e}",
             existing.display()
         ))
-    })
+    })?;
+    let shared = matches!(kind, Some(OutputKind::Report { shared: true, .. }));
+    (!shared)
+        .then(|| OutputLock::acquire("--out", out))
+        .transpose()
 }
 
 /// The caps on a command's projected work and memory (`--max-work`,

@@ -12,6 +12,8 @@
 //!   rerun writes fewer files (old entry points removed first, dropped files removed,
 //!   entry points written last); several journals may share one directory, one per
 //!   output set (the studies' convergence folder).
+//! - [`lock`]: [`OutputLock`], one running command per output directory (an advisory
+//!   lock on the directory, released when the process ends).
 //! - [`staging`]: [`Staging`], where a run's files wait, hidden inside the output
 //!   directory, until the run has succeeded; a refusal or failure drops them and leaves
 //!   the directory as it was.
@@ -29,12 +31,14 @@
 pub mod columns;
 pub mod figure;
 pub mod io;
+pub mod lock;
 pub mod manifest;
 pub mod provenance;
 pub mod staging;
 
 pub use figure::{AxisUnits, Figure, Series, SeriesColor, SeriesStyle};
 pub use io::{AtomicFile, remove_stale_temporaries, write_atomic, write_csv, write_json};
+pub use lock::OutputLock;
 pub use manifest::{Manifest, ReportRun, new_run_id, read_manifest};
 pub use provenance::{DescribeScene, Provenance, ProvenanceRef, SceneProvenance};
 pub use staging::Staging;

@@ -104,18 +104,25 @@ impl Drop for Staging {
             return;
         }
         let _ = fs::remove_dir_all(&self.staging);
-        if let Some(top) = &self.created {
-            let mut d = self.dir.clone();
-            while fs::remove_dir(&d).is_ok() && d != *top {
-                let Some(parent) = d.parent() else { break };
-                d = parent.to_path_buf();
-            }
-        }
+        remove_created_if_empty(&self.dir, self.created.as_deref());
+    }
+}
+
+/// Removes `dir` and its ancestors up to `top` (the topmost directory a run created, as
+/// [`first_missing`] found it) while they are empty; nothing if `top` is `None`.
+pub(crate) fn remove_created_if_empty(dir: &Path, top: Option<&Path>) {
+    let Some(top) = top else {
+        return;
+    };
+    let mut d = dir;
+    while fs::remove_dir(d).is_ok() && d != top {
+        let Some(parent) = d.parent() else { break };
+        d = parent;
     }
 }
 
 /// The topmost ancestor of `dir` (or `dir` itself) that does not exist yet, if any.
-fn first_missing(dir: &Path) -> Option<PathBuf> {
+pub(crate) fn first_missing(dir: &Path) -> Option<PathBuf> {
     let mut missing = None;
     let mut d = Some(dir);
     while let Some(p) = d.filter(|p| !p.as_os_str().is_empty()) {
