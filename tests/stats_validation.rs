@@ -1088,25 +1088,28 @@ fn product_sum_test_rejects_a_wrong_correlation_without_saturating() {
 }
 
 /// The decay-rate test with its lag taken from the reference rate ([`LagRule::Expected`])
-/// against the lag from the data's pilot ρ̂(1), on the layouts of the checks that were
-/// skipped at the quick budget (hinged-linear-2d and clamped-clamped-3d, the paper's
-/// run, mode 1): 8 series of 32 samples at ρ = 0.61 and 16 series of 32 at ρ = 0.72,
-/// mean known, 2 000 replicates each. With the expected lag the estimate is made in every
-/// replicate at one fixed lag, and its t-test p-values are uniform with their 5 % and 1 %
-/// rates in band. With the pilot lag the estimate needs a lag the series are too short
-/// for unless the pilot decay looks fast, so it is made in only a few replicates, and in
-/// those the p-values crowd near 0 (the known wrong answer: more than 15 % below 0.05;
-/// 20–41 % measured), which is why a skipped check must not choose its lag from its data.
+/// against the lag from the data's pilot ρ̂(1), on the layouts of the two checks that the
+/// quick budget skipped (the paper's run, mode 1, sampled twice per relaxation time,
+/// ρ = e^−0.5, mean known): hinged-linear-2d's 8 series of 32 samples and
+/// clamped-clamped-3d's 16 of 32; 2 000 replicates each. With the expected lag the
+/// estimate is made in every replicate at one fixed lag (1 and 2: the longest the series
+/// allow 10 blocks at), and its t-test p-values are uniform with their 5 % and 1 % rates
+/// in band. With the pilot's lag the hinged layout needs lag 2, which its series are too
+/// short for, unless the pilot decay looks fast (ρ̂(1) < 0.513): the estimate is made in
+/// a few replicates only, and in those its p-values crowd near 0 — the known wrong answer:
+/// more than 15 % below 0.05 (38 % measured). The clamped layout's pilot asks for the
+/// too-long lag 3 only in the few replicates whose decay looks slow (about 3 %).
 #[test]
 fn decay_rate_lag_from_the_reference_removes_the_selection_bias() {
     use langevin_fem::stats::{LagRule, decay_rate_with_lag, t_test};
     const N_REP: u64 = 2000;
-    for &(m, n, rho, lag) in &[(8_u64, 32, 0.61_f64, 1), (16, 32, 0.72, 2)] {
-        let lambda = -rho.ln();
+    let rho = (-0.5_f64).exp();
+    let lambda = 0.5;
+    for &(m, lag) in &[(8_u64, 1), (16, 2)] {
         let (mut expected, mut pilot) = (Vec::new(), Vec::new());
         for r in 0..N_REP {
             let xs: Vec<Vec<f64>> = (0..m)
-                .map(|i| ar1(SEED_DECAY_LAG, 100 * r + i, n, rho, 0.0, 1.0))
+                .map(|i| ar1(SEED_DECAY_LAG, 100 * r + i, 32, rho, 0.0, 1.0))
                 .collect();
             let refs: Vec<&[f64]> = xs.iter().map(Vec::as_slice).collect();
             let e = decay_rate_with_lag(&refs, 1.0, Some(0.0), 0.95, LagRule::Expected(lambda))
@@ -1125,12 +1128,17 @@ fn decay_rate_lag_from_the_reference_removes_the_selection_bias() {
                 );
             }
         }
-        assert_null_p_values(&format!("expected lag, {m} x {n}, rho {rho}"), &expected);
+        assert_null_p_values(&format!("expected lag, {m} series"), &expected);
         let low = pilot.iter().filter(|&&p| p < 0.05).count() as f64 / pilot.len() as f64;
+        let ran = pilot.len() as f64 / N_REP as f64;
+        let ok = if m == 8 {
+            ran < 0.25 && low > 0.15
+        } else {
+            (0.9..1.0).contains(&ran)
+        };
         assert!(
-            pilot.len() < N_REP as usize / 4 && low > 0.15,
-            "pilot lag, {m} x {n}: ran {} of {N_REP}, {low:.3} below 0.05",
-            pilot.len()
+            ok,
+            "pilot lag, {m} series: ran {ran:.3}, {low:.3} below 0.05"
         );
     }
 }

@@ -80,6 +80,10 @@ pub struct RateEstimate {
     /// Jackknife correlation of λ̂ with the second moment Ĉ₀ of the same series (see the
     /// module documentation); NaN if either has no jackknife spread.
     pub variance_correlation: f64,
+    /// Whether the lag came from the data's pilot ρ̂(1): always with [`LagRule::Pilot`];
+    /// with [`LagRule::Expected`] only as its fallback (ρ̂ not positive at the expected
+    /// lag).
+    pub lag_from_data: bool,
 }
 
 /// Additive sufficient statistics of one block for the lag-k ratio estimator
@@ -201,7 +205,11 @@ pub enum LagRule {
     /// From a rate λ known before the data are seen (the exact reference's rate, in the
     /// inverse time units of `dt`): k = max(1, round(1/(λ dt))), lowered to the longest
     /// lag at which the series still give [`MIN_JACKKNIFE_BLOCKS`] blocks. The lag, and
-    /// whether an estimate is made at all, then depend on the sampling plan only.
+    /// whether an estimate is made at all, then depend on the sampling plan only — with
+    /// one exception: if ρ̂(k), or that of a jackknife replicate, is not positive there
+    /// (data that decay far faster than λ; under λ itself a rare event, ρ(k) ≈ e⁻¹), the
+    /// pilot's lag is used instead, so that a gross error gives an estimate to be
+    /// rejected rather than no estimate ([`RateEstimate::lag_from_data`]).
     Expected(f64),
 }
 
@@ -225,15 +233,39 @@ pub fn decay_rate_with_lag(
         None => series.iter().flat_map(|s| s.iter()).sum::<f64>() / n_total as f64,
     };
     let known = known_mean.is_some();
-    let k = match lag {
-        LagRule::Pilot => choose_lag(series, n_total, shift, known)?,
+    let pilot = || -> Result<RateEstimate> {
+        let k = choose_lag(series, n_total, shift, known)?;
+        let blocks = jackknife_blocks(series, n_total, k, shift)?;
+        let estimate = jackknife_estimate(&blocks, k, dt, known, confidence)?;
+        Ok(RateEstimate {
+            lag_from_data: true,
+            ..estimate
+        })
+    };
+    match lag {
+        LagRule::Pilot => pilot(),
         LagRule::Expected(rate) => {
             crate::error::require_positive("expected rate", rate)?;
-            expected_lag(series, n_total, rate * dt)?
+            let k = expected_lag(series, n_total, rate * dt)?;
+            let blocks = jackknife_blocks(series, n_total, k, shift)?;
+            if all_rho_positive(&blocks, known) {
+                jackknife_estimate(&blocks, k, dt, known, confidence)
+            } else {
+                pilot()
+            }
         }
+    }
+}
+
+/// Whether ρ̂(k) of the pooled `blocks` and of every delete-one-block replicate is
+/// positive (finite), as [`jackknife_estimate`] needs.
+fn all_rho_positive(blocks: &[Sums], known: bool) -> bool {
+    let total = blocks.iter().copied().fold(Sums::default(), Sums::add);
+    let positive = |s: &Sums| {
+        let r = s.rho(known);
+        r.is_finite() && r > 0.0
     };
-    let blocks = jackknife_blocks(series, n_total, k, shift)?;
-    jackknife_estimate(&blocks, k, dt, known, confidence)
+    positive(&total) && blocks.iter().all(|b| positive(&total.sub(*b)))
 }
 
 /// The argument checks of [`decay_rate`] (its `Error::InvalidParameter` cases).
@@ -415,6 +447,7 @@ fn jackknife_estimate(
         lag: k,
         n_blocks,
         variance_correlation,
+        lag_from_data: false,
     })
 }
 
@@ -476,7 +509,15 @@ mod tests {
         let x = ar1(rho, 100_000, 0);
         let lambda = -rho.ln();
         let e = decay_rate_with_lag(&[&x], 1.0, None, 0.95, LagRule::Expected(lambda)).unwrap();
-        assert_eq!(e, decay_rate(&[&x], 1.0, None, 0.95).unwrap());
+        let p = decay_rate(&[&x], 1.0, None, 0.95).unwrap();
+        assert!(!e.lag_from_data && p.lag_from_data);
+        assert_eq!(
+            e,
+            RateEstimate {
+                lag_from_data: false,
+                ..p
+            }
+        );
         // 1/(λ dt) = 4.48 but 1 000 samples allow 10 segments of 20 lags only up to lag 5,
         // 400 samples only lag 2: the lag shrinks to fit whatever the data.
         let rule = LagRule::Expected(lambda);
@@ -505,6 +546,21 @@ mod tests {
             let r = LagRule::Expected(bad);
             assert!(decay_rate_with_lag(&[&x], 1.0, None, 0.95, r).is_err());
         }
+    }
+
+    /// ρ̂ negative at the expected lag (a series that oscillates with period 16 where the
+    /// reference expects lag 8): the lag comes from the pilot instead, and says so.
+    #[test]
+    fn expected_lag_falls_back_to_the_pilot_where_rho_is_not_positive() {
+        let x: Vec<f64> = (0..4000)
+            .map(|i| (std::f64::consts::PI * i as f64 / 8.0).sin())
+            .collect();
+        let rule = LagRule::Expected(1.0 / 8.0);
+        let e = decay_rate_with_lag(&[&x], 1.0, Some(0.0), 0.95, rule).unwrap();
+        let p = decay_rate(&[&x], 1.0, Some(0.0), 0.95).unwrap();
+        assert!(e.lag_from_data, "{e:?}");
+        assert_eq!(e, p);
+        assert_eq!(e.lag, 13); // −1/ln cos(π/8) = 12.6
     }
 
     #[test]

@@ -593,7 +593,9 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
         return Ok(());
     };
     // The lag comes from the reference's rate, not from the data: whether the check runs
-    // must not depend on how fast this sample happens to decay (statistics.md).
+    // must not depend on how fast this sample happens to decay (statistics.md). Data that
+    // decay far faster than the reference (ρ̂ not positive at its lag) get the pilot's lag,
+    // so that they fail rather than skip.
     let lag = stats::LagRule::Expected(rate_ref);
     match stats::decay_rate_with_lag(&m.series, m.dt_sample, Some(0.0), CONFIDENCE, lag) {
         Ok(re) => {
@@ -606,8 +608,16 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
                 &o,
                 Some(mr.rate_continuum),
                 format!(
-                    "-ln rho(k)/(k dt) at lag {}, {} jackknife blocks, 95% CI [{:.4e}, {:.4e}]",
-                    re.lag, re.n_blocks, re.ci_low, re.ci_high
+                    "-ln rho(k)/(k dt) at lag {}{}, {} jackknife blocks, 95% CI [{:.4e}, {:.4e}]",
+                    re.lag,
+                    if re.lag_from_data {
+                        " (from the data: at the reference's lag rho(k) was not positive)"
+                    } else {
+                        ""
+                    },
+                    re.n_blocks,
+                    re.ci_low,
+                    re.ci_high
                 ),
             );
             c.variance_correlation = re
