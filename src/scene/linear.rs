@@ -916,7 +916,7 @@ impl Setup<'_> {
                 (1..=n_modes)
                     .map(|n| {
                         let s = crate::spectral::sin_pi(n as f64 * u);
-                        let weight = continuum.variance_scale() * s * s / (n as f64).powi(4);
+                        let weight = continuum.mode_variance(n) * s * s;
                         (weight, (-continuum.mode_rate(n) * dt).exp())
                     })
                     .collect()

@@ -111,10 +111,10 @@ pub fn prepare_data_check(
     let components = scene.components();
     let reference = LinearReference {
         modes,
-        profile_x: profile.0,
-        profile_discrete: profile.1,
-        profile_terms: profile.4,
-        profile_continuum: profile.2,
+        profile_x: profile.x,
+        profile_discrete: profile.discrete,
+        profile_terms: profile.terms,
+        profile_continuum: profile.continuum,
         two_time,
         dt: dts,
         max_rate,
@@ -142,7 +142,7 @@ pub fn prepare_data_check(
         n_modes_data: data.modes,
         n_rigid_data: rigid_suffixes.len(),
         n_tangent_data: data.tangent_modes,
-        profile_cols: profile.3,
+        profile_cols: profile.columns,
         tt_cols,
     };
     let mut columns = object.columns(sidecar.dims, data.positions.len(), data.modes)?;
@@ -538,48 +538,55 @@ fn profile_references(
     notes: &mut Vec<String>,
 ) -> Result<ProfileRefs> {
     let length = continuum.line_length();
-    // The discrete terms are per step of the discrete run; a data row is `per_row` steps.
-    let per_row = discrete.map(|d| (data.dt_sample / d.reference.dt).round());
     // Profile points present in the data.
-    let mut profile = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut profile = ProfileRefs::default();
     for (j, f) in scene.sampling.profile_points.iter().enumerate() {
         let x = f * length;
-        match column_of(data, length, x) {
-            Some(col) => {
-                profile.0.push(x);
-                let exact = continuum.profile_variance(x)?;
-                profile.1.push(match discrete {
-                    Some(d) => d.reference.profile_discrete[j],
-                    None => exact,
-                });
-                profile.2.push(exact);
-                profile.3.push(col);
-                profile.4.push(match (discrete, per_row) {
-                    (Some(d), Some(r)) => d.reference.profile_terms[j]
-                        .iter()
-                        .map(|&(u, m)| (u, m.powf(r)))
-                        .collect(),
-                    _ => Vec::new(),
-                });
-            }
-            None => notes.push(format!(
+        let Some(col) = column_of(data, length, x) else {
+            notes.push(format!(
                 "run {}: profile point x/L = {f} is not among the data's positions: not checked",
                 data.name
-            )),
-        }
+            ));
+            continue;
+        };
+        let exact = continuum.profile_variance(x)?;
+        let (reference, terms) = match discrete {
+            Some(d) => {
+                // The discrete terms are per step of the discrete run; a data row is
+                // `per_row` steps.
+                let per_row = (data.dt_sample / d.reference.dt).round();
+                let terms = d.reference.profile_terms[j]
+                    .iter()
+                    .map(|&(u, m)| (u, m.powf(per_row)))
+                    .collect();
+                (d.reference.profile_discrete[j], terms)
+            }
+            None => (exact, Vec::new()),
+        };
+        profile.x.push(x);
+        profile.discrete.push(reference);
+        profile.continuum.push(exact);
+        profile.columns.push(col);
+        profile.terms.push(terms);
     }
     Ok(profile)
 }
 
-/// Profile points: x, discrete and continuum references, their columns, and the
-/// discrete autocovariance terms per data row (empty without a discrete reference).
-type ProfileRefs = (
-    Vec<f64>,
-    Vec<f64>,
-    Vec<f64>,
-    Vec<usize>,
-    Vec<Vec<(f64, f64)>>,
-);
+/// The profile points found among the data's positions, one entry each.
+#[derive(Default)]
+struct ProfileRefs {
+    /// x.
+    x: Vec<f64>,
+    /// The reference: discrete where the discretization is known, else the continuum's.
+    discrete: Vec<f64>,
+    /// The continuum's ⟨w²(x)⟩.
+    continuum: Vec<f64>,
+    /// The data's column.
+    columns: Vec<usize>,
+    /// The discrete autocovariance terms per data row (empty without a discrete
+    /// reference).
+    terms: Vec<Vec<(f64, f64)>>,
+}
 
 /// The scene's two-time points on the data's rows and positions, from rest only: the
 /// references (with row indices as steps) and the columns of x and y; the others are
