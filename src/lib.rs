@@ -1,9 +1,9 @@
 //! # langevin-fem
 //!
 //! Finite-element Langevin dynamics for the thermal shape fluctuations of elastic
-//! bio-filaments, after Lin & Shenoy, *A Langevin dynamics approach for analyzing the
-//! mechanical response of bio-polymers*, and a statistical verification suite that judges
-//! the simulation against exact references.
+//! bio-filaments and membranes, after Lin & Shenoy, *A Langevin dynamics approach for
+//! analyzing the mechanical response of bio-polymers*, and a statistical verification
+//! suite that judges the simulation against exact references.
 //!
 //! Layers, from the bottom up (each imports only from the layers below it):
 //!

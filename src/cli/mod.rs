@@ -27,8 +27,8 @@ use langevin_fem::work::WorkLimits;
 use std::path::Path;
 use std::str::FromStr;
 
-/// Finite-element Langevin dynamics of thermally fluctuating filaments, with exact
-/// references and statistical verification.
+/// Finite-element Langevin dynamics of thermally fluctuating filaments and membranes, with
+/// exact references and statistical verification.
 ///
 /// Results and summaries go to stdout; progress, warnings and errors to stderr. Exit
 /// codes: 0 ok, 1 checks failed, 2 bad input (the message names the flag, or the file and

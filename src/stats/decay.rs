@@ -31,9 +31,12 @@
 //! estimated) without one block, and SE² = (B−1)/B Σ_b (λ̂_(b) − λ̄)². Blocks are groups
 //! of whole series when there are at least 20 series (up to [`TARGET_BLOCKS`]
 //! groups of nearly equal numbers of series); otherwise each series is cut into
-//! contiguous segments so that there are about [`TARGET_BLOCKS`] blocks, each at least
-//! [`MIN_SEGMENT_LAGS`]·k samples long (a lag-k pair belongs to the block of its first
-//! sample). At least
+//! contiguous segments (a lag-k pair belongs to the block of its first sample). The
+//! target is b = min([`TARGET_BLOCKS`], N / ([`MIN_SEGMENT_LAGS`]·k)) blocks of average
+//! length ℓ = N/b ≥ [`MIN_SEGMENT_LAGS`]·k over the N samples; a series of n samples is
+//! cut into round(n/ℓ) equal segments, at least one, so a segment is at least about ¾ℓ
+//! long (15 lags) unless its whole series is shorter (8 series of 32 samples at lag 1
+//! give 16 segments of 16 samples; the validation tests calibrate that layout). At least
 //! [`MIN_JACKKNIFE_BLOCKS`] blocks are required. The confidence interval is
 //! λ̂ ± t_{B−1, (1+confidence)/2} · SE.
 //!
@@ -56,8 +59,9 @@ use crate::error::{Error, Result};
 pub const TARGET_BLOCKS: usize = 32;
 /// Minimum number of jackknife blocks.
 pub const MIN_JACKKNIFE_BLOCKS: usize = 10;
-/// Contiguous segments cut from one series are at least this many lags k long, so that
-/// neighbouring blocks are nearly independent.
+/// Contiguous segments cut from the series are this many lags k long on average (per
+/// series at least about ¾ of it, see the module documentation), so that neighbouring
+/// blocks are nearly independent.
 pub const MIN_SEGMENT_LAGS: usize = 20;
 /// Number of series from which whole series are used as (groups of) blocks.
 const WHOLE_SERIES_BLOCKS: usize = 20;
@@ -366,7 +370,7 @@ fn jackknife_blocks(series: &[&[f64]], n_total: usize, k: usize, shift: f64) -> 
         if b_target < MIN_JACKKNIFE_BLOCKS {
             return Err(numerical(format!(
                 "{n_total} samples in {m} series allow only {b_target} jackknife segments of \
-                 at least {MIN_SEGMENT_LAGS} x lag {k} samples (need {MIN_JACKKNIFE_BLOCKS})"
+                 {MIN_SEGMENT_LAGS} x lag {k} samples on average (need {MIN_JACKKNIFE_BLOCKS})"
             )));
         }
         let seg_len = n_total as f64 / b_target as f64;
