@@ -845,6 +845,48 @@ fn verify_continuum_columns_match_theory_subcommand() {
     }
 }
 
+/// What: the two-time table's `std_error` beside each estimate is the error of that
+/// point's check in `summary.json`, for a diagonal point (x = y, t = η: the χ² test,
+/// error from the reference) and an off-diagonal one (the quadratic-form test, error
+/// from the reference) alike.
+/// Reference: `summary.json`'s `std_error` of the same checks, in the same order.
+/// Tolerance: exact (both print the same f64 with round-trip precision).
+#[test]
+fn two_time_table_errors_are_the_checks_errors() {
+    let dir = TempDir::new("two-time-errors");
+    let text = std::fs::read_to_string(fixture(TINY)).unwrap();
+    let text = replaced(
+        &text,
+        "two_time = [[0.5, 0.5, 0.5, 1.0]]",
+        "two_time = [[0.5, 0.5, 0.5, 1.0], [0.5, 0.5, 1.0, 1.0]]",
+    );
+    let scene = write_scene(&dir, "two-time-errors", text.as_bytes());
+    let out = dir.join("out");
+    let summary = verify_scene(&scene, &out, None);
+    let checks: Vec<(String, f64)> = summary["scenes"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["check"] == "two-time")
+        .map(|c| {
+            let kind = c["kind"].as_str().unwrap().to_string();
+            (kind, c["std_error"].as_f64().unwrap())
+        })
+        .collect();
+    let kinds: Vec<&str> = checks.iter().map(|(k, _)| k.as_str()).collect();
+    assert_eq!(kinds, ["quadratic-form", "chi2-variance"]);
+    let table = std::fs::read_to_string(out.join("two-time-errors/crank-nicolson-two-time.csv"))
+        .expect("two-time table");
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "std_error").unwrap();
+    let errors: Vec<f64> = lines
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    let expected: Vec<f64> = checks.iter().map(|c| c.1).collect();
+    assert_eq!(errors, expected);
+}
+
 /// The directives of a bad scene fixture.
 struct BadScene {
     path: PathBuf,

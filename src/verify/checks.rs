@@ -698,11 +698,9 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
             let o = stats::t_test(m.mean, q.discrete, m.std_error, values.len())?;
             (o, "t-test", m.std_error)
         };
-        // The error beside the estimate: the check's own where it comes from the
-        // reference, else the spread over the samples.
-        ctx.est
-            .two_time
-            .push((m.mean, if law.is_some() { se } else { m.std_error }));
+        // The error beside the estimate is the check's own: from the reference for the
+        // χ² and the quadratic-form tests, from the spread over the samples for the t-test.
+        ctx.est.two_time.push((m.mean, se));
         ctx.out.push(check(
             format!(
                 "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
