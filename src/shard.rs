@@ -26,7 +26,7 @@
 use crate::error::{Error, Result};
 use crate::output::Staging;
 use crate::output::io::write_json;
-use crate::output::manifest::{OutputKind, refuse_occupied};
+use crate::output::manifest::{OutputKind, refuse_occupied, refuse_taken};
 use crate::output::provenance::{Provenance, SceneProvenance, VERSION_LINE};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -239,6 +239,9 @@ pub struct ShardWriter {
     /// Where the shard's files wait until [`Self::finish`] ([`crate::output::staging`]);
     /// `None` before [`Self::start`].
     staging: Option<Staging>,
+    /// The files an earlier shard of the same command in the directory lists (read by
+    /// [`Self::start`]): the only existing files the shard may replace.
+    earlier: std::collections::BTreeSet<String>,
 }
 
 impl ShardWriter {
@@ -271,6 +274,13 @@ impl ShardWriter {
             command: &self.manifest.command,
         };
         refuse_occupied(&self.dir, kind)?;
+        // `refuse_occupied` let a manifest here only if it is the same command's.
+        let path = self.dir.join(SHARD_MANIFEST);
+        self.earlier = crate::input::read_text(&path, "-", crate::input::MAX_METADATA_BYTES)
+            .ok()
+            .and_then(|text| serde_json::from_str::<ShardManifest>(&text).ok())
+            .map(|m| m.files.into_iter().map(|f| f.path).collect())
+            .unwrap_or_default();
         self.staging = Some(Staging::new(&self.dir)?);
         Ok(self)
     }
@@ -300,6 +310,7 @@ impl ShardWriter {
             },
             provenance,
             staging: None,
+            earlier: Default::default(),
         }
     }
 
@@ -407,6 +418,12 @@ impl ShardWriter {
         self.provenance.finish();
         self.manifest.provenance = serde_json::to_value(&self.provenance)
             .map_err(|e| Error::io(self.dir.join(SHARD_MANIFEST), e.into()))?;
+        if let Some(staging) = &self.staging {
+            let files = self.manifest.files.iter().map(|f| f.path.as_str());
+            if let Some(rel) = staging.taken(files, |f| self.earlier.contains(f)) {
+                return Err(refuse_taken(&self.dir, &self.manifest.command, &rel));
+            }
+        }
         let old = self.dir.join(SHARD_MANIFEST);
         match std::fs::remove_file(&old) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&old, e)),

@@ -512,6 +512,63 @@ fn a_rerun_leaves_the_old_report_until_it_finishes_and_removes_dropped_files() {
     );
 }
 
+/// What: a run never replaces what it does not own below the top level (issue #25): a
+/// user's file at the name of one of its files, in a directory no journal describes or
+/// that the earlier run of the same command did not write, and a file where one of its
+/// directories must go, make its finish refuse with exit 2 (`--out`, naming the entry),
+/// before anything is moved or removed: the tree, entry points and earlier report
+/// included, is byte for byte as it was. The earlier run's own files are replaced.
+/// Tolerance: exact (file sets and bytes).
+#[test]
+fn a_run_refuses_to_replace_files_it_does_not_own() {
+    let tmp = TempDir::new("report-taken");
+    let dir = tmp.path().join("out");
+    // No journal: a user's file where the run writes.
+    fs::create_dir_all(dir.join("a")).unwrap();
+    fs::write(dir.join("a/x.csv"), b"mine").unwrap();
+    let before = tree_bytes(&dir);
+    let run = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    run.write(&dir.join("a/x.csv"), b"new").expect("write");
+    let err = run
+        .finish(&[("summary.json", b"s"), ("index.html", b"i")])
+        .expect_err("a user's file at a file's name");
+    assert_eq!(err.exit_code(), 2, "{err}");
+    assert!(
+        err.to_string().contains("--out") && err.to_string().contains("a/x.csv"),
+        "{err}"
+    );
+    assert_eq!(tree_bytes(&dir), before);
+    assert_eq!(all_files(&dir), ["a/x.csv"], "no staging left");
+
+    // An earlier report of the same command, and a user's files beside its own.
+    fs::remove_dir_all(&dir).unwrap();
+    complete_run(&dir, &["a/x.csv"]);
+    fs::write(dir.join("a/mine.csv"), b"mine").unwrap();
+    fs::write(dir.join("b"), b"a file where a directory must go").unwrap();
+    let before = tree_bytes(&dir);
+    for (rel, obstacle) in [("a/mine.csv", "a/mine.csv"), ("b/y.csv", "b")] {
+        let run = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+        run.write(&dir.join("a/x.csv"), b"new").expect("write");
+        run.write(&dir.join(rel), b"new").expect("write");
+        let err = run
+            .finish(&[("summary.json", b"s"), ("index.html", b"i")])
+            .expect_err(rel);
+        assert_eq!(err.exit_code(), 2, "{err}");
+        assert!(
+            err.to_string().contains(&format!("holds {obstacle},")),
+            "{err}"
+        );
+        assert_eq!(tree_bytes(&dir), before, "{rel}: nothing moved or removed");
+    }
+    // Its own earlier file it replaces.
+    let run = ReportRun::begin(&dir, "verify", "manifest.json", &ENTRIES).expect("begin");
+    run.write(&dir.join("a/x.csv"), b"newer").expect("write");
+    run.finish(&[("summary.json", b"s"), ("index.html", b"i")])
+        .expect("finish");
+    assert_eq!(fs::read(dir.join("a/x.csv")).unwrap(), b"newer");
+    assert_eq!(fs::read(dir.join("a/mine.csv")).unwrap(), b"mine");
+}
+
 /// Every file under `dir` with its bytes, but those of a run's staging directory (where
 /// its files wait, unseen, until it finishes).
 fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {

@@ -421,6 +421,62 @@ fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
     assert_eq!(tree_bytes(Path::new(&report)), before);
 }
 
+/// What: `run`, `run --shard` and `check` never write over a user's file below `--out`
+/// (issue #25: nothing the user gave is overwritten): a file of the user's at the name of
+/// a trajectory, a shard's trajectory or a report table, in a folder no journal of the
+/// command describes, is refused with exit 2 naming `--out` and the file, and the folder
+/// is byte for byte as it was (nothing written beside it either).
+/// Tolerance: exact bytes.
+#[test]
+fn run_and_check_refuse_to_overwrite_a_users_file_below_out() {
+    let dir = TempDir::new("run-check-taken");
+    let cases: [(&str, &[&str], &str); 3] = [
+        ("run", &[], "crank-nicolson/trajectory-0000.npy"),
+        (
+            "run",
+            &["--shard", "1/2"],
+            "crank-nicolson/trajectory-0000.npy",
+        ),
+        ("check", &[], "hinged-linear-2d/crank-nicolson-modes.csv"),
+    ];
+    let data = dir.join_str("data");
+    simulate(&data, "npy");
+    for (i, (command, extra, mine)) in cases.into_iter().enumerate() {
+        let out = dir.join(&format!("out{i}"));
+        std::fs::create_dir_all(out.join(mine).parent().unwrap()).unwrap();
+        std::fs::write(out.join(mine), b"my own data").unwrap();
+        let before = tree_bytes(&out);
+        let out_s = out.to_str().unwrap();
+        let o = if command == "run" {
+            let mut args = vec![
+                "run",
+                "-q",
+                "--scene",
+                "hinged-linear-2d",
+                "--run",
+                "crank-nicolson",
+                "--trajectories",
+                "2",
+                "--duration-tau1",
+                "5",
+                "--out",
+                out_s,
+            ];
+            args.extend(extra);
+            run(&args)
+        } else {
+            check(&data, out_s).0
+        };
+        let err = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(2), "{command} {extra:?}: {err}");
+        assert!(
+            err.contains("--out") && err.contains(mine),
+            "{command} {extra:?}: {err}"
+        );
+        assert_eq!(tree_bytes(&out), before, "{command} {extra:?}");
+    }
+}
+
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
 #[test]
 fn bad_data_directories_exit_2_naming_what_to_fix() {

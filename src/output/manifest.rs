@@ -18,7 +18,10 @@
 //!    ([`write_atomic`]), into the staging directory. A run that is refused or fails at
 //!    any point before it finishes is dropped with its staging directory: the earlier
 //!    report is exactly as it was.
-//! 3. [`ReportRun::finish`] swaps: it removes the earlier entry points, replaces the
+//! 3. [`ReportRun::finish`] first refuses, touching nothing, if a staged file would
+//!    replace an entry below the directory that the earlier journal does not list (a
+//!    user's file in a sub-directory; [`refuse_taken`]). Then it swaps: it removes the
+//!    earlier entry points, replaces the
 //!    journal by one naming the new run as incomplete with its files and every file the
 //!    earlier journal listed (`superseded`), moves the staged files into place, removes
 //!    the superseded files this run did not write (dropped scenes: only files named in
@@ -340,6 +343,17 @@ impl ReportRun {
                 ),
             ));
         }
+        // Nothing the run does not own is replaced (issue #25): the top level was read by
+        // `refuse_occupied`; below it a file of the user's, or of no journal of this
+        // command, may stand where this run would write. Refused before anything moves.
+        {
+            let state = self.lock();
+            let owned: BTreeSet<&str> = state.superseded.iter().map(String::as_str).collect();
+            let files = state.files.iter().map(String::as_str);
+            if let Some(rel) = self.staging.taken(files, |f| owned.contains(f)) {
+                return Err(refuse_taken(&self.dir, &state.command, &rel));
+            }
+        }
         // Entry points first: an entry point on disk always names the run of the journal
         // beside it (killed in between, the earlier journal stays, without its entry
         // points: nothing describes a file wrongly).
@@ -500,7 +514,9 @@ pub enum OutputKind<'a> {
 /// manifest, a trajectory sidecar and entry points without a journal. Allowed: an empty
 /// or missing directory, the same command's earlier output (which the run replaces, as
 /// its journal says), another study's output set in the studies' shared folder, and any
-/// sub-directory (never touched unless a journal of the same command names its files).
+/// sub-directory. Below the top level the run's own file names decide, when it finishes:
+/// a file it would replace that its earlier journal does not list is refused then
+/// ([`Staging::taken`], [`refuse_taken`]), before anything is moved.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `--out`, the directory, what it holds (the file
@@ -520,6 +536,19 @@ pub fn refuse_occupied(dir: &Path, kind: OutputKind<'_>) -> Result<()> {
             "a directory for {what} of `{me}` alone, but it holds {held}, which `{me}` would replace or remove; choose another output directory (or remove that one yourself if it is no longer needed)"
         ),
     ))
+}
+
+/// The refusal of a run of `command` whose file `rel` (relative to `dir`) would replace
+/// what no earlier run of that command wrote there ([`Staging::taken`]): exit 2, naming
+/// `--out`, the directory and the entry; nothing has been moved or removed.
+pub(crate) fn refuse_taken(dir: &Path, command: &str, rel: &str) -> Error {
+    Error::invalid(
+        "--out",
+        dir.display(),
+        format!(
+            "a directory `{command}` may write its files into, but it holds {rel}, which no earlier run of `{command}` wrote there and which this run would replace; nothing was written: choose another output directory (or move {rel} away yourself)"
+        ),
+    )
 }
 
 /// What of another command (or of nobody's) `dir` holds that `kind` must not touch, in

@@ -94,6 +94,40 @@ impl Staging {
         let _ = fs::remove_dir_all(&self.staging);
         Ok(())
     }
+
+    /// The first place that [`Self::publish`] of the staged files `rels` would take from
+    /// something the run does not own, relative to the output directory: an existing
+    /// entry at a file's name that `may_replace` does not allow (an earlier run's file of
+    /// the same command is allowed by its caller; a directory never is), or an entry that
+    /// is not a directory where a file's parent directory must go. `None` if every staged
+    /// file can be moved into place replacing only what the run may replace. Files never
+    /// staged are skipped, as [`Self::publish`] skips them.
+    pub fn taken<'a>(
+        &self,
+        rels: impl IntoIterator<Item = &'a str>,
+        may_replace: impl Fn(&str) -> bool,
+    ) -> Option<String> {
+        for rel in rels {
+            if fs::symlink_metadata(self.staging.join(rel)).is_err() {
+                continue;
+            }
+            let parts: Vec<&str> = rel.split('/').collect();
+            for i in 1..parts.len() {
+                let parent = parts[..i].join("/");
+                // Followed: a symbolic link to a directory is a directory to write into.
+                if fs::symlink_metadata(self.dir.join(&parent)).is_ok()
+                    && !self.dir.join(&parent).is_dir()
+                {
+                    return Some(parent);
+                }
+            }
+            match fs::symlink_metadata(self.dir.join(rel)) {
+                Ok(m) if m.is_dir() || !may_replace(rel) => return Some(rel.to_string()),
+                _ => {}
+            }
+        }
+        None
+    }
 }
 
 impl Drop for Staging {
