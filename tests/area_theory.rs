@@ -661,3 +661,31 @@ fn cli_mesh_convergence() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// What: the membrane's exact-theory domain, as `theory area` bounds its flags: the
+/// test membrane (κ = 7, K_A = 3·10⁵, kT = 1.3, 1.3 × 0.9) inside at strains up to its
+/// bound `max_area_strain_ratio`, and κ, K_A and a strain each found outside.
+/// Reference: `AREA_BENDING_RANGE`, `STRETCH_BEND_RATIO_RANGE` (S/(κ/kT)²).
+/// Tolerance: exact.
+#[test]
+fn domain_violation_names_the_input_outside() {
+    use langevin_fem::theory::DomainInput;
+    let p = params(MembraneBoundary::SimplySupported);
+    let max = langevin_fem::fem::plate_area::max_area_strain_ratio(&p);
+    assert_eq!(p.domain_violation(&[0.0, 4.0, max]), None);
+    let input = |q: AreaParams, r: &[f64]| q.domain_violation(r).map(|(i, _)| i);
+    assert_eq!(
+        input(p, &[0.0, max * 1.01]),
+        Some(DomainInput::StrainRatio(1))
+    );
+    let soft = AreaParams {
+        area_modulus: 1e-30,
+        ..p
+    };
+    assert_eq!(input(soft, &[0.0]), Some(DomainInput::StretchRigidity));
+    let floppy = AreaParams {
+        bending_rigidity: 1e-4,
+        ..p
+    };
+    assert_eq!(input(floppy, &[0.0]), Some(DomainInput::BendingRigidity));
+}

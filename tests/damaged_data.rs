@@ -824,6 +824,13 @@ fn sidecar_missing(name: &str, pointer: &'static str, key: &str) -> Case {
 #[rustfmt::skip]
 const SIDECAR_EDITS: &[(&str, Input, &str, &str, &[&str])] = &[
     ("sidecar-length-nan", Input::LinNpy, "/filament/length", "NaN", &["data.json", "filament.length", "NaN"]),
+    // Inside [1e-30, 1e30] but outside the exact compression theory's domain (S/P² in
+    // [1e-2, 1e12], P in [1e-3, 1e6]): the theory exhausted memory at EA = 1e-6, ran for
+    // minutes at 50 and failed as a "run" (exit 3) at 1e30.
+    ("sidecar-comp-ea-below-theory", Input::CompCsv, "/filament/stretch_rigidity", "1e-6", &["data.json", "filament.stretch_rigidity", "S/P²", "1e-6"]),
+    ("sidecar-comp-ea-just-below-theory", Input::CompCsv, "/filament/stretch_rigidity", "50.0", &["data.json", "filament.stretch_rigidity", "S/P²", "5e1"]),
+    ("sidecar-comp-ea-above-theory", Input::CompNpy, "/filament/stretch_rigidity", "1e30", &["data.json", "filament.stretch_rigidity", "S/P²", "1e30"]),
+    ("sidecar-comp-ei-above-theory", Input::CompCsv, "/filament/bending_rigidity", "1e7", &["data.json", "filament.bending_rigidity", "P = EI/(kT L)", "1e7"]),
     ("sidecar-kt-infinity", Input::LinNpy, "/filament/kt", "Infinity", &["data.json", "filament.kt", "Infinity|inf"]),
     ("sidecar-drag-minus-infinity", Input::LinNpy, "/filament/drag", "-Infinity", &["data.json", "filament.drag", "-Infinity|-inf"]),
     ("sidecar-ei-nan", Input::LinNpy, "/filament/bending_rigidity", "NaN", &["data.json", "filament.bending_rigidity", "NaN"]),

@@ -70,7 +70,8 @@ use super::plate_modes::{Wave, axis_waves};
 use crate::error::{Error, Result, require_positive};
 use crate::spectral::membrane::{Membrane, MembraneBoundary, MembraneParams};
 use crate::theory::compression::{
-    CompressionTheory, ForceDistribution, GlobalConstraint, QuadratureOptions, StoredLengthLaw,
+    CompressionTheory, DomainInput, ForceDistribution, GlobalConstraint, QuadratureOptions,
+    StoredLengthLaw,
 };
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::f64::consts::PI;
@@ -169,6 +170,39 @@ impl AreaParams {
             ));
         }
         self.constraint().map(|_| ())
+    }
+
+    /// Where these parameters at the strain ratios `strain_ratios` leave the domain in
+    /// which `theory area` computes the exact theory (as the filament's
+    /// [`crate::theory::domain_violation`]): κ/kT in [`AREA_BENDING_RANGE`],
+    /// S/(κ/kT)² (S = K_A·A₀/kT) in [`crate::theory::STRETCH_BEND_RATIO_RANGE`], each
+    /// strain ratio in [[`crate::theory::MIN_STRAIN_RATIO`], [`max_area_strain_ratio`]].
+    /// The first input outside ([`DomainInput::StretchRigidity`] stands for K_A) with its
+    /// allowed range in words; `None` inside.
+    pub fn domain_violation(&self, strain_ratios: &[f64]) -> Option<(DomainInput, String)> {
+        let k = self.bending_rigidity / self.kt;
+        let (k_lo, k_hi) = AREA_BENDING_RANGE;
+        if !(k.is_finite() && (k_lo..=k_hi).contains(&k)) {
+            let allowed = format!(
+                "such that κ/kT is in [{k_lo:e}, {k_hi:e}] (here {k:.3e}; the exact theory's domain)"
+            );
+            return Some((DomainInput::BendingRigidity, allowed));
+        }
+        let (l_lo, l_hi) = crate::theory::STRETCH_BEND_RATIO_RANGE;
+        let l = self.area_modulus * self.area() / self.kt / (k * k);
+        if !(l.is_finite() && (l_lo..=l_hi).contains(&l)) {
+            let allowed = format!(
+                "such that S/(κ/kT)² = K_A A₀ kT/κ² is in [{l_lo:e}, {l_hi:e}] (here {l:.3e}; the \
+                 exact theory's domain: outside it runs for minutes or meets a known limit)"
+            );
+            return Some((DomainInput::StretchRigidity, allowed));
+        }
+        let (min, max) = (crate::theory::MIN_STRAIN_RATIO, max_area_strain_ratio(self));
+        let i = strain_ratios
+            .iter()
+            .position(|r| !(r.is_finite() && (min..=max).contains(r)))?;
+        let allowed = format!("in [{min:e}, {max:e}] here (the exact theory's domain)");
+        Some((DomainInput::StrainRatio(i), allowed))
     }
 
     /// The parameters of the membrane `params` (its tension ignored: under imposed

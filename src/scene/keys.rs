@@ -199,7 +199,7 @@ pub const KEYS: &[KeyDoc] = &[
         PHYSICAL,
         "1e6",
         closed(1e-30, 1e30),
-        "Stretching rigidity EA (a force); used by the compression model only (EA·L/kT = 1e6 in the paper's Fig. 2).",
+        "Stretching rigidity EA (a force); used by the compression model only (EA·L/kT = 1e6 in the paper's Fig. 2), which also needs EI/(kT·L) in [1e-3, 1e6] and S/P² = EA·L³·kT/EI² in [1e-2, 1e12], the exact theory's domain.",
     ),
     key(
         "filament.drag",
@@ -409,7 +409,7 @@ pub const KEYS: &[KeyDoc] = &[
         "1 to 100 strains, each in [-1000, 1000]",
         "required",
         closed(-1000.0, 1000.0),
-        "Compression scenes: imposed end-shortening strains ε = Δ/L in units of the Euler strain ε_c0 = π²EI/(EA·L²) (negative: tension).",
+        "Compression scenes: imposed end-shortening strains ε = Δ/L in units of the Euler strain ε_c0 = π²EI/(EA·L²) (negative: tension); at most 100·√S/P (S = EA·L/kT, P = EI/(kT·L); a membrane: the same bound of `theory area`), the exact theory's domain.",
     ),
     key(
         "compression.distribution_strain_ratios",
@@ -449,7 +449,7 @@ pub const KEYS: &[KeyDoc] = &[
         "in [1e-30, 1e30]; required with a [membrane] table (whose tension must be 0), refused with a filament",
         "none",
         closed(1e-30, 1e30),
-        "Compression scenes of a membrane under imposed projected area (issue #28): the area modulus K_A. The strains are 1 − A_p/A₀ in units of ε_c0 = κq²_min/K_A, the recorded value the compressive stress −σ/σ_c0.",
+        "Compression scenes of a membrane under imposed projected area (issue #28): the area modulus K_A. The strains are 1 − A_p/A₀ in units of ε_c0 = κq²_min/K_A, the recorded value the compressive stress −σ/σ_c0. The exact theory's domain needs κ/kT in [1e-3, 1e6] and K_A·A₀·kT/κ² in [1e-2, 1e12].",
     ),
     key(
         "runs[].name",

@@ -36,8 +36,10 @@ use super::spec::{
 use crate::dynamics::{Family, IntegratorKind};
 use crate::error::{Error, Result};
 use crate::fem::noise::NoiseModel;
+use crate::fem::plate_area::AreaParams;
 use crate::params::{End, physical};
 use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
+use crate::theory::DomainInput;
 use crate::work::{Origin, Part, RunWork};
 use std::fmt::Display;
 
@@ -845,6 +847,7 @@ impl Scene {
                 return Err(bad(self, &key, &Num(r), "one of compression.strain_ratios"));
             }
         }
+        self.validate_theory_domain(&c.strain_ratios, c.area_modulus)?;
         let b = c.burn_in_tau1;
         if !(b.is_finite() && (0.0..=1e4).contains(&b)) {
             return Err(bad(
@@ -864,6 +867,59 @@ impl Scene {
             ));
         }
         Ok(())
+    }
+
+    /// A compression scene lies in the exact theory's domain: a filament's
+    /// ([`crate::theory::domain_violation`]) or a membrane's under imposed projected area
+    /// of modulus `area_modulus` ([`AreaParams::domain_violation`]). Outside, the key of
+    /// the input (EI or κ, EA or K_A, a strain ratio) with its allowed range.
+    fn validate_theory_domain(
+        &self,
+        strain_ratios: &[f64],
+        area_modulus: Option<f64>,
+    ) -> Result<()> {
+        let f = &self.filament;
+        let found = match (&self.membrane, area_modulus) {
+            (Some(m), Some(k_a)) => {
+                let found = AreaParams::from_membrane(m, k_a).domain_violation(strain_ratios);
+                found.map(|(input, allowed)| {
+                    let (key, value) = match input {
+                        DomainInput::BendingRigidity => {
+                            ("membrane.bending_rigidity", m.bending_rigidity)
+                        }
+                        DomainInput::StretchRigidity => ("compression.area_modulus", k_a),
+                        DomainInput::StrainRatio(_) => ("", 0.0),
+                    };
+                    (input, key.to_string(), value, allowed)
+                })
+            }
+            _ => {
+                let (p, s) = (
+                    f.bending_rigidity / (f.kt * f.length),
+                    f.stretch_rigidity * f.length / f.kt,
+                );
+                crate::theory::domain_violation(p, s, strain_ratios).map(|(input, allowed)| {
+                    let (key, value) = match input {
+                        DomainInput::BendingRigidity => ("bending_rigidity", f.bending_rigidity),
+                        DomainInput::StretchRigidity => ("stretch_rigidity", f.stretch_rigidity),
+                        DomainInput::StrainRatio(_) => ("", 0.0),
+                    };
+                    let key = match &self.physical {
+                        Some(ph) => ph.keys_of(key).first().copied().unwrap_or(key),
+                        None => key,
+                    };
+                    (input, format!("filament.{key}"), value, allowed)
+                })
+            }
+        };
+        match found {
+            None => Ok(()),
+            Some((DomainInput::StrainRatio(i), _, _, allowed)) => {
+                let key = format!("compression.strain_ratios[{i}]");
+                Err(bad(self, &key, &Num(strain_ratios[i]), &allowed))
+            }
+            Some((_, key, value, allowed)) => Err(bad(self, &key, &Num(value), &allowed)),
+        }
     }
 
     /// The one per-run check of every scene: name, integrator and noise, own checks,

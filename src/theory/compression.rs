@@ -284,6 +284,55 @@ pub fn max_strain_ratio(persistence_ratio: f64, stretch_ratio: f64) -> f64 {
     STRAIN_RATIO_SCALE * stretch_ratio.sqrt() / persistence_ratio
 }
 
+/// The input of a filament that puts it outside the exact theory's domain
+/// ([`domain_violation`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DomainInput {
+    /// EI (through the persistence ratio P = EI/(kT·L)).
+    BendingRigidity,
+    /// EA (through S/P², S = EA·L/kT).
+    StretchRigidity,
+    /// The strain ratio of this index.
+    StrainRatio(usize),
+}
+
+/// Where a filament of persistence ratio `p` = EI/(kT·L) and stretch ratio `s` = EA·L/kT
+/// at the strain ratios ε/ε_c0 `strain_ratios` leaves the domain in which the exact
+/// equilibrium theory is computed and tested: P in [`PERSISTENCE_RATIO_RANGE`], S/P² in
+/// [`STRETCH_BEND_RATIO_RANGE`], each strain ratio in [[`MIN_STRAIN_RATIO`],
+/// [`max_strain_ratio`]]. Outside, the quadrature runs for minutes, exhausts memory or
+/// meets a known limit; so scenes and data are refused there, as `theory compression`
+/// refuses its flags. The first input found outside, with the allowed range of that input
+/// (the others held) in words; `None` inside.
+pub fn domain_violation(p: f64, s: f64, strain_ratios: &[f64]) -> Option<(DomainInput, String)> {
+    let (p_lo, p_hi) = PERSISTENCE_RATIO_RANGE;
+    if !(p.is_finite() && (p_lo..=p_hi).contains(&p)) {
+        let allowed = format!(
+            "such that P = EI/(kT L) is in [{p_lo:e}, {p_hi:e}] (here {p:.3e}; the exact \
+             compression theory's domain)"
+        );
+        return Some((DomainInput::BendingRigidity, allowed));
+    }
+    let (k_lo, k_hi) = STRETCH_BEND_RATIO_RANGE;
+    let k = s / (p * p);
+    if !(k.is_finite() && (k_lo..=k_hi).contains(&k)) {
+        let allowed = format!(
+            "such that S/P² = EA L³ kT/EI² is in [{k_lo:e}, {k_hi:e}] (here {k:.3e}; the exact \
+             compression theory's domain: outside it runs for minutes or meets a known limit)"
+        );
+        return Some((DomainInput::StretchRigidity, allowed));
+    }
+    let max = max_strain_ratio(p, s);
+    let i = strain_ratios
+        .iter()
+        .position(|r| !(r.is_finite() && (MIN_STRAIN_RATIO..=max).contains(r)))?;
+    let allowed = format!(
+        "in [{MIN_STRAIN_RATIO:e}, {max:e}] at P = {p:e}, S = {s:e} (at most {STRAIN_RATIO_SCALE}·√S/P: \
+         the exact compression theory's domain)"
+    );
+    Some((DomainInput::StrainRatio(i), allowed))
+}
+
 /// Terms of the power series used for the small modes.
 const SERIES_TERMS: usize = 30;
 /// Modes with `b τ_max` at most this go into the power series.
@@ -2086,6 +2135,47 @@ impl ForceDistribution {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The exact theory's domain, as `theory compression` bounds its flags: the paper's
+    /// filament inside at every strain up to 100·√S/P, each input found outside at either
+    /// side of its range (the bounds themselves inside), EI before EA before the strains.
+    #[test]
+    fn domain_violation_names_the_input_outside() {
+        assert_eq!(
+            domain_violation(100.0, 1e6, &[-8.0, 0.0, 6.0, 1000.0]),
+            None
+        );
+        assert_eq!(domain_violation(1e-3, 1e-8, &[0.0]), None);
+        assert_eq!(domain_violation(1e6, 1e24, &[0.0]), None);
+        let input = |p, s, r: &[f64]| domain_violation(p, s, r).map(|(i, _)| i);
+        assert_eq!(
+            input(100.0, 1e6, &[0.0, 1000.5]),
+            Some(DomainInput::StrainRatio(1))
+        );
+        assert_eq!(
+            input(100.0, 1e6, &[-1.1e8]),
+            Some(DomainInput::StrainRatio(0))
+        );
+        assert_eq!(
+            input(100.0, 1e6, &[f64::NAN]),
+            Some(DomainInput::StrainRatio(0))
+        );
+        assert_eq!(
+            input(100.0, 50.0, &[0.0]),
+            Some(DomainInput::StretchRigidity)
+        );
+        assert_eq!(
+            input(100.0, 1.1e16, &[0.0]),
+            Some(DomainInput::StretchRigidity)
+        );
+        assert_eq!(input(1e7, 1e6, &[0.0]), Some(DomainInput::BendingRigidity));
+        assert_eq!(input(9e-4, 1e6, &[1e9]), Some(DomainInput::BendingRigidity));
+        let (_, allowed) = domain_violation(100.0, 50.0, &[0.0]).unwrap();
+        assert!(
+            allowed.contains("[1e-2, 1e12]") && allowed.contains("5.000e-3"),
+            "{allowed}"
+        );
+    }
 
     #[test]
     fn inverse_power_tails_are_consistent() {

@@ -14,9 +14,9 @@ pub mod compression;
 pub mod scheme_law;
 
 pub use compression::{
-    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, ForceDistribution, GlobalConstraint,
-    MAX_DISCRETE_ELEMENTS, MAX_QUADRATURE_WORK, MIN_STRAIN_RATIO, PERSISTENCE_RATIO_RANGE,
-    QuadratureOptions, STRAIN_RATIO_SCALE, STRETCH_BEND_RATIO_RANGE, StoredLengthLaw, Tail,
-    buckling_load_discrete, continuum_tail_log_char_bound, discrete_buckling_loads,
-    max_strain_ratio,
+    CompressionTheory, DEFAULT_CONTINUUM_MODES, Dims, DomainInput, ForceDistribution,
+    GlobalConstraint, MAX_DISCRETE_ELEMENTS, MAX_QUADRATURE_WORK, MIN_STRAIN_RATIO,
+    PERSISTENCE_RATIO_RANGE, QuadratureOptions, STRAIN_RATIO_SCALE, STRETCH_BEND_RATIO_RANGE,
+    StoredLengthLaw, Tail, buckling_load_discrete, continuum_tail_log_char_bound,
+    discrete_buckling_loads, domain_violation, max_strain_ratio,
 };

@@ -33,6 +33,7 @@ use crate::scene::linear::{
 };
 use crate::scene::{CheckKind, CompressionSpec, MeshScheme, ModelKind, RunSpec, Scene};
 use crate::stats::moments::MIN_SERIES_LEN;
+use crate::theory::DomainInput;
 use std::path::Path;
 
 /// A data run ready for the checks: the references in rows of the data, the records
@@ -256,6 +257,37 @@ fn data_filament(sidecar: &DataSidecar, dir: &Path) -> Result<crate::data::DataF
             "must be given for compression data",
         )
     })
+}
+
+/// Refuses compression data whose filament (`data.json`'s, `f`) puts the scene's strains
+/// `strain_ratios` outside the exact theory's domain ([`crate::theory::domain_violation`]),
+/// naming the sidecar's key, before any reference is computed.
+fn data_theory_domain(f: &FilamentParams, strain_ratios: &[f64], dir: &Path) -> Result<()> {
+    let (p, s) = (
+        f.bending_rigidity / (f.kt * f.length),
+        f.stretch_rigidity * f.length / f.kt,
+    );
+    let Some((input, allowed)) = crate::theory::domain_violation(p, s, strain_ratios) else {
+        return Ok(());
+    };
+    let (key, message) = match input {
+        DomainInput::BendingRigidity => (
+            "filament.bending_rigidity",
+            format!("must be {allowed}, got {:e}", f.bending_rigidity),
+        ),
+        DomainInput::StretchRigidity => (
+            "filament.stretch_rigidity",
+            format!("must be {allowed}, got {:e}", f.stretch_rigidity),
+        ),
+        DomainInput::StrainRatio(i) => (
+            "filament",
+            format!(
+                "puts the scene's strain ratio {} outside the exact theory's domain: it must be {allowed}",
+                strain_ratios[i]
+            ),
+        ),
+    };
+    Err(refused(&dir.join(crate::data::SIDECAR), key, message))
 }
 
 /// Refuses the trajectory files of `sidecar` (in `dir`) unless each is a regular file
@@ -1209,6 +1241,7 @@ fn compression_data_check(
     let first = by_strain[0].1;
     let mut scene = scene.clone();
     scene.filament = data_filament(sidecar, dir)?.params();
+    data_theory_domain(&scene.filament, &comp.strain_ratios, dir)?;
     let fem = first
         .discretization
         .as_ref()
