@@ -897,6 +897,7 @@ const SIDECAR_EDITS: &[(&str, Input, &str, &str, &[&str])] = &[
     ("sidecar-file-is-the-run-dir", Input::LinNpy, "/runs/0/files/1", "\"crank-nicolson\"", &["data.json", "runs[0].files[1]", "crank-nicolson"]),
     ("sidecar-file-txt", Input::LinNpy, "/runs/0/files/1", "\"crank-nicolson/trajectory-0001.txt\"", &["data.json", "runs[0].files[1]", "trajectory-0001.txt"]),
     ("sidecar-file-listed-twice", Input::LinNpy, "/runs/0/files/1", "\"crank-nicolson/trajectory-0000.npy\"", &["data.json", "runs[0].files[1]", "trajectory-0000.npy"]),
+    ("sidecar-file-listed-twice-spelled-apart", Input::LinNpy, "/runs/0/files/1", "\"crank-nicolson/.//trajectory-0000.npy\"", &["data.json", "runs[0].files[1]", "trajectory-0000.npy", "again"]),
     ("sidecar-elements-zero", Input::LinNpy, "/runs/0/discretization/elements", "0", &["data.json", "runs[0].discretization.elements", "0"]),
     ("sidecar-elements-1e8", Input::LinNpy, "/runs/0/discretization/elements", "100000000", &["data.json", "runs[0].discretization.elements", "100000000"]),
     ("sidecar-elements-u64-max", Input::LinNpy, "/runs/0/discretization/elements", "18446744073709551615", &["data.json", "runs[0].discretization.elements", "18446744073709551615"]),
@@ -1183,6 +1184,18 @@ fn sidecar_cases() -> Vec<Case> {
             "file-links-to-dev-zero",
             &["trajectory-0001.npy", "runs[0].files[1]", "device"],
             |_, r| make_link(r, LIN_NPY, "/dev/zero"),
+        ),
+        refused(
+            S,
+            LinNpy,
+            "file-links-to-another-listed-file",
+            &[
+                "data.json",
+                "runs[0].files[1]",
+                "runs[0].files[0]",
+                "same file",
+            ],
+            |_, r| make_link(r, LIN_NPY, "trajectory-0000.npy"),
         ),
         refused(
             S,

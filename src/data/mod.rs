@@ -654,11 +654,15 @@ impl DataSidecar {
             run.validate(k, &object, self.runs.iter().take(k))
                 .map_err(|(key, message)| bad(key, message))?;
         }
-        // Each file is one trajectory: listed twice, it would be counted twice.
-        let mut seen: std::collections::HashMap<&str, (usize, usize)> = Default::default();
+        // Each file is one trajectory: listed twice, it would be counted twice. Compared
+        // as path components, so that `a/./b` and `a//b` are `a/b` (the same file reached
+        // through a link is found when the files are opened: `require_data_size`).
+        let mut seen: std::collections::HashMap<std::path::PathBuf, (usize, usize)> =
+            Default::default();
         for (k, run) in self.runs.iter().enumerate() {
             for (j, file) in run.files.iter().enumerate() {
-                if let Some((k0, j0)) = seen.insert(file.as_str(), (k, j)) {
+                let spelled = Path::new(file).components().collect();
+                if let Some((k0, j0)) = seen.insert(spelled, (k, j)) {
                     return Err(bad(
                         format!("runs[{k}].files[{j}]"),
                         format!(

@@ -300,10 +300,11 @@ fn data_theory_domain(f: &FilamentParams, strain_ratios: &[f64], dir: &Path) -> 
 pub fn require_data_size(sidecar: &DataSidecar, dir: &Path, max_bytes: u64) -> Result<()> {
     let mut total: u64 = 0;
     let mut files = 0usize;
+    let mut seen = std::collections::HashMap::new();
     for (k, run) in sidecar.runs.iter().enumerate() {
         for (j, path) in run.paths(dir).iter().enumerate() {
             let key = format!("runs[{k}].files[{j}]");
-            let (_, len) = open_regular(path, &key).map_err(|e| match e {
+            let (file, len) = open_regular(path, &key).map_err(|e| match e {
                 // Named from the sidecar that lists the file, with why it cannot be read.
                 Error::Scene { message, .. } => refused(
                     &dir.join(crate::data::SIDECAR),
@@ -312,6 +313,17 @@ pub fn require_data_size(sidecar: &DataSidecar, dir: &Path, max_bytes: u64) -> R
                 ),
                 other => other,
             })?;
+            // One file reached by two names (a symbolic or hard link) is one trajectory.
+            if let Some(first) = file_identity(&file).and_then(|id| seen.insert(id, key.clone())) {
+                return Err(refused(
+                    &dir.join(crate::data::SIDECAR),
+                    &key,
+                    format!(
+                        "names {}, the same file as {first} (through a link): each file is one trajectory and may be listed once",
+                        path.display()
+                    ),
+                ));
+            }
             total = total.saturating_add(len);
             files += 1;
         }
@@ -328,6 +340,20 @@ pub fn require_data_size(sidecar: &DataSidecar, dir: &Path, max_bytes: u64) -> R
         ));
     }
     Ok(())
+}
+
+/// The device and inode of an open file (Unix), which two names of one file share.
+fn file_identity(file: &std::fs::File) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        file.metadata().ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = file;
+        None
+    }
 }
 
 /// Refuses data run `k` unless `scene` is linear, the dimensions agree and the run has
