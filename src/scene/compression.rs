@@ -66,10 +66,13 @@ impl CompressionTheoryTable {
         for &r in &spec.strain_ratios {
             discrete.push(disc.force_ratio(r)?);
             continuum.push(cont.force_ratio(r)?);
-            distributions.push(if spec.distribution_strain_ratios.contains(&r) {
-                Some(disc.force_distribution(r * strain_unit)?)
-            } else {
-                None
+            let j = spec.distribution_strain_ratios.iter().position(|&d| d == r);
+            distributions.push(match j {
+                Some(j) => Some(
+                    disc.force_distribution(r * strain_unit)
+                        .map_err(|e| distribution_error(scene, j, r, e))?,
+                ),
+                None => None,
             });
         }
         let lo = spec
@@ -112,6 +115,22 @@ impl CompressionTheoryTable {
     /// stays out of the paper's Fig. 2 (imposed compression, `fig2.svg`).
     pub fn reaches_tension(&self) -> bool {
         self.strain_ratios.iter().any(|&r| r < 0.0)
+    }
+}
+
+/// A failure of the exact law of F at distribution strain `j` (ratio `r`) as the key of
+/// the scene that asked for it (exit 2): where the law's Fourier series is out of reach
+/// (F too narrow at a small stretch rigidity) the strain can only be left out of the list.
+fn distribution_error(scene: &Scene, j: usize, r: f64, e: Error) -> Error {
+    match e {
+        Error::Numerical { routine, detail } => Error::Scene {
+            file: scene.path.clone(),
+            key: format!("compression.distribution_strain_ratios[{j}]"),
+            message: format!(
+                "asks for the exact distribution of F at strain ratio {r}, which cannot be computed for this filament ({routine}: {detail}); leave this strain out of distribution_strain_ratios (its mean force is still checked)"
+            ),
+        },
+        other => other,
     }
 }
 

@@ -417,7 +417,7 @@ pub const KEYS: &[KeyDoc] = &[
         "values of compression.strain_ratios",
         "[]",
         None,
-        "Compression scenes: strains where the distribution of F is tested against the exact equilibrium law.",
+        "Compression scenes: strains where the distribution of F is tested against the exact equilibrium law (refused, naming the strain, where that law's Fourier series is out of reach: F too narrow at a small S/P²).",
     ),
     key(
         "compression.burn_in_tau1",

@@ -349,6 +349,8 @@ const RANGE_MARGIN: f64 = 10.0;
 /// ([`CompressionTheory::quadrature_work`]); about 10 s. Inside the ranges the CLI accepts
 /// ([`STRETCH_BEND_RATIO_RANGE`], [`max_strain_ratio`]) the work stays below 10⁸.
 pub const MAX_QUADRATURE_WORK: f64 = 2e9;
+/// Cap on the trapezoid nodes a [`ForceDistribution`] stores (16 bytes each: 160 MB).
+pub const MAX_DISTRIBUTION_NODES: f64 = 1e7;
 /// Cap on the number of continuum tail modes summed one by one in one evaluation of the
 /// exact tail at a real argument (`2c₁|η|` up to `(cap/4)²`); about 40 ms each.
 const MAX_TAIL_MODES: usize = 4_000_000;
@@ -1869,8 +1871,25 @@ impl CompressionTheory {
         let rho_exp = self.options.decay_exponent + RANGE_MARGIN;
         let rho = (4.0 * self.a * rho_exp).sqrt();
         let (k_cap, rigorous_bound) = self.fourier_cap(&s, &mo, du, rho, rho_exp);
+        let contour = self.contour(&s, k_cap as f64 * du + rho);
+        // Refused before anything is allocated: the nodes up to the last Fourier
+        // frequency are stored, each costs the modes, and each coefficient sums the nodes
+        // within rho of its frequency.
+        let nodes = (k_cap as f64 * du + rho) / s.h + 1.0;
+        let work = nodes * contour.modes_per_node() as f64 + k_cap as f64 * (2.0 * rho / s.h + 1.0);
+        if nodes > MAX_DISTRIBUTION_NODES || work > MAX_QUADRATURE_WORK {
+            return Err(numerical(
+                "compression force distribution",
+                format!(
+                    "strain {strain:e} would need {nodes:.3e} kernel nodes (cap \
+                     {MAX_DISTRIBUTION_NODES:e}) and {work:.3e} mode evaluations (cap \
+                     {MAX_QUADRATURE_WORK:e}): the distribution of F is too narrow for its \
+                     Fourier series at this stretch rigidity"
+                ),
+            ));
+        }
         let mut sums = KernelSums {
-            contour: self.contour(&s, k_cap as f64 * du + rho),
+            contour,
             h: s.h,
             rho,
             inv4a: 0.25 / self.a,
@@ -2175,6 +2194,34 @@ mod tests {
             allowed.contains("[1e-2, 1e12]") && allowed.contains("5.000e-3"),
             "{allowed}"
         );
+    }
+
+    /// The exact law of F is refused, before anything is allocated, where its Fourier
+    /// series would need more than [`MAX_DISTRIBUTION_NODES`] nodes (a small stretch
+    /// rigidity: S/P² = 0.1 at 4 elements asks for 3·10⁷; before the cap, S/P² = 10⁻²
+    /// aborted on a 4 GiB allocation); the paper's filament (S/P² = 100) is far inside.
+    #[test]
+    fn force_distribution_is_refused_beyond_its_node_cap() {
+        let law = |ea: f64| {
+            let p = FilamentParams {
+                bending_rigidity: 100.0,
+                stretch_rigidity: ea,
+                ..FilamentParams::default()
+            };
+            let disc = StoredLengthLaw::discrete(&p, Dims::Two, 4).unwrap();
+            let t = CompressionTheory::new(&p, disc).unwrap();
+            let strain = 2.0 * t.constraint().reference_strain;
+            t.force_distribution(strain)
+        };
+        for ea in [100.0, 1000.0] {
+            match law(ea) {
+                Err(Error::Numerical { detail, .. }) => {
+                    assert!(detail.contains("kernel nodes (cap 1e7)"), "{detail}")
+                }
+                other => panic!("EA = {ea}: {other:?}"),
+            }
+        }
+        assert!(law(1e6).is_ok());
     }
 
     #[test]

@@ -1279,7 +1279,15 @@ fn compression_data_check(
     }
     let spec = data_spec(&scene, first);
     let run = CompressionRun::prepare(&scene, comp, &spec)?;
-    let mut theory = CompressionTheoryTable::new(&scene, comp)?;
+    let mut theory = CompressionTheoryTable::new(&scene, comp).map_err(|e| match e {
+        // The scene's distribution strains are out of reach at the data's filament.
+        Error::Scene { key, message, .. } if key.starts_with("compression.") => refused(
+            &dir.join(crate::data::SIDECAR),
+            "filament.stretch_rigidity",
+            format!("is the stretch rigidity at which the scene's {key} {message}"),
+        ),
+        other => other,
+    })?;
     match fem {
         Some(e) => notes.push(format!(
             "run {name}: references: the exact equilibrium theory of the producer's discretization ({e} elements) at every strain; the continuum beside it"
