@@ -887,6 +887,39 @@ fn two_time_table_errors_are_the_checks_errors() {
     assert_eq!(errors, expected);
 }
 
+/// What: `verify` refuses (exit 2, naming `--scene` and both files) two scene files of
+/// one name (the file stem, which names the output folder: the second would write over
+/// the first's tables) and one scene given twice (it would be counted twice), before
+/// writing anything.
+/// Tolerance: exact substrings.
+#[test]
+fn scenes_of_one_name_are_refused() {
+    let dir = TempDir::new("same-stem");
+    let text = std::fs::read_to_string(fixture(TINY)).unwrap();
+    std::fs::create_dir_all(dir.join("a")).unwrap();
+    std::fs::create_dir_all(dir.join("b")).unwrap();
+    std::fs::write(dir.join("a/x.toml"), &text).unwrap();
+    std::fs::write(dir.join("b/x.toml"), text.replace("kt = 1.0", "kt = 2.0")).unwrap();
+    let (a, b, out) = (
+        dir.join_str("a/x.toml"),
+        dir.join_str("b/x.toml"),
+        dir.join_str("out"),
+    );
+    for (first, second, named) in [(&a, &b, "both named \"x\""), (&a, &a, "given twice")] {
+        let args = [
+            "verify", "-q", "--scene", first, "--scene", second, "--out", &out,
+        ];
+        let o = command().args(args).output().expect("binary runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("--scene") && err.contains(named) && err.contains(second.as_str()),
+            "{err}"
+        );
+        assert!(!Path::new(&out).exists(), "nothing written");
+    }
+}
+
 /// The directives of a bad scene fixture.
 struct BadScene {
     path: PathBuf,

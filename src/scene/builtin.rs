@@ -268,10 +268,36 @@ pub fn load_scene(name_or_path: &str, scene_dir: Option<&Path>) -> Result<Scene>
 /// # Errors
 /// As [`resolve_scenes`] and [`SceneSource::load`].
 pub fn load_scenes(names: &[String], scene_dir: Option<&Path>) -> Result<Vec<Scene>> {
-    resolve_scenes(names, scene_dir)?
+    let scenes: Vec<Scene> = resolve_scenes(names, scene_dir)?
         .iter()
         .map(SceneSource::load)
-        .collect()
+        .collect::<Result<_>>()?;
+    // A scene's name is its file stem, and its outputs go to `<name>/`: two scenes of one
+    // name would write over each other's tables, and one scene given twice would be
+    // counted twice.
+    for (i, s) in scenes.iter().enumerate() {
+        if let Some(first) = scenes[..i].iter().find(|t| t.name == s.name) {
+            let what = if first.path == s.path {
+                format!("{} is given twice", s.path.display())
+            } else {
+                format!(
+                    "{} and {} are both named {:?} (the file stem) and would write the same {}/ folder",
+                    first.path.display(),
+                    s.path.display(),
+                    s.name,
+                    s.name
+                )
+            };
+            return Err(Error::invalid(
+                "--scene",
+                s.path.display(),
+                format!(
+                    "scenes of distinct names, each once: {what}; rename one file or give it once"
+                ),
+            ));
+        }
+    }
+    Ok(scenes)
 }
 
 #[cfg(test)]
