@@ -178,6 +178,22 @@ fn compression_run_in_three_shards_merges_to_the_whole_run() {
     three_shards_merge_to_the_whole_run(COMPRESSION, COMPRESSION_FLAGS, 3 * (7 + 5));
 }
 
+/// What: `run --shard 1/1` writes a shard (its manifest, no data.json), as `verify
+/// --shard 1/1` does and as `--help` says, and `merge` of it alone gives the whole run.
+/// Reference: the whole run's directory. Tolerance: as [`assert_same_run`].
+#[test]
+fn run_shard_one_of_one_is_a_shard_that_merges_to_the_whole_run() {
+    let tmp = TempDir::new("run-shard-1-of-1");
+    let (w, s, m) = (tmp.join("whole"), tmp.join("shard"), tmp.join("merged"));
+    whole(LINEAR, &w, &[]);
+    whole(LINEAR, &s, &["--shard", "1/1"]);
+    assert!(s.join("shard.json").is_file(), "a shard manifest");
+    assert!(!s.join("data.json").exists(), "no sidecar in a shard");
+    let o = merge(std::slice::from_ref(&s), &m);
+    assert_eq!(o.status.code(), Some(0), "merge: {}", stderr_of(&o));
+    assert_same_run(&w, &m);
+}
+
 /// Asserts that merging `dirs` into `out` exits 2, that stderr names every string of
 /// `names`, and that nothing of a run was written.
 fn refused(dirs: &[PathBuf], out: &Path, names: &[&str]) {

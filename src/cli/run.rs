@@ -145,9 +145,9 @@ struct Job {
     seed_note: String,
     /// Indices of the chosen runs in the scene.
     chosen: Vec<usize>,
-    /// The share of every run's trajectories simulated ([`Shard::WHOLE`] but with
-    /// `--shard`).
-    shard: Shard,
+    /// `--shard`, if given: the output is then a shard (even `1/1`, which `merge` takes
+    /// alone), else the whole run's directory.
+    shard: Option<Shard>,
     limits: WorkLimits,
 }
 
@@ -229,7 +229,7 @@ impl Job {
         seed_note: String,
         out: PathBuf,
         verbosity: Verbosity,
-        (shard, limits): (Shard, WorkLimits),
+        (shard, limits): (Option<Shard>, WorkLimits),
     ) -> Result<Job> {
         if let Some(n) = settings.trajectories
             && !(1..=MAX_TRAJECTORIES).contains(&n)
@@ -297,6 +297,11 @@ impl Job {
         )
     }
 
+    /// The share of every run's trajectories simulated: `--shard`, else the whole.
+    fn share(&self) -> Shard {
+        self.shard.unwrap_or(Shard::WHOLE)
+    }
+
     /// The file extension of the trajectories.
     fn ext(&self) -> &'static str {
         match self.settings.format {
@@ -308,13 +313,13 @@ impl Job {
     /// Starts the output: the report directory with its provenance, or the shard.
     fn begin(&self) -> Result<Sink> {
         let provenance = Provenance::begin(&[&self.scene]);
-        if !self.shard.is_whole() {
+        if let Some(shard) = self.shard {
             let settings = serde_json::to_value(&self.settings).map_err(|e| {
                 Error::io(self.out.join(langevin_fem::shard::SHARD_MANIFEST), e.into())
             })?;
             let scenes = vec![ShardScene::of(&self.scene, &self.seed_note)];
             let writer =
-                ShardWriter::begin(&self.out, COMMAND, self.shard, settings, scenes, provenance)?;
+                ShardWriter::begin(&self.out, COMMAND, shard, settings, scenes, provenance)?;
             return Ok(Sink::Shard(writer));
         }
         let report = ReportRun::begin(&self.out, "run", "manifest.json", &[SIDECAR])?;
@@ -336,10 +341,10 @@ impl Job {
             Sink::Whole(provenance, report) => (provenance, report),
             Sink::Shard(writer) => {
                 let manifest = writer.finish()?;
-                let n = self.shard.count;
+                let n = self.share().count;
                 println!(
                     "shard {}: {} trajectory file(s) in {}; when every shard of {n} is done: langevin-fem merge <the {n} shard directories> -o <output dir>",
-                    self.shard,
+                    self.share(),
                     manifest.files.len(),
                     self.out.display(),
                 );
@@ -447,7 +452,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
         seed_note,
         args.out,
         verbosity,
-        (args.shard.unwrap_or(Shard::WHOLE), args.limits.limits()),
+        (args.shard, args.limits.limits()),
     )?;
     if job.scene.compression.is_some() {
         run_compression(&job)
@@ -496,7 +501,7 @@ fn run_linear(job: &Job) -> Result<i32> {
     let scene = &job.scene;
     let (runs, plans) = prepare_linear(job)?;
     // This shard's share of the work.
-    let work = projection(job, &plans).scaled(job.shard.fraction());
+    let work = projection(job, &plans).scaled(job.share().fraction());
     job.limits.check(&work)?;
     let mut sink = job.begin()?;
     let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
@@ -523,7 +528,7 @@ fn write_linear_run(
     let (scene, out) = (&job.scene, &job.out);
     let spec = &scene.runs[k];
     let count = job.ensemble(k).0 as u64;
-    let range = job.shard.range(count);
+    let range = job.share().range(count);
     let per_trajectory = bar.run_work() / (range.end - range.start).max(1) as f64;
     let files: Vec<String> = (0..count)
         .map(|j| linear_file(&spec.name, j, job.ext()))
@@ -676,7 +681,7 @@ fn run_compression(job: &Job) -> Result<i32> {
     scene.refuse_membrane("run of a membrane under imposed projected area")?;
     let runs = prepare_compression(job)?;
     // This shard's share of the work.
-    let work = compression_projection(job).scaled(job.shard.fraction());
+    let work = compression_projection(job).scaled(job.share().fraction());
     job.limits.check(&work)?;
     let mut sink = job.begin()?;
     let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
@@ -734,7 +739,7 @@ fn write_compression_run(
     };
     let spec = &scene.runs[k];
     let (n, duration) = job.ensemble(k);
-    let range = job.shard.range(n as u64);
+    let range = job.share().range(n as u64);
     let share = (range.end - range.start) as usize;
     let per_trajectory = bar.run_work() / (share * run.points()).max(1) as f64;
     let steps: Vec<u64> = (0..run.points())

@@ -81,7 +81,7 @@ pub fn merge(set: ShardSet, out: &Path, verbosity: Verbosity) -> Result<i32> {
         seed_note,
         out.to_path_buf(),
         verbosity,
-        (Shard::WHOLE, WorkLimits::default()),
+        (None, WorkLimits::default()),
     )
     .map_err(|e| set.settings_error(e))?;
     if job.scene.compression.is_some() {
