@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{TempDir, all_files, describe, json, run, stderr_of};
+use common::{TempDir, all_files, describe, fixture, json, run, stderr_of};
 use std::path::Path;
 
 /// `run` of the Crank–Nicolson run of hinged-linear-2d (8 trajectories × 40 τ1, a row
@@ -475,6 +475,26 @@ fn run_and_check_refuse_to_overwrite_a_users_file_below_out() {
         );
         assert_eq!(tree_bytes(&out), before, "{command} {extra:?}");
     }
+}
+
+/// What: `run --every` on a compression scene, whose rows follow the scene's
+/// `compression.sample_every_tau1`, is refused (exit 2 naming `--every`) rather than
+/// ignored, and nothing is written.
+#[test]
+fn run_every_is_refused_for_a_compression_scene() {
+    let dir = TempDir::new("run-every-compression");
+    let out = dir.join_str("out");
+    let scene = fixture("tests/scenes/good/tiny-compression.toml");
+    let scene = scene.to_str().unwrap();
+    let args = ["run", "-q", "--scene", scene, "--every", "5", "--out", &out];
+    let o = run(&args);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--every") && err.contains("sample_every_tau1"),
+        "{err}"
+    );
+    assert!(!Path::new(&out).exists());
 }
 
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.

@@ -75,7 +75,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "TAU1", allow_negative_numbers = true)]
     duration_tau1: Option<f64>,
     /// Steps between rows (default: the cadence of the fastest checked mode, made a
-    /// divisor of the two-time points' steps).
+    /// divisor of the two-time points' steps). Linear scenes only: a compression scene
+    /// records F every `compression.sample_every_tau1`.
     #[arg(long, value_name = "STEPS", value_parser = super::count_in::<1, MAX_EVERY>)]
     every: Option<u64>,
     /// File format of the trajectories.
@@ -247,6 +248,18 @@ impl Job {
                 "--every",
                 n,
                 format!("an integer in [1, {MAX_EVERY}]"),
+            ));
+        }
+        if let (Some(n), Some(c)) = (settings.every, &scene.compression) {
+            // A compression run records F every compression.sample_every_tau1.
+            return Err(Error::invalid(
+                "--every",
+                n,
+                format!(
+                    "left out for a compression scene (its rows are one every compression.sample_every_tau1 = {} tau1 of the scene, {})",
+                    c.sample_every_tau1,
+                    scene.path.display()
+                ),
             ));
         }
         if let Some(d) = settings.duration_tau1
