@@ -2439,6 +2439,22 @@ fn cli_cases() -> Vec<Case> {
             &[S, "--elements", "five"],
             &["--elements", "got five", "in [2, 200]"],
         ),
+        // A repeated item (however spelled) would compute and report one cell twice.
+        args(
+            "stability-elements-repeated",
+            &[S, "--elements", "5,05"],
+            &["--elements", "got 05", "distinct"],
+        ),
+        args(
+            "stability-dt-repeated",
+            &[S, "--dt-lambda-max", "1,1.0"],
+            &["--dt-lambda-max", "got 1.0", "distinct"],
+        ),
+        args(
+            "stability-integrators-repeated",
+            &[S, "--integrators", "crank-nicolson,crank-nicolson"],
+            &["--integrators", "got crank-nicolson", "distinct"],
+        ),
         args(
             "stability-dt-negative",
             &[S, "--dt-lambda-max", "-1"],
@@ -2532,6 +2548,20 @@ fn cli_cases() -> Vec<Case> {
             ],
         ),
         // work-precision
+        args(
+            "wp-methods-repeated",
+            &[
+                W,
+                "--methods",
+                "crank-nicolson/consistent,crank-nicolson/consistent",
+            ],
+            &["--methods", "got crank-nicolson/consistent", "distinct"],
+        ),
+        args(
+            "wp-dt-repeated",
+            &[W, "--dt-tau1", "1e-3,0.001"],
+            &["--dt-tau1", "got 0.001", "distinct"],
+        ),
         args(
             "wp-trajectories-zero",
             &[W, "--trajectories", "0"],

@@ -372,19 +372,38 @@ fn usize_in<const LO: u64, const HI: u64>(text: &str) -> std::result::Result<usi
 }
 
 /// Parses a comma-separated list for `flag`; a bad item exits with code 2 naming the
-/// flag, the item and `allowed`.
-fn parse_list<T: FromStr>(flag: &str, text: &str, allowed: &str) -> Result<Vec<T>> {
-    text.split(',')
-        .map(|s| {
-            s.trim()
-                .parse::<T>()
-                .map_err(|_| Error::invalid(flag, s.trim(), allowed))
-        })
-        .collect()
+/// flag, the item and `allowed`, and so does an item equal to an earlier one (a list of
+/// study points or schemes: a repeat would compute and report one cell twice).
+fn parse_list<T: FromStr + PartialEq>(flag: &str, text: &str, allowed: &str) -> Result<Vec<T>> {
+    let items: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values = items
+        .iter()
+        .map(|s| s.parse::<T>().map_err(|_| Error::invalid(flag, s, allowed)))
+        .collect::<Result<Vec<T>>>()?;
+    refuse_repeated(flag, &values, &items, allowed)?;
+    Ok(values)
+}
+
+/// Exit 2 naming `flag` and the item (as typed, `texts[i]`) if `values[i]` equals an
+/// earlier value: the items of a list flag must be distinct.
+fn refuse_repeated<T: PartialEq>(
+    flag: &str,
+    values: &[T],
+    texts: &[&str],
+    allowed: &str,
+) -> Result<()> {
+    match (1..values.len()).find(|&i| values[..i].contains(&values[i])) {
+        Some(i) => Err(Error::invalid(
+            flag,
+            texts[i],
+            format!("{allowed}, distinct (this one is repeated)"),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// [`parse_list`] of `text` if the flag was given, else `default`.
-fn parse_list_or<T: FromStr + Clone>(
+fn parse_list_or<T: FromStr + Clone + PartialEq>(
     flag: &str,
     text: Option<&str>,
     default: &[T],

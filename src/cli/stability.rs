@@ -77,23 +77,23 @@ pub struct StabilityArgs {
 /// code 0 if every formula comparison passed and every stability prediction held, 1
 /// otherwise.
 pub fn run(args: StabilityArgs, verbosity: Verbosity) -> Result<i32> {
+    let allowed = IntegratorKind::list(&IntegratorKind::LINEAR);
     let integrators = match &args.integrators {
         None => DEFAULT_INTEGRATORS.to_vec(),
-        Some(t) => t
-            .split(',')
-            .map(|s| {
-                IntegratorKind::LINEAR
-                    .into_iter()
-                    .find(|k| k.name() == s.trim())
-                    .ok_or_else(|| {
-                        Error::invalid(
-                            "--integrators",
-                            s.trim(),
-                            IntegratorKind::list(&IntegratorKind::LINEAR),
-                        )
-                    })
-            })
-            .collect::<Result<_>>()?,
+        Some(t) => {
+            let items: Vec<&str> = t.split(',').map(str::trim).collect();
+            let kinds = items
+                .iter()
+                .map(|s| {
+                    IntegratorKind::LINEAR
+                        .into_iter()
+                        .find(|k| k.name() == *s)
+                        .ok_or_else(|| Error::invalid("--integrators", s, &allowed))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            super::refuse_repeated("--integrators", &kinds, &items, &allowed)?;
+            kinds
+        }
     };
     let mut scene = load_scene(&args.scene, args.scene_dir.as_deref())?;
     args.sim.apply(&mut scene);

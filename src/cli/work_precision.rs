@@ -153,10 +153,15 @@ pub fn run(args: WorkPrecisionArgs, verbosity: Verbosity) -> Result<i32> {
     }
     let methods = match &args.methods {
         None => DEFAULT_METHODS.to_vec(),
-        Some(t) => t
-            .split(',')
-            .map(|m| parse_method(m, &IntegratorKind::LINEAR))
-            .collect::<Result<_>>()?,
+        Some(t) => {
+            let items: Vec<&str> = t.split(',').map(str::trim).collect();
+            let methods = items
+                .iter()
+                .map(|m| parse_method(m, &IntegratorKind::LINEAR))
+                .collect::<Result<Vec<_>>>()?;
+            super::refuse_repeated("--methods", &methods, &items, "INTEGRATOR/NOISE pairs")?;
+            methods
+        }
     };
     let dt_tau1 = parse_list_or(
         "--dt-tau1",
@@ -228,10 +233,15 @@ fn run_fig2(args: WorkPrecisionArgs, scene: Scene, verbosity: Verbosity) -> Resu
     ];
     let methods = match &args.methods {
         None => fig2_schemes::DEFAULT_METHODS.to_vec(),
-        Some(t) => t
-            .split(',')
-            .map(|m| parse_method(m, &kinds))
-            .collect::<Result<_>>()?,
+        Some(t) => {
+            let items: Vec<&str> = t.split(',').map(str::trim).collect();
+            let methods = items
+                .iter()
+                .map(|m| parse_method(m, &kinds))
+                .collect::<Result<Vec<_>>>()?;
+            super::refuse_repeated("--methods", &methods, &items, "INTEGRATOR/NOISE pairs")?;
+            methods
+        }
     };
     let s = run_fig2_schemes(&Fig2SchemesOptions {
         methods,
