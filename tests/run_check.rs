@@ -497,6 +497,72 @@ fn run_every_is_refused_for_a_compression_scene() {
     assert!(!Path::new(&out).exists());
 }
 
+/// What: degenerate data of a broken simulator are judged, not mistaken for too little
+/// data: (1) a trajectory identical to another, number for number (a reused seed), is
+/// refused with exit 2 naming both files' keys; (2) a modal amplitude frozen at one value
+/// in every trajectory (a mode the noise never drives) fails its checks (exit 1): the
+/// mean, rate and spectra tests, whose error is the spread across series, give p = 0 for
+/// values with no spread (probability zero under a continuous null) instead of exiting 3
+/// with "longer or more trajectories may help".
+#[test]
+fn identical_trajectories_are_refused_and_a_frozen_amplitude_fails() {
+    let dir = TempDir::new("run-check-degenerate");
+    let data = dir.join_str("data");
+    simulate(&data, "csv");
+    let files = Path::new(&data).join("crank-nicolson");
+    let t0 = files.join("trajectory-0000.csv");
+    let original = std::fs::read(files.join("trajectory-0001.csv")).unwrap();
+    std::fs::copy(&t0, files.join("trajectory-0001.csv")).unwrap();
+    let (o, args) = check(&data, &dir.join_str("report-same"));
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    assert!(
+        err.contains("runs[0].files[1]") && err.contains("runs[0].files[0]"),
+        "{err}"
+    );
+    assert!(err.contains("independent"), "{err}");
+    std::fs::write(files.join("trajectory-0001.csv"), original).unwrap();
+
+    for entry in std::fs::read_dir(&files).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap();
+        let col = header
+            .split(',')
+            .position(|c| c == "aw_2")
+            .expect("aw_2 column");
+        let body: Vec<String> = lines
+            .map(|l| {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[col] = "0.25";
+                f.join(",")
+            })
+            .collect();
+        std::fs::write(&path, format!("{header}\n{}\n", body.join("\n"))).unwrap();
+    }
+    let report = dir.join("report-frozen");
+    let (o, args) = check(&data, report.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
+    let failed: Vec<String> = checks(&report)
+        .into_iter()
+        .filter(|(_, passed)| !passed)
+        .map(|(name, _)| name)
+        .collect();
+    for name in ["mode-variance/n=2", "mode-mean/n=2", "decay-rate/n=2"] {
+        assert!(
+            failed.iter().any(|f| f.ends_with(name)),
+            "{name} not failed: {failed:?}"
+        );
+    }
+    assert!(
+        failed
+            .iter()
+            .all(|f| f.ends_with("n=2") || f.contains("pooled")),
+        "{failed:?}"
+    );
+}
+
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
 #[test]
 fn bad_data_directories_exit_2_naming_what_to_fix() {

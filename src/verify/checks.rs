@@ -105,7 +105,7 @@ fn series_average_test(
         })
         .collect::<Result<_>>()?;
     let between = stats::ensemble_mean(&values)?;
-    let o = stats::t_test(between.mean, reference, between.std_error, values.len())?;
+    let o = spread_t_test(between.mean, reference, between.std_error, values.len())?;
     Ok((
         between.mean,
         between.std_error,
@@ -117,6 +117,33 @@ fn series_average_test(
             values.len() - 1
         ),
     ))
+}
+
+/// Student's t-test of the mean of `n` independent values whose error `std_error` is
+/// their spread: as [`stats::t_test`], except that values all equal (no spread: identical
+/// series, or an amplitude frozen by a simulator that never drives it) are an event of
+/// probability zero under the null of a continuous process, so the test fails with
+/// p = 0 (statistic ±∞, or 0 at the reference) instead of being a numerical failure.
+fn spread_t_test(
+    mean: f64,
+    reference: f64,
+    std_error: f64,
+    n: usize,
+) -> Result<stats::TestOutcome> {
+    if std_error == 0.0 && n >= 2 && mean.is_finite() {
+        let d = mean - reference;
+        let statistic = if d == 0.0 {
+            0.0
+        } else {
+            d.signum() * f64::INFINITY
+        };
+        return Ok(stats::TestOutcome {
+            statistic,
+            p_value: 0.0,
+            dof: Some((n - 1) as f64),
+        });
+    }
+    stats::t_test(mean, reference, std_error, n)
 }
 
 /// A t-test that independent values (one per trajectory or series) have mean zero: the
@@ -140,7 +167,7 @@ fn zero_mean_check(
         return Ok(());
     }
     let m = stats::ensemble_mean(values)?;
-    let o = stats::t_test(m.mean, 0.0, m.std_error, values.len())?;
+    let o = spread_t_test(m.mean, 0.0, m.std_error, values.len())?;
     ctx.out.push(check(
         name,
         "t-test",
@@ -600,7 +627,7 @@ fn decay_rate_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) -> Result
     match stats::decay_rate_with_lag(&m.series, m.dt_sample, Some(0.0), CONFIDENCE, lag) {
         Ok(re) => {
             m.me.rate = (re.rate, re.std_error);
-            let o = stats::t_test(re.rate, rate_ref, re.std_error, re.n_blocks)?;
+            let o = spread_t_test(re.rate, rate_ref, re.std_error, re.n_blocks)?;
             let mut c = check(
                 format!("{prefix}/decay-rate/n={}", mr.n),
                 "t-test",
@@ -695,7 +722,7 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
             let (o, _, se) = stats::sum_test(values.iter().sum(), values.len(), law)?;
             (o, QUADRATIC_FORM, se)
         } else {
-            let o = stats::t_test(m.mean, q.discrete, m.std_error, values.len())?;
+            let o = spread_t_test(m.mean, q.discrete, m.std_error, values.len())?;
             (o, "t-test", m.std_error)
         };
         // The error beside the estimate is the check's own: from the reference for the
@@ -788,7 +815,7 @@ fn pooled_variance_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         .map(|i| weights[i] / total * r.modes[i].variance_continuum / r.modes[i].variance_discrete)
         .sum();
     let m = stats::ensemble_mean(&values)?;
-    let o = stats::t_test(m.mean, 1.0, m.std_error, values.len())?;
+    let o = spread_t_test(m.mean, 1.0, m.std_error, values.len())?;
     ctx.out.push(check(
         name,
         "t-test",
@@ -1062,7 +1089,7 @@ fn spectrum_check(
             continue;
         }
         let m = stats::ensemble_mean(ratios)?;
-        let o = stats::t_test(m.mean, 1.0, m.std_error, ratios.len())?;
+        let o = spread_t_test(m.mean, 1.0, m.std_error, ratios.len())?;
         out.push(check(
             format!("{prefix}/spectrum-{band}/n={}", mr.n),
             "t-test",

@@ -813,12 +813,30 @@ fn read_records(
     max_bytes: u64,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let dts = data.dt_sample;
-    let mut records = Vec::new();
+    let mut records: Vec<TrajectoryRecord> = Vec::new();
     let mut products = Vec::new();
+    let mut signatures = std::collections::HashMap::new();
     for (j, path) in data.paths(dir).iter().enumerate() {
         let key = format!("runs[{k}].files[{j}]");
         let table = read_trajectory(data, path, &key, cols, max_bytes)?;
         let (rec, tt) = read_record(run, data, (path, &key), &table, layout)?;
+        // Trajectories are independent draws: two with the same checked series (a
+        // simulator that reused its seed) are no ensemble, and would give a zero spread.
+        if let Some(&i) = signatures.get(&signature(&rec)) {
+            let earlier: &TrajectoryRecord = &records[i];
+            if earlier.modes == rec.modes && earlier.profile == rec.profile {
+                return Err(sidecar_error(
+                    dir,
+                    k,
+                    &format!("files[{j}]"),
+                    format!(
+                        "names {}, whose checked series are those of runs[{k}].files[{i}], number for number: the trajectories of a run must be independent (a simulator that reused one seed?)",
+                        path.display()
+                    ),
+                ));
+            }
+        }
+        signatures.insert(signature(&rec), records.len());
         records.push(rec);
         products.push(tt);
     }
@@ -844,6 +862,18 @@ fn read_records(
         ));
     }
     Ok((records, products))
+}
+
+/// A hash of the modal and profile series of a trajectory (their bits), to find two
+/// identical trajectories without comparing every pair.
+fn signature(rec: &TrajectoryRecord) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for s in rec.modes.iter().chain(&rec.profile) {
+        s.len().hash(&mut h);
+        s.iter().for_each(|v| v.to_bits().hash(&mut h));
+    }
+    h.finish()
 }
 
 /// The columns the checks read from a file.
