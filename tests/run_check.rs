@@ -563,6 +563,52 @@ fn identical_trajectories_are_refused_and_a_frozen_amplitude_fails() {
     );
 }
 
+/// What: membrane data whose sidecar names another boundary than the scene's (here
+/// simply supported against a periodic patch) are refused with exit 2 naming
+/// `membrane.boundary` and both boundaries, before any reference is computed (the
+/// references are the scene's modes: a simply supported edge has zero variance where
+/// the periodic patch has none).
+#[test]
+fn membrane_data_of_another_boundary_are_refused() {
+    let dir = TempDir::new("run-check-boundary");
+    let (data, out) = (dir.join_str("data"), dir.join_str("out"));
+    let scene = fixture("tests/scenes/good/membrane-pbc.toml");
+    let scene = scene.to_str().unwrap();
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        scene,
+        "--trajectories",
+        "2",
+        "--out",
+        &data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let side = Path::new(&data).join("data.json");
+    let text = std::fs::read_to_string(&side).unwrap();
+    assert!(text.contains("\"periodic\""), "{text}");
+    std::fs::write(
+        &side,
+        text.replacen("\"periodic\"", "\"simply-supported\"", 1),
+    )
+    .unwrap();
+    let args = [
+        "check", "-q", "--scene", scene, "--data", &data, "--out", &out,
+    ];
+    let o = run(&args);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("membrane.boundary")
+            && err.contains("simply-supported")
+            && err.contains("periodic"),
+        "{err}"
+    );
+    assert!(!Path::new(&out).exists());
+}
+
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
 #[test]
 fn bad_data_directories_exit_2_naming_what_to_fix() {

@@ -84,7 +84,24 @@ pub fn prepare_data_check(
                 ..f.params()
             }
         }
-        DataObject::Membrane(m) => data_scene.membrane = Some(m.params()),
+        DataObject::Membrane(m) => {
+            // The references are the scene's modes: the data must share its edges.
+            if let Some(sm) = &scene.membrane
+                && sm.boundary != m.boundary
+            {
+                return Err(refused(
+                    &dir.join(crate::data::SIDECAR),
+                    "membrane.boundary",
+                    format!(
+                        "is {}, but scene {} is {}: check data against a scene of their boundary",
+                        m.boundary.name(),
+                        scene.name,
+                        sm.boundary.name()
+                    ),
+                ));
+            }
+            data_scene.membrane = Some(m.params())
+        }
     }
     let continuum = Continuum::of(&data_scene)?;
     // The scene's τ₁ with the data's parameters: the unit of the scene's times (dt_tau1,
@@ -1057,6 +1074,13 @@ fn discrete_run(
     };
     let (model, scheme) = match d.model.as_str() {
         "fem" => (ModelKind::Fem, MeshScheme::Hermite),
+        "spectral" if !scene.is_membrane() && !scene.ends.is_hinged() => {
+            let message = format!(
+                "is \"spectral\" (the sine modes of a filament with hinged ends), but scene {} has {} ends: give the producer's own model (\"fem\" with its elements), or leave discretization out for the continuum references",
+                scene.name, scene.ends
+            );
+            return Err(sidecar_error(dir, k, "discretization.model", message));
+        }
         "spectral" => (ModelKind::Spectral, MeshScheme::Hermite),
         _ if d.is_chain() && !scene.is_membrane() && scene.ends.is_hinged() => {
             (ModelKind::Fem, MeshScheme::Chain)
@@ -1531,6 +1555,29 @@ mod tests {
         let side = write(&dir, &linear(vec![r]), 600);
         let r = prepare_data_check(&builtin("grafted-clamped-free"), &side, &dir, 0, CAP);
         refusal(r, &["key `runs[0].tangent_modes`", "clamped end", "is 3"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A declared `spectral` discretization (the hinged filament's sine modes) against a
+    /// scene with other ends is refused naming `runs[0].discretization.model` and the
+    /// ends, instead of a zero reference variance at a clamp failing as a run.
+    #[test]
+    fn a_spectral_discretization_of_other_ends_is_refused() {
+        let dir = temp("spectral-ends");
+        let mut r = run("cn", tau1() / 100.0, None);
+        r.discretization = Some(Discretization {
+            model: "spectral".into(),
+            elements: Some(2),
+            elements_y: None,
+            integrator: Some("exact-modal".into()),
+            noise: None,
+            dt: Some(tau1() / 100.0),
+        });
+        let side = write(&dir, &linear(vec![r]), 600);
+        for name in ["grafted-clamped-free", "microtubule-free-free"] {
+            let r = prepare_data_check(&builtin(name), &side, &dir, 0, CAP);
+            refusal(r, &["key `runs[0].discretization.model`", "spectral", name]);
+        }
         let _ = std::fs::remove_dir_all(&dir);
     }
 
