@@ -609,6 +609,66 @@ fn membrane_data_of_another_boundary_are_refused() {
     assert!(!Path::new(&out).exists());
 }
 
+/// What: `run` refuses, before anything runs or is written, trajectory files whose
+/// projected size exceeds `--max-output-gib` (rows × columns × 8 bytes in .npy): 2
+/// trajectories of 10⁶ τ₁ at `--every 1` (about 283 GiB) at the default 16 GiB; the same
+/// small job passes its cap and fails a cap below it.
+/// Tolerance: exact substrings.
+#[test]
+fn run_refuses_trajectory_files_above_the_output_cap() {
+    let dir = TempDir::new("run-output-cap");
+    let out = dir.join_str("out");
+    let base = [
+        "run",
+        "-q",
+        "--scene",
+        "hinged-linear-2d",
+        "--run",
+        "crank-nicolson",
+    ];
+    let mut args: Vec<&str> = base.to_vec();
+    args.extend([
+        "--duration-tau1",
+        "1e6",
+        "--trajectories",
+        "2",
+        "--every",
+        "1",
+        "--out",
+        &out,
+    ]);
+    let o = run(&args);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--max-output-gib") && err.contains("GiB") && err.contains("--every"),
+        "{err}"
+    );
+    assert!(!Path::new(&out).exists(), "nothing written");
+    // 2 trajectories of the quick duration: a few MB.
+    let mut args: Vec<&str> = base.to_vec();
+    args.extend([
+        "--trajectories",
+        "2",
+        "--max-output-gib",
+        "1e-6",
+        "--out",
+        &out,
+    ]);
+    assert_eq!(run(&args).status.code(), Some(2));
+    let mut args: Vec<&str> = base.to_vec();
+    args.extend([
+        "--trajectories",
+        "2",
+        "--max-output-gib",
+        "0.1",
+        "--out",
+        &out,
+    ]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
+}
+
 /// Sidecars and files that are the user's mistake: exit 2 naming the key or the file.
 #[test]
 fn bad_data_directories_exit_2_naming_what_to_fix() {

@@ -337,7 +337,8 @@ fn gib_bytes(gib: f64) -> u64 {
     (gib * (1u64 << 30) as f64).min(u64::MAX as f64) as u64
 }
 
-/// `--max-memory-gib`: a number in (0, 1e6] (clap adds the flag to the message).
+/// `--max-memory-gib` (and `run --max-output-gib`): a number in (0, 1e6] (clap adds the
+/// flag to the message).
 fn parse_max_memory_gib(text: &str) -> std::result::Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(v) if v > 0.0 && v <= 1e6 => Ok(v),

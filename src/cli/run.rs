@@ -98,6 +98,11 @@ pub struct RunArgs {
     scene_dir: Option<PathBuf>,
     #[command(flatten)]
     limits: super::LimitArgs,
+    /// Cap on the projected size of the trajectory files this command writes, in GiB
+    /// (rows × columns × 8 bytes in .npy, about 25 bytes a value in CSV): refused (exit 2)
+    /// above it, before anything runs. Raise it deliberately for a larger data set.
+    #[arg(long, value_name = "GIB", default_value = "16", allow_negative_numbers = true, value_parser = super::parse_max_memory_gib)]
+    max_output_gib: f64,
 }
 
 impl RunArgs {
@@ -150,6 +155,8 @@ struct Job {
     /// alone), else the whole run's directory.
     shard: Option<Shard>,
     limits: WorkLimits,
+    /// `--max-output-gib` in bytes (`None`: no cap, as for `merge`, whose files exist).
+    max_output_bytes: Option<f64>,
 }
 
 /// Where a job's files go: a whole run's report directory, with its provenance (its
@@ -293,6 +300,7 @@ impl Job {
             chosen,
             shard,
             limits,
+            max_output_bytes: None,
         })
     }
 
@@ -459,7 +467,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
         every: args.every,
         format: args.format,
     };
-    let job = Job::new(
+    let mut job = Job::new(
         settings,
         scene,
         seed_note,
@@ -467,6 +475,7 @@ pub fn run(args: RunArgs, verbosity: Verbosity) -> Result<i32> {
         verbosity,
         (args.shard, args.limits.limits()),
     )?;
+    job.max_output_bytes = Some(args.max_output_gib * GIB);
     if job.scene.compression.is_some() {
         run_compression(&job)
     } else {
@@ -516,6 +525,7 @@ fn run_linear(job: &Job) -> Result<i32> {
     // This shard's share of the work.
     let work = projection(job, &plans).scaled(job.share().fraction());
     job.limits.check(&work)?;
+    check_output_size(job, &plans)?;
     let mut sink = job.begin()?;
     let bar = Progress::new(job.verbosity.progress(), work.dof_steps(), "DOF-steps");
     let mut data_runs = Vec::new();
@@ -526,6 +536,49 @@ fn run_linear(job: &Job) -> Result<i32> {
     }
     bar.finish();
     job.finish(sink, data_runs, None, linear_what(job))
+}
+
+/// Bytes in a GiB.
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Refuses a linear job whose trajectory files (this shard's) would exceed
+/// `--max-output-gib`: rows × columns × bytes a value, summed over the files, before
+/// anything runs (a long run at `--every 1` could otherwise fill the disk).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--max-output-gib`, the projected size and what
+/// drives it.
+fn check_output_size(job: &Job, plans: &[RowPlan]) -> Result<()> {
+    let Some(cap) = job.max_output_bytes else {
+        return Ok(());
+    };
+    let per_value = match job.settings.format {
+        FormatArg::Npy => 8.0,
+        FormatArg::Csv => 25.0,
+    };
+    let mut total = 0.0;
+    let mut largest = (0.0, 0u64, 0usize);
+    for (&k, plan) in job.chosen.iter().zip(plans) {
+        let range = job.share().range(job.ensemble(k).0 as u64);
+        let file = plan.rows as f64 * plan.columns.len() as f64 * per_value;
+        total += file * (range.end - range.start) as f64;
+        if file > largest.0 {
+            largest = (file, plan.rows, plan.columns.len());
+        }
+    }
+    if total <= cap {
+        return Ok(());
+    }
+    let (_, rows, cols) = largest;
+    Err(Error::invalid(
+        "--max-output-gib",
+        cap / GIB,
+        format!(
+            "at least the {:.3} GiB the trajectory files would take ({rows} rows x {cols} columns a file at most, {}): raise --every, lower --duration-tau1 or --trajectories, or raise --max-output-gib deliberately",
+            total / GIB,
+            job.ext()
+        ),
+    ))
 }
 
 /// Simulates and writes this shard's trajectories of linear run `k`; returns its

@@ -196,9 +196,10 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "filament.stretch_rigidity",
         SCENE_UNITS,
-        PHYSICAL,
+        // The bound of a compression scene depends on EI, L and kT: not probed alone.
+        "in [1e-30, 1e30]; with model = \"compression\" such that S/P² = EA·L³·kT/EI² is in [1e-2, 1e12]",
         "1e6",
-        closed(1e-30, 1e30),
+        None,
         "Stretching rigidity EA (a force); used by the compression model only (EA·L/kT = 1e6 in the paper's Fig. 2), which also needs EI/(kT·L) in [1e-3, 1e6] and S/P² = EA·L³·kT/EI² in [1e-2, 1e12], the exact theory's domain.",
     ),
     key(
@@ -446,9 +447,10 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "compression.area_modulus",
         "energy/area",
-        "in [1e-30, 1e30]; required with a [membrane] table (whose tension must be 0), refused with a filament",
+        "in [1e-30, 1e30] such that K_A·A₀·kT/κ² is in [1e-2, 1e12]; required with a [membrane] table (whose tension must be 0), refused with a filament",
         "none",
-        closed(1e-30, 1e30),
+        // The bound depends on κ, the area and kT: not probed alone.
+        None,
         "Compression scenes of a membrane under imposed projected area (issue #28): the area modulus K_A. The strains are 1 − A_p/A₀ in units of ε_c0 = κq²_min/K_A, the recorded value the compressive stress −σ/σ_c0. The exact theory's domain needs κ/kT in [1e-3, 1e6] and K_A·A₀·kT/κ² in [1e-2, 1e12].",
     ),
     key(

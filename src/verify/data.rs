@@ -832,28 +832,11 @@ fn read_records(
     let dts = data.dt_sample;
     let mut records: Vec<TrajectoryRecord> = Vec::new();
     let mut products = Vec::new();
-    let mut signatures = std::collections::HashMap::new();
-    for (j, path) in data.paths(dir).iter().enumerate() {
+    let paths = data.paths(dir);
+    for (j, path) in paths.iter().enumerate() {
         let key = format!("runs[{k}].files[{j}]");
         let table = read_trajectory(data, path, &key, cols, max_bytes)?;
         let (rec, tt) = read_record(run, data, (path, &key), &table, layout)?;
-        // Trajectories are independent draws: two with the same checked series (a
-        // simulator that reused its seed) are no ensemble, and would give a zero spread.
-        if let Some(&i) = signatures.get(&signature(&rec)) {
-            let earlier: &TrajectoryRecord = &records[i];
-            if earlier.modes == rec.modes && earlier.profile == rec.profile {
-                return Err(sidecar_error(
-                    dir,
-                    k,
-                    &format!("files[{j}]"),
-                    format!(
-                        "names {}, whose checked series are those of runs[{k}].files[{i}], number for number: the trajectories of a run must be independent (a simulator that reused one seed?)",
-                        path.display()
-                    ),
-                ));
-            }
-        }
-        signatures.insert(signature(&rec), records.len());
         records.push(rec);
         products.push(tt);
     }
@@ -877,6 +860,26 @@ fn read_records(
                 (shortest as u64).saturating_mul(sparsest)
             ),
         ));
+    }
+    // Trajectories are independent draws: two with the same checked series (a simulator
+    // that reused its seed) are no ensemble, and would give a zero spread.
+    let mut signatures = std::collections::HashMap::new();
+    for (j, rec) in records.iter().enumerate() {
+        if let Some(&i) = signatures.get(&signature(rec)) {
+            let earlier: &TrajectoryRecord = &records[i];
+            if earlier.modes == rec.modes && earlier.profile == rec.profile {
+                return Err(sidecar_error(
+                    dir,
+                    k,
+                    &format!("files[{j}]"),
+                    format!(
+                        "names {}, whose checked series are those of runs[{k}].files[{i}], number for number: the trajectories of a run must be independent (a simulator that reused one seed?)",
+                        paths[j].display()
+                    ),
+                ));
+            }
+        }
+        signatures.insert(signature(rec), j);
     }
     Ok((records, products))
 }
@@ -1482,7 +1485,8 @@ mod tests {
     }
 
     /// Writes `sidecar` and `rows` rows of each of its files to `dir` (t = t₀ + r·dt_sample
-    /// with t₀ = 0 from rest, else 3·dt_sample; other columns arbitrary finite values),
+    /// with t₀ = 0 from rest, else 3·dt_sample; other columns arbitrary finite values,
+    /// different in every file),
     /// then reads it back as `check` does.
     fn write(dir: &Path, sidecar: &DataSidecar, rows: u64) -> DataSidecar {
         for r in &sidecar.runs {
@@ -1492,12 +1496,14 @@ mod tests {
             } else {
                 3.0 * r.dt_sample
             };
-            for path in r.paths(dir) {
-                let mut f = TrajectoryFile::create(&path, &cols, rows).unwrap();
+            for (j, path) in r.paths(dir).iter().enumerate() {
+                let mut f = TrajectoryFile::create(path, &cols, rows).unwrap();
                 for i in 0..rows {
                     let mut row = vec![t0 + i as f64 * r.dt_sample];
+                    // Files differ (independent trajectories are never identical).
                     row.extend(
-                        (1..cols.len()).map(|c| ((i * 31 + c as u64 * 17) % 97) as f64 - 48.0),
+                        (1..cols.len())
+                            .map(|c| ((i * 31 + c as u64 * 17 + j as u64 * 13) % 97) as f64 - 48.0),
                     );
                     f.push_row(&row).unwrap();
                 }
