@@ -274,13 +274,21 @@ impl ShardWriter {
             command: &self.manifest.command,
         };
         refuse_occupied(&self.dir, kind)?;
-        // `refuse_occupied` let a manifest here only if it is the same command's.
-        let path = self.dir.join(SHARD_MANIFEST);
-        self.earlier = crate::input::read_text(&path, "-", crate::input::MAX_METADATA_BYTES)
-            .ok()
+        // `refuse_occupied` let a manifest here only if it is the same command's; a shard
+        // killed while moving its files into place left their list instead.
+        let read = |name: &str| {
+            crate::input::read_text(&self.dir.join(name), "-", crate::input::MAX_METADATA_BYTES)
+                .ok()
+        };
+        self.earlier = read(SHARD_MANIFEST)
             .and_then(|text| serde_json::from_str::<ShardManifest>(&text).ok())
             .map(|m| m.files.into_iter().map(|f| f.path).collect())
             .unwrap_or_default();
+        if let Some(list) =
+            read(PUBLISHING).and_then(|t| serde_json::from_str::<Vec<String>>(&t).ok())
+        {
+            self.earlier.extend(list);
+        }
         self.staging = Some(Staging::new(&self.dir)?);
         Ok(self)
     }
@@ -408,9 +416,11 @@ impl ShardWriter {
         Ok(())
     }
 
-    /// Finishes the shard: removes an earlier manifest (so that a shard killed from here
-    /// on is never taken for a finished one), moves the files into place and writes the
-    /// manifest (atomically, last); returns it.
+    /// Finishes the shard: refuses, touching nothing, a file that would replace one no
+    /// earlier shard here listed ([`Staging::taken`]); writes the list of files it owns
+    /// ([`PUBLISHING`]), removes an earlier manifest (so that a shard killed from here on
+    /// is never taken for a finished one), moves the files into place, writes the
+    /// manifest (atomically) and removes the list; returns the manifest.
     ///
     /// # Errors
     /// [`Error::Io`] if a file cannot be moved or written.
@@ -424,6 +434,13 @@ impl ShardWriter {
                 return Err(refuse_taken(&self.dir, &self.manifest.command, &rel));
             }
         }
+        // The files this shard owns from here until its manifest is written: a shard
+        // killed in between is rerun into the same directory without a refusal.
+        let owned: Vec<&str> = (self.earlier.iter().map(String::as_str))
+            .chain(self.manifest.files.iter().map(|f| f.path.as_str()))
+            .collect();
+        let publishing = self.dir.join(PUBLISHING);
+        write_json(&publishing, &owned)?;
         let old = self.dir.join(SHARD_MANIFEST);
         match std::fs::remove_file(&old) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&old, e)),
@@ -433,9 +450,14 @@ impl ShardWriter {
             staging.publish(self.manifest.files.iter().map(|f| f.path.as_str()))?;
         }
         write_json(&self.dir.join(SHARD_MANIFEST), &self.manifest)?;
+        std::fs::remove_file(&publishing).map_err(|e| Error::io(&publishing, e))?;
         Ok(self.manifest)
     }
 }
+
+/// The list of files a shard is moving into place (hidden; removed once its manifest is
+/// written): what a rerun after a kill in between may replace.
+const PUBLISHING: &str = ".langevin-fem-shard-publishing.json";
 
 /// The SHA-256 of `bytes` in lower-case hex.
 fn sha256_hex(bytes: &[u8]) -> String {

@@ -194,6 +194,48 @@ fn run_shard_one_of_one_is_a_shard_that_merges_to_the_whole_run() {
     assert_same_run(&w, &m);
 }
 
+/// What: a shard rerun into its own directory replaces its files; one killed while
+/// moving them into place (no manifest; the hidden list of the files it owns,
+/// `.langevin-fem-shard-publishing.json`, left behind) is rerun there too and merges to
+/// the whole run; files with neither a manifest nor that list are the user's and the
+/// shard is refused (exit 2, naming `--out` and the file), leaving them as they were.
+/// Reference: the whole run's directory. Tolerance: as [`assert_same_run`]; exact bytes.
+#[test]
+fn a_shard_reruns_over_its_own_files_and_refuses_anyone_elses() {
+    let tmp = TempDir::new("run-shard-rerun");
+    let (w, s, m) = (tmp.join("whole"), tmp.join("shard"), tmp.join("merged"));
+    whole(LINEAR, &w, &[]);
+    whole(LINEAR, &s, &["--shard", "1/1"]);
+    whole(LINEAR, &s, &["--shard", "1/1"]);
+    let manifest = std::fs::read_to_string(s.join("shard.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+    let files: Vec<String> = v["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["path"].as_str().unwrap().to_string())
+        .collect();
+    // Killed between the removal of the manifest and its rewrite.
+    std::fs::remove_file(s.join("shard.json")).unwrap();
+    let list = serde_json::to_string(&files).unwrap();
+    std::fs::write(s.join(".langevin-fem-shard-publishing.json"), list).unwrap();
+    whole(LINEAR, &s, &["--shard", "1/1"]);
+    assert!(!s.join(".langevin-fem-shard-publishing.json").exists());
+    let o = merge(std::slice::from_ref(&s), &m);
+    assert_eq!(o.status.code(), Some(0), "merge: {}", stderr_of(&o));
+    assert_same_run(&w, &m);
+    // Neither a manifest nor the list: the files are somebody else's.
+    std::fs::remove_file(s.join("shard.json")).unwrap();
+    let mine = s.join(&files[0]);
+    std::fs::write(&mine, b"my own data").unwrap();
+    let args = run_args(LINEAR, &s, &["--shard", "1/1"]);
+    let o = run_in(common::manifest_dir(), &args);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--out") && err.contains(&files[0]), "{err}");
+    assert_eq!(std::fs::read(&mine).unwrap(), b"my own data");
+}
+
 /// Asserts that merging `dirs` into `out` exits 2, that stderr names every string of
 /// `names`, and that nothing of a run was written.
 fn refused(dirs: &[PathBuf], out: &Path, names: &[&str]) {
