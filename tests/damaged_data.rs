@@ -862,6 +862,7 @@ const SIDECAR_EDITS: &[(&str, Input, &str, &str, &[&str])] = &[
     ("sidecar-start-unknown", Input::LinNpy, "/runs/0/start", "\"moving\"", &["data.json", "runs[0].start", "moving"]),
     ("sidecar-start-number", Input::LinNpy, "/runs/0/start", "0", &["data.json", "runs[0].start", "0"]),
     ("sidecar-elements-string", Input::LinNpy, "/runs/0/discretization/elements", "\"4\"", &["data.json", "runs[0].discretization.elements", "\"4\""]),
+    ("sidecar-filament-elements-y", Input::LinNpy, "/runs/0/discretization/elements_y", "4", &["data.json", "runs[0].discretization.elements_y", "filament", "got 4"]),
     ("sidecar-integrator-number", Input::LinNpy, "/runs/0/discretization/integrator", "5", &["data.json", "runs[0].discretization.integrator", "5"]),
     ("sidecar-unknown-top-key", Input::LinNpy, "/extra", "1", &["data.json", "extra"]),
     ("sidecar-unknown-filament-key", Input::LinNpy, "/filament/temperature", "300.0", &["data.json", "filament.temperature"]),

@@ -793,6 +793,16 @@ impl DataRun {
                 ),
             ));
         }
+        if let Some(e) = self.discretization.as_ref().and_then(|d| d.elements_y)
+            && !membrane
+        {
+            return Err((
+                key("discretization.elements_y"),
+                format!(
+                    "must be left out for filament data (a membrane's elements or mode indices along y; a filament's count is discretization.elements), got {e}"
+                ),
+            ));
+        }
         if membrane && self.rigid {
             return Err((
                 key("rigid"),
