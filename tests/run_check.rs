@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{TempDir, all_files, describe, fixture, json, run, stderr_of};
+use common::{TempDir, all_files, assert_refused, describe, fixture, json, run, stderr_of};
 use std::path::Path;
 
 /// `run` of the Crank–Nicolson run of hinged-linear-2d (8 trajectories × 40 τ1, a row
@@ -487,13 +487,7 @@ fn run_every_is_refused_for_a_compression_scene() {
     let scene = fixture("tests/scenes/good/tiny-compression.toml");
     let scene = scene.to_str().unwrap();
     let args = ["run", "-q", "--scene", scene, "--every", "5", "--out", &out];
-    let o = run(&args);
-    let err = stderr_of(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("--every") && err.contains("sample_every_tau1"),
-        "{err}"
-    );
+    assert_refused(&run(&args), &args, &["--every", "sample_every_tau1"]);
     assert!(!Path::new(&out).exists());
 }
 
@@ -597,15 +591,8 @@ fn membrane_data_of_another_boundary_are_refused() {
     let args = [
         "check", "-q", "--scene", scene, "--data", &data, "--out", &out,
     ];
-    let o = run(&args);
-    let err = stderr_of(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("membrane.boundary")
-            && err.contains("simply-supported")
-            && err.contains("periodic"),
-        "{err}"
-    );
+    let needles = ["membrane.boundary", "simply-supported", "periodic"];
+    assert_refused(&run(&args), &args, &needles);
     assert!(!Path::new(&out).exists());
 }
 
@@ -637,13 +624,8 @@ fn run_refuses_trajectory_files_above_the_output_cap() {
         "--out",
         &out,
     ]);
-    let o = run(&args);
-    let err = stderr_of(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("--max-output-gib") && err.contains("GiB") && err.contains("--every"),
-        "{err}"
-    );
+    let needles = ["--max-output-gib", "GiB", "--every"];
+    assert_refused(&run(&args), &args, &needles);
     assert!(!Path::new(&out).exists(), "nothing written");
     // 2 trajectories of the quick duration: a few MB.
     let mut args: Vec<&str> = base.to_vec();

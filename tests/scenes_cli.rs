@@ -16,7 +16,7 @@
 mod common;
 
 use common::{
-    TempDir, all_files, assert_no_panic, command, describe, fixture, stderr_of, stdout_of,
+    TempDir, all_files, assert_no_panic, assert_refused, command, describe, fixture, stdout_of,
 };
 use langevin_fem::scene::keys::{KEYS, key_paths, matches};
 use langevin_fem::scene::{BUILTIN, Scene};
@@ -41,15 +41,6 @@ fn run_in(cwd: &Path, args: &[&str]) -> Output {
         .expect("binary runs");
     assert_no_panic(args, &o);
     o
-}
-
-/// Asserts exit 2 and every needle in stderr.
-fn assert_refused(o: &Output, args: &[&str], needles: &[&str]) {
-    assert_eq!(o.status.code(), Some(2), "{}", describe(args, o));
-    let err = stderr_of(o);
-    for n in needles {
-        assert!(err.contains(n), "stderr lacks {n:?}: {}", describe(args, o));
-    }
 }
 
 /// Runs `verify --scene <tiny> --out <out>` plus `extra` from the crate root; asserts

@@ -879,47 +879,43 @@ impl Scene {
         area_modulus: Option<f64>,
     ) -> Result<()> {
         let f = &self.filament;
-        let found = match (&self.membrane, area_modulus) {
-            (Some(m), Some(k_a)) => {
-                let found = AreaParams::from_membrane(m, k_a).domain_violation(strain_ratios);
-                found.map(|(input, allowed)| {
-                    let (key, value) = match input {
-                        DomainInput::BendingRigidity => {
-                            ("membrane.bending_rigidity", m.bending_rigidity)
-                        }
-                        DomainInput::StretchRigidity => ("compression.area_modulus", k_a),
-                        DomainInput::StrainRatio(_) => ("", 0.0),
-                    };
-                    (input, key.to_string(), value, allowed)
-                })
+        let area = self.membrane.zip(area_modulus);
+        let found = match area {
+            Some((m, k_a)) => AreaParams::from_membrane(&m, k_a).domain_violation(strain_ratios),
+            None => crate::theory::domain_violation(
+                f.persistence_ratio(),
+                f.stretch_ratio(),
+                strain_ratios,
+            ),
+        };
+        let Some((input, allowed)) = found else {
+            return Ok(());
+        };
+        let filament_key = |key: &'static str| {
+            let key = match &self.physical {
+                Some(ph) => ph.keys_of(key).first().copied().unwrap_or(key),
+                None => key,
+            };
+            format!("filament.{key}")
+        };
+        let (key, value) = match (input, area) {
+            (DomainInput::StrainRatio(i), _) => {
+                (format!("compression.strain_ratios[{i}]"), strain_ratios[i])
             }
-            _ => {
-                let (p, s) = (
-                    f.bending_rigidity / (f.kt * f.length),
-                    f.stretch_rigidity * f.length / f.kt,
-                );
-                crate::theory::domain_violation(p, s, strain_ratios).map(|(input, allowed)| {
-                    let (key, value) = match input {
-                        DomainInput::BendingRigidity => ("bending_rigidity", f.bending_rigidity),
-                        DomainInput::StretchRigidity => ("stretch_rigidity", f.stretch_rigidity),
-                        DomainInput::StrainRatio(_) => ("", 0.0),
-                    };
-                    let key = match &self.physical {
-                        Some(ph) => ph.keys_of(key).first().copied().unwrap_or(key),
-                        None => key,
-                    };
-                    (input, format!("filament.{key}"), value, allowed)
-                })
+            (DomainInput::BendingRigidity, Some((m, _))) => {
+                ("membrane.bending_rigidity".to_string(), m.bending_rigidity)
+            }
+            (DomainInput::StretchRigidity, Some((_, k_a))) => {
+                ("compression.area_modulus".to_string(), k_a)
+            }
+            (DomainInput::BendingRigidity, None) => {
+                (filament_key("bending_rigidity"), f.bending_rigidity)
+            }
+            (DomainInput::StretchRigidity, None) => {
+                (filament_key("stretch_rigidity"), f.stretch_rigidity)
             }
         };
-        match found {
-            None => Ok(()),
-            Some((DomainInput::StrainRatio(i), _, _, allowed)) => {
-                let key = format!("compression.strain_ratios[{i}]");
-                Err(bad(self, &key, &Num(strain_ratios[i]), &allowed))
-            }
-            Some((_, key, value, allowed)) => Err(bad(self, &key, &Num(value), &allowed)),
-        }
+        Err(bad(self, &key, &Num(value), &allowed))
     }
 
     /// The one per-run check of every scene: name, integrator and noise, own checks,

@@ -76,33 +76,7 @@ pub fn prepare_data_check(
     check_linear_data(scene, sidecar, dir, k)?;
     let data = &sidecar.runs[k];
     let object = data_object(sidecar, dir)?;
-    let mut data_scene = scene.clone();
-    match object {
-        DataObject::Filament(f) => {
-            data_scene.filament = FilamentParams {
-                stretch_rigidity: scene.filament.stretch_rigidity,
-                ..f.params()
-            }
-        }
-        DataObject::Membrane(m) => {
-            // The references are the scene's modes: the data must share its edges.
-            if let Some(sm) = &scene.membrane
-                && sm.boundary != m.boundary
-            {
-                return Err(refused(
-                    &dir.join(crate::data::SIDECAR),
-                    "membrane.boundary",
-                    format!(
-                        "is {}, but scene {} is {}: check data against a scene of their boundary",
-                        m.boundary.name(),
-                        scene.name,
-                        sm.boundary.name()
-                    ),
-                ));
-            }
-            data_scene.membrane = Some(m.params())
-        }
-    }
+    let data_scene = data_scene(scene, &object, dir)?;
     let continuum = Continuum::of(&data_scene)?;
     // The scene's τ₁ with the data's parameters: the unit of the scene's times (dt_tau1,
     // two-time points), that of the ends' slowest elastic mode for other ends than hinges.
@@ -177,6 +151,42 @@ pub fn prepare_data_check(
         notes,
         continuum_references,
     })
+}
+
+/// `scene` with the data's object: a filament's parameters (the scene's EA kept), or a
+/// membrane's, which must share the scene's boundary (the references are the scene's
+/// modes).
+///
+/// # Errors
+/// [`Error::Scene`] naming the sidecar's `membrane.boundary` if it is not the scene's.
+fn data_scene(scene: &Scene, object: &DataObject, dir: &Path) -> Result<Scene> {
+    let mut data_scene = scene.clone();
+    match object {
+        DataObject::Filament(f) => {
+            data_scene.filament = FilamentParams {
+                stretch_rigidity: scene.filament.stretch_rigidity,
+                ..f.params()
+            }
+        }
+        DataObject::Membrane(m) => {
+            if let Some(sm) = &scene.membrane
+                && sm.boundary != m.boundary
+            {
+                return Err(refused(
+                    &dir.join(crate::data::SIDECAR),
+                    "membrane.boundary",
+                    format!(
+                        "is {}, but scene {} is {}: check data against a scene of their boundary",
+                        m.boundary.name(),
+                        scene.name,
+                        sm.boundary.name()
+                    ),
+                ));
+            }
+            data_scene.membrane = Some(m.params())
+        }
+    }
+    Ok(data_scene)
 }
 
 /// The object of a loaded sidecar (in `dir`).
@@ -280,10 +290,7 @@ fn data_filament(sidecar: &DataSidecar, dir: &Path) -> Result<crate::data::DataF
 /// `strain_ratios` outside the exact theory's domain ([`crate::theory::domain_violation`]),
 /// naming the sidecar's key, before any reference is computed.
 fn data_theory_domain(f: &FilamentParams, strain_ratios: &[f64], dir: &Path) -> Result<()> {
-    let (p, s) = (
-        f.bending_rigidity / (f.kt * f.length),
-        f.stretch_rigidity * f.length / f.kt,
-    );
+    let (p, s) = (f.persistence_ratio(), f.stretch_ratio());
     let Some((input, allowed)) = crate::theory::domain_violation(p, s, strain_ratios) else {
         return Ok(());
     };
@@ -830,7 +837,7 @@ fn read_records(
     max_bytes: u64,
 ) -> Result<(Vec<TrajectoryRecord>, Vec<Vec<f64>>)> {
     let dts = data.dt_sample;
-    let mut records: Vec<TrajectoryRecord> = Vec::new();
+    let mut records = Vec::new();
     let mut products = Vec::new();
     let paths = data.paths(dir);
     for (j, path) in paths.iter().enumerate() {
@@ -865,8 +872,8 @@ fn read_records(
     // that reused its seed) are no ensemble, and would give a zero spread.
     let mut signatures = std::collections::HashMap::new();
     for (j, rec) in records.iter().enumerate() {
-        if let Some(&i) = signatures.get(&signature(rec)) {
-            let earlier: &TrajectoryRecord = &records[i];
+        if let Some(i) = signatures.insert(signature(rec), j) {
+            let earlier = &records[i];
             if earlier.modes == rec.modes && earlier.profile == rec.profile {
                 return Err(sidecar_error(
                     dir,
@@ -879,7 +886,6 @@ fn read_records(
                 ));
             }
         }
-        signatures.insert(signature(rec), j);
     }
     Ok((records, products))
 }

@@ -160,6 +160,15 @@ pub fn describe(args: &[&str], o: &Output) -> String {
     )
 }
 
+/// Asserts exit 2 (bad input) and every needle in stderr.
+pub fn assert_refused(o: &Output, args: &[&str], needles: &[&str]) {
+    assert_eq!(o.status.code(), Some(2), "{}", describe(args, o));
+    let err = stderr_of(o);
+    for n in needles {
+        assert!(err.contains(n), "stderr lacks {n:?}: {}", describe(args, o));
+    }
+}
+
 /// The process ended by itself (not by a signal) and did not panic.
 pub fn assert_no_panic(args: &[&str], o: &Output) {
     assert!(
