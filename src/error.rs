@@ -39,10 +39,11 @@ pub enum Error {
         /// What is wrong and what is allowed.
         message: String,
     },
-    /// A time step is above the stability limit of an explicit integrator.
+    /// A time step is above the stability limit of an explicit integrator, or above the
+    /// step at which Crank–Nicolson's multiplier of the fastest mode rounds to −1.
     #[error(
-        "time step dt = {dt:e} exceeds the stability limit {limit:e} of the {integrator} integrator \
-         (2/lambda_max); use a smaller dt or a stable integrator such as {suggestion}"
+        "time step dt = {dt:e} of the {integrator} integrator is not below {limit:e}, {bound}; \
+         use a smaller dt or {suggestion}"
     )]
     UnstableTimeStep {
         /// Integrator name.
@@ -51,7 +52,9 @@ pub enum Error {
         dt: f64,
         /// The stability limit.
         limit: f64,
-        /// A stable integrator to use instead.
+        /// What the limit is (e.g. `the stability limit 2/lambda_max of euler-maruyama`).
+        bound: String,
+        /// What to do instead (e.g. a stable integrator to use).
         suggestion: String,
     },
     /// The state became non-finite during a run.

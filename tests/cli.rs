@@ -665,6 +665,29 @@ fn theory_overflow_is_not_reported_as_success_with_null() {
     }
 }
 
+/// What: a result beyond f64 (`theory variance --ends free-free --length 1e300`) exits 2
+/// naming the result's field and the parameter flags to rescale (it named neither flag).
+/// Tolerance: exact substrings.
+#[test]
+fn theory_overflow_names_the_flags_to_rescale() {
+    let args = [
+        "theory",
+        "variance",
+        "--x",
+        "0.5",
+        "--ends",
+        "free-free",
+        "--length",
+        "1e300",
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    let err = stderr_of(&o);
+    for needle in ["`variance`", "--length", "--bending-rigidity", "rescale"] {
+        assert!(err.contains(needle), "{needle}: {}", describe(&args, &o));
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // 3. Scene files
 // ---------------------------------------------------------------------------------------

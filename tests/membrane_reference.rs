@@ -1062,9 +1062,10 @@ fn theory_membrane_rejects_bad_input_with_exit_2() {
 /// What: `theory membrane --elements` gives the Bogner–Fox–Schmit plate's discrete rate
 /// of mode (2, 1), converging to the continuum rate from above at fourth order (observed
 /// order log₂ of successive error ratios on 4, 8, 16 elements in [3.7, 4.3]), the
-/// element-uniform noise's variance ratio below 1 and rising towards 1, and with --dt the
-/// exact discrete law (Crank–Nicolson, consistent noise: ratio to equipartition 1; Euler–
-/// Maruyama: 1/(1 − λΔt/2) for the mode's own λ). Refusals: an explicit step at its
+/// element-uniform noise's variance ratio below 1 and rising towards 1 up to 64 elements a
+/// side, and with --dt the exact discrete law (Crank–Nicolson, consistent noise: ratio to
+/// equipartition 1, element-uniform noise: the noise's own ratio; Euler–Maruyama:
+/// 1/(1 − λΔt/2) for the mode's own λ). Refusals: an explicit step at its
 /// stability limit, a mode the mesh does not resolve, too many elements, exit 2 naming
 /// the flag. Reference: the continuum of `theory membrane` and the closed forms above.
 /// Tolerance: 1e-9 relative for the closed forms (rounding), the order band for the
@@ -1102,11 +1103,21 @@ fn theory_membrane_finite_elements() {
             "order {order} from {errors:?}"
         );
     }
-    let ratios: Vec<f64> = ["4", "16"]
+    // Up to the documented 64 a side (16 384 unknowns: one mode's numbers without dense
+    // modes; it used to be refused at 46 and above by the dense-modes cap).
+    let ratios: Vec<f64> = ["4", "16", "64"]
         .iter()
         .map(|e| num(&fe(e, &[]).1, "element_uniform_variance_ratio"))
         .collect();
-    assert!(ratios[0] < ratios[1] && ratios[1] < 1.0, "{ratios:?}");
+    assert!(
+        ratios[0] < ratios[1] && ratios[1] < ratios[2] && ratios[2] < 1.0,
+        "{ratios:?}"
+    );
+    // Crank–Nicolson's consistent-noise variance is equipartition's, so its
+    // element-uniform variance ratio is the modal noise's own: Σ_q,ii.
+    let (_, eu) = fe("64", &["--dt", "1e-4", "--noise", "element-uniform"]);
+    let got = num(&eu["discrete"], "variance_ratio_to_equipartition");
+    assert!((got - ratios[2]).abs() < 1e-12, "{got} vs {}", ratios[2]);
     let (_, cn) = fe("8", &["--dt", "1e-3"]);
     let d = &cn["discrete"];
     assert!(

@@ -596,6 +596,135 @@ fn membrane_data_of_another_boundary_are_refused() {
     assert!(!Path::new(&out).exists());
 }
 
+/// What: membrane data whose sidecar declares a mesh beyond a membrane scene's bounds
+/// (within the sidecar's own [1, 1000], the filament's range) are refused with exit 2
+/// naming `runs[0].discretization.elements_y` / `.elements`, the membrane's range and the
+/// value, as `mesh.elements_y` is in scene files (they used to name `runs[0].discretization`
+/// with an internal type's name, or the spectral simulator's `mx`).
+/// Tolerance: exact substrings.
+#[test]
+fn membrane_data_beyond_a_membrane_mesh_are_refused_naming_the_key() {
+    let dir = TempDir::new("run-check-membrane-mesh");
+    let (data, out) = (dir.join_str("data"), dir.join_str("out"));
+    let scene = fixture("tests/scenes/good/membrane-pbc.toml");
+    let scene = scene.to_str().unwrap();
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        scene,
+        "--trajectories",
+        "2",
+        "--out",
+        &data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let side = Path::new(&data).join("data.json");
+    let original: serde_json::Value = json(&side);
+    for (edit, key, needles) in [
+        (
+            &[("elements_y", 1000)][..],
+            "runs[0].discretization.elements_y",
+            &["in [2, 256] for a periodic membrane", "got 1000"][..],
+        ),
+        (
+            &[("elements", 1000), ("elements_y", 1000)][..],
+            "runs[0].discretization.elements",
+            &["in [2, 256]", "got 1000"][..],
+        ),
+        (
+            &[("elements", 100), ("elements_y", 100)][..],
+            "runs[0].discretization.elements_y",
+            &["at most 40", "100 x 100 = 10000"][..],
+        ),
+    ] {
+        let mut d = original.clone();
+        for &(k, v) in edit {
+            d["runs"][0]["discretization"][k] = serde_json::json!(v);
+        }
+        std::fs::write(&side, serde_json::to_string(&d).unwrap()).unwrap();
+        let args = [
+            "check", "-q", "--scene", scene, "--data", &data, "--out", &out,
+        ];
+        let mut all = vec!["data.json", key];
+        all.extend_from_slice(needles);
+        assert_refused(&run(&args), &args, &all);
+        assert!(!Path::new(&out).exists());
+    }
+}
+
+/// What: filament data whose sidecar states kT = 1e-30 (inside the sidecar's range, 30
+/// orders below the data's scale) fail their checks (exit 1): the variance tests' null
+/// law is so far from the data that its saddle point is not resolvable in f64, and the
+/// Chernoff bound gives p = 0, where the run used to fail with exit 3 ("no saddle point").
+/// Tolerance: the exit code; the failed checks include the variance ones.
+#[test]
+fn data_thirty_orders_off_the_reference_fail_their_checks() {
+    let dir = TempDir::new("run-check-kt-off");
+    let (data, out) = (dir.join_str("data"), dir.join_str("out"));
+    let scene = fixture("tests/scenes/good/tiny-linear.toml");
+    let scene = scene.to_str().unwrap();
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        scene,
+        "--trajectories",
+        "4",
+        "--out",
+        &data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let side = Path::new(&data).join("data.json");
+    let mut d: serde_json::Value = json(&side);
+    d["filament"]["kt"] = serde_json::json!(1e-30);
+    std::fs::write(&side, serde_json::to_string(&d).unwrap()).unwrap();
+    let args = [
+        "check", "-q", "--scene", scene, "--data", &data, "--out", &out,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(1), "{}", describe(&args, &o));
+    let summary: serde_json::Value = json(&Path::new(&out).join("summary.json"));
+    let checks = summary["scenes"][0]["checks"].as_array().unwrap();
+    let far = checks.iter().find(|c| {
+        c["check"] == "mode-variance" && c["kind"] == "quadratic-form" && c["parameter"] == "n=1"
+    });
+    let far = far.expect("the mode variance's quadratic-form check");
+    assert_eq!(far["passed"], false, "{far}");
+    assert_eq!(far["p_value"], 0.0, "{far}");
+}
+
+/// What: `run`'s work refusal names `--trajectories` and `--duration-tau1` (with their
+/// values) when they drive the work, not the scene's budget keys they replace.
+/// Tolerance: exact substrings.
+#[test]
+fn run_work_refusal_names_the_flags_that_drive_it() {
+    let dir = TempDir::new("run-work-flags");
+    let out = dir.join_str("out");
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        "hinged-linear-2d",
+        "--run",
+        "crank-nicolson",
+        "--trajectories",
+        "100000",
+        "--duration-tau1",
+        "1e6",
+        "--out",
+        &out,
+    ];
+    let needles = [
+        "the projected work of `run` (--trajectories 100000, --duration-tau1 1000000)",
+        "--max-work",
+    ];
+    assert_refused(&run(&args), &args, &needles);
+    assert!(!Path::new(&out).exists());
+}
+
 /// What: `run` refuses, before anything runs or is written, trajectory files whose
 /// projected size exceeds `--max-output-gib` (rows × columns × 8 bytes in .npy): 2
 /// trajectories of 10⁶ τ₁ at `--every 1` (about 283 GiB) at the default 16 GiB; the same

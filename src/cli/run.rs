@@ -27,7 +27,7 @@ use langevin_fem::scene::compression::CompressionRun;
 use langevin_fem::scene::linear::{LinearRun, RowPlan};
 use langevin_fem::scene::{Budget, ModelKind, Scene};
 use langevin_fem::shard::{Shard, ShardScene, ShardWriter};
-use langevin_fem::work::{RunWork, WorkLimits, WorkProjection};
+use langevin_fem::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -684,10 +684,28 @@ fn projection(job: &Job, plans: &[RowPlan]) -> WorkProjection {
                     plan.rows,
                     plan.columns.len()
                 );
-                part
+                flag_driven(job, part)
             })
             .collect(),
     }
+}
+
+/// `part` named after `--trajectories` / `--duration-tau1` where they were given (they, not
+/// the scene's budget keys, then drive the work): the refusal names the flags first.
+fn flag_driven(job: &Job, mut part: Part) -> Part {
+    let mut flags = Vec::new();
+    if let Some(n) = job.settings.trajectories {
+        flags.push(format!("--trajectories {n}"));
+    }
+    if let Some(d) = job.settings.duration_tau1 {
+        flags.push(format!("--duration-tau1 {d}"));
+    }
+    if !flags.is_empty() {
+        let flags = flags.join(", ");
+        part.drivers = format!("{flags} (the flags; the scene's {})", part.drivers);
+        part.origin = Origin::Flags(flags);
+    }
+    part
 }
 
 /// The chosen runs of a compression scene, prepared. A budget by target precision
@@ -784,7 +802,7 @@ fn compression_projection(job: &Job) -> WorkProjection {
                     part.work.trajectory_steps *= scale.max(1.0);
                     part.work.dof_steps *= scale.max(1.0);
                 }
-                part
+                flag_driven(job, part)
             })
             .collect(),
     }

@@ -2,9 +2,9 @@
 
 use clap::{Args, Subcommand};
 use langevin_fem::FilamentParams;
-use langevin_fem::dynamics::{DiscreteLaw, IntegratorKind};
+use langevin_fem::dynamics::{IntegratorKind, ModeLaw};
 use langevin_fem::error::{Error, Result, require_in_range, require_positive};
-use langevin_fem::fem::noise::{NoiseModel, element_uniform_ratios};
+use langevin_fem::fem::noise::{NoiseModel, element_uniform_mode_ratio};
 use langevin_fem::fem::plate::PlateModel;
 use langevin_fem::fem::plate_area::{
     AREA_BENDING_RANGE, AreaCutoff, AreaParams, AreaTheory, MAX_AREA_ASPECT_RATIO,
@@ -310,7 +310,7 @@ const MAX_THEORY_PLATE_ELEMENTS: usize = 64;
 /// The finite-element part of `theory membrane`: the acoustic plate mode converging to
 /// `mode` on `nx × ny` elements, its rate and (continuum-convention) variance, the
 /// element-uniform noise's ratio (eq. 5 per element area) and, with `dt`, the exact
-/// discrete law of `integrator` with `noise` ([`DiscreteLaw`]).
+/// discrete law of `integrator` with `noise` ([`ModeLaw`], the diagonal of the whole law).
 fn membrane_fem(
     args: &MembraneArgs,
     mb: &Membrane,
@@ -342,20 +342,22 @@ fn membrane_fem(
     // of the discrete mode's amplitude (kT/λ_h of its C-normalized amplitude) in the
     // continuum's convention.
     let variance = mb.mode_variance(mode) * exact / rate;
-    let gm = modes.generalized_modes()?;
-    let index = modes.dense_column(mode).ok_or_else(|| Error::Numerical {
+    let index = modes.position(mode).ok_or_else(|| Error::Numerical {
         routine: "theory membrane".into(),
-        detail: "the mode's column is missing from the dense modes".into(),
+        detail: "the acoustic mode has no index among the modes".into(),
     })?;
-    let ratios = element_uniform_ratios(&plate, &gm, gm.len())?;
+    let uniform_ratio = element_uniform_mode_ratio(&plate, &modes.mode_vector(index));
+    // The separable modes are all of them: the largest rate is λ_max, exactly (the banded
+    // inertia bisection would cost O(n·bw²) per step at 64 × 64).
+    let max_rate = modes.rates().into_iter().fold(0.0, f64::max);
     let mut out = json!({
         "elements": [nx, ny],
         "unknowns": plate.n_dofs(),
         "rate": rate,
         "rate_relative_error": rate / exact - 1.0,
         "variance": variance,
-        "element_uniform_variance_ratio": ratios[index],
-        "max_rate": plate.max_rate()?,
+        "element_uniform_variance_ratio": uniform_ratio,
+        "max_rate": max_rate,
     });
     if let Some(dt) = args.dt {
         require_positive("--dt", dt)?;
@@ -381,7 +383,7 @@ fn membrane_fem(
                 ));
             }
         };
-        if let Some(limit) = integrator.stability_limit(plate.max_rate()?)
+        if let Some(limit) = integrator.stability_limit(max_rate)
             && dt >= limit
         {
             return Err(Error::invalid(
@@ -390,16 +392,21 @@ fn membrane_fem(
                 format!("< {limit:e}, the {integrator} stability limit 2/lambda_max of this mesh"),
             ));
         }
-        let law = DiscreteLaw::new(&plate, &gm, integrator, noise, dt)?;
+        let noise_variance = match noise {
+            NoiseModel::Consistent => 1.0,
+            NoiseModel::ElementUniform => uniform_ratio,
+        };
+        let law = ModeLaw::new(rate, noise_variance, integrator, dt, plate.kt())?;
+        let ratio = law.variance / law.equipartition;
         out["discrete"] = json!({
             "dt": dt,
             "integrator": integrator.name(),
             "noise": noise.name(),
-            "multiplier": law.multipliers[index],
-            "variance": law.mode_variance(index) / law.equipartition(index) * variance,
-            "variance_ratio_to_equipartition": law.mode_variance(index) / law.equipartition(index),
+            "multiplier": law.multiplier,
+            "variance": ratio * variance,
+            "variance_ratio_to_equipartition": ratio,
         });
-        match law.decay_rate(index) {
+        match law.decay_rate {
             Some(r) => out["discrete"]["decay_rate"] = json!(r),
             None => {
                 out["discrete"]["decay_rate_note"] =
@@ -797,9 +804,9 @@ pub fn run(args: TheoryArgs) -> Result<i32> {
     };
     if let Some(bad) = non_finite_number(&value) {
         return Err(Error::invalid(
-            bad,
-            "a non-finite result",
-            "parameters whose result is representable in f64 (rescale the units)",
+            format!("the result's `{bad}`"),
+            "a number beyond f64 (an overflow)",
+            "finite: rescale the units of the parameter flags given (e.g. --length, --bending-rigidity, --drag, --kt) so that the result fits in f64",
         ));
     }
     println!("{value}");

@@ -121,12 +121,105 @@ impl DiscreteLaw {
     }
 }
 
+/// The exact discrete law of one mode alone (the diagonal of [`DiscreteLaw`], module docs):
+/// what a mode's variance and decay need, in O(1), for one mode of a mesh too large for
+/// dense modes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeLaw {
+    /// One-step multiplier `m`.
+    pub multiplier: f64,
+    /// Stationary variance `g² Σ_q,ii / (1 − m²)` of the mode's amplitude.
+    pub variance: f64,
+    /// Equipartition's variance `kT/λ`.
+    pub equipartition: f64,
+    /// The discrete decay rate `−ln(m)/Δt`, `None` if `m ≤ 0`.
+    pub decay_rate: Option<f64>,
+}
+
+impl ModeLaw {
+    /// The law of a mode of generalized rate `rate` under `integrator` and step `dt` at
+    /// temperature `kt`, driven by modal noise of variance `noise_variance` (`Σ_q,ii`: 1
+    /// for consistent noise, the element-uniform ratio for the paper's load).
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] if the step is unstable for the mode (`|m| ≥ 1`).
+    pub fn new(
+        rate: f64,
+        noise_variance: f64,
+        integrator: IntegratorKind,
+        dt: f64,
+        kt: f64,
+    ) -> Result<Self> {
+        let (m, g) = integrator.modal_form(rate, dt, kt);
+        let s = discrete_stationary_covariance(
+            &DMatrix::from_element(1, 1, noise_variance),
+            &[m],
+            &[g],
+        )?;
+        Ok(ModeLaw {
+            multiplier: m,
+            variance: s[(0, 0)],
+            equipartition: kt / rate,
+            decay_rate: (m > 0.0).then(|| -m.ln() / dt),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fem::banded::SymBanded;
     use crate::fem::modal::generalized_modes_signed;
     use crate::fem::system::ElementLoad;
+
+    /// One mode's law is the diagonal of the whole law, both noises, every integrator.
+    #[test]
+    fn one_mode_law_is_the_diagonal_of_the_whole() {
+        use crate::fem::beam::BeamModel;
+        use crate::fem::mesh::Mesh;
+        use crate::fem::modal::generalized_modes;
+        use crate::fem::noise::element_uniform_mode_ratio;
+        let p = crate::params::FilamentParams::default();
+        let beam = BeamModel::new(p, Mesh::uniform(p.length, 6).unwrap()).unwrap();
+        let gm = generalized_modes(&beam).unwrap();
+        let dt = 0.3 / gm.rates[0];
+        for integrator in IntegratorKind::LINEAR {
+            if integrator
+                .stability_limit(gm.rates.max())
+                .is_some_and(|l| dt >= l)
+            {
+                continue;
+            }
+            for noise in NoiseModel::ALL {
+                let law = DiscreteLaw::new(&beam, &gm, integrator, noise, dt).unwrap();
+                for i in 0..gm.rates.len() {
+                    let sq = match noise {
+                        NoiseModel::Consistent => 1.0,
+                        NoiseModel::ElementUniform => {
+                            let phi: Vec<f64> = gm.vectors.column(i).iter().copied().collect();
+                            element_uniform_mode_ratio(&beam, &phi)
+                        }
+                    };
+                    let one = ModeLaw::new(gm.rates[i], sq, integrator, dt, beam.kt()).unwrap();
+                    // The dense ΦᵀΣ_ζΦ rounds at the scale of its largest entries (a stiff
+                    // mode's element-uniform variance, ~1e-41, comes out as ~±1e-26
+                    // there): compare at the slowest mode's scale.
+                    let (a, b) = (one.variance, law.mode_variance(i));
+                    let scale = law.mode_variance(0);
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "{integrator} {noise} {i}: {a} vs {b}"
+                    );
+                    assert!(a > 0.0, "{integrator} {noise} {i}: {a}");
+                    assert_eq!(one.multiplier, law.multipliers[i]);
+                    assert_eq!(one.equipartition, law.equipartition(i));
+                    assert_eq!(one.decay_rate, law.decay_rate(i));
+                }
+            }
+        }
+        // An unstable step is refused.
+        assert!(ModeLaw::new(10.0, 1.0, IntegratorKind::EulerMaruyama, 0.3, 1.0).is_err());
+    }
 
     /// One DOF, `c ẋ = −k x + F`: rate λ = k/c, and for Euler–Maruyama the closed forms
     /// m = 1 − λΔt, stationary variance (kT/λ)/(1 − λΔt/2) (consistent noise), the

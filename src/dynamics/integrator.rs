@@ -40,25 +40,43 @@ pub(super) fn check_dt(dt: f64) -> Result<()> {
 
 /// The stability half of the shared step-size refusal: `dt` must lie below
 /// [`IntegratorKind::stability_limit`] for the fastest rate `max_rate` (the amplification
-/// factor of the fastest mode reaches −1 there); `suggestion` names stable alternatives.
+/// factor of the fastest mode reaches −1 there; `suggestion` names stable alternatives),
+/// and below [`IntegratorKind::rounding_limit`] (where Crank–Nicolson's multiplier of the
+/// fastest mode rounds to −1).
 ///
 /// # Errors
-/// [`Error::UnstableTimeStep`] at or above the limit.
+/// [`Error::UnstableTimeStep`] at or above either limit.
 pub(crate) fn check_stability(
     kind: IntegratorKind,
     dt: f64,
     max_rate: f64,
     suggestion: &str,
 ) -> Result<()> {
+    let refuse = |limit: f64, bound: &str, suggestion: String| Error::UnstableTimeStep {
+        integrator: kind.name().to_string(),
+        dt,
+        limit,
+        bound: bound.to_string(),
+        suggestion,
+    };
     if let Some(limit) = kind.stability_limit(max_rate)
         && dt >= limit
     {
-        return Err(Error::UnstableTimeStep {
-            integrator: kind.name().to_string(),
-            dt,
+        let instead = format!("a stable integrator such as {suggestion}");
+        let bound = format!("the stability limit 2/lambda_max of {kind}");
+        return Err(refuse(limit, &bound, instead));
+    }
+    if let Some(limit) = kind.rounding_limit(max_rate)
+        && dt >= limit
+    {
+        let bound = format!(
+            "the step at which the multiplier (1 - a/2)/(1 + a/2) of {kind}'s fastest mode, a = lambda_max dt, rounds to -1 in double precision and that mode stops decaying"
+        );
+        return Err(refuse(
             limit,
-            suggestion: suggestion.to_string(),
-        });
+            &bound,
+            "backward-euler or exact-modal (their multipliers tend to 0 on stiff modes), or a mesh with a smaller lambda_max (fewer elements, a milder mesh.grading)".into(),
+        ));
     }
     Ok(())
 }

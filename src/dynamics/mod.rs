@@ -43,7 +43,7 @@ pub mod modal_step;
 pub mod nonlinear;
 
 pub use batch::{BatchTrajectory, ComponentBatch, LaneOf, ThetaBatch};
-pub use discrete::DiscreteLaw;
+pub use discrete::{DiscreteLaw, ModeLaw};
 pub use driver::{Components, Driver, NonlinearState, Observer, Trajectory};
 pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
@@ -223,6 +223,32 @@ impl IntegratorKind {
         (m.abs() < 1.0).then(|| g * g * rate / (1.0 - m * m))
     }
 
+    /// For Crank–Nicolson, the step above which its multiplier `(1 − a/2)/(1 + a/2)`,
+    /// `a = λ_max Δt`, rounds to −1 in f64 (`a` about 2⁵⁵): A-stable in exact arithmetic,
+    /// the fastest mode would then never decay and its discrete stationary variance
+    /// `g²/(1 − m²)` is 0/0. `None` for every other integrator (explicit ones have
+    /// [`Self::stability_limit`]; the others' multipliers tend to 0 or to `(θ − 1)/θ > −1`).
+    pub fn rounding_limit(self, max_rate: f64) -> Option<f64> {
+        if self != IntegratorKind::CrankNicolson {
+            return None;
+        }
+        // The least a whose multiplier is −1, by bisection (m decreases with a).
+        let m = |a: f64| self.modal_form(a, 1.0, 1.0).0;
+        let (mut lo, mut hi) = (1.0_f64, 2.0_f64.powi(64));
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid == lo || mid == hi {
+                break;
+            }
+            if m(mid) <= -1.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(hi / max_rate)
+    }
+
     /// Largest stable time step for a system whose fastest mode has rate `max_rate`, or
     /// `None` if the integrator is unconditionally stable on the linear part. For θ < ½
     /// the amplification factor `m = (1 − (1−θ)a)/(1 + θa)` reaches −1 at
@@ -323,5 +349,20 @@ mod tests {
         assert_eq!(IntegratorKind::BackwardEuler.stability_limit(4.0), None);
         assert_eq!(IntegratorKind::CrankNicolson.stability_limit(4.0), None);
         assert_eq!(IntegratorKind::ExactModal.stability_limit(4.0), None);
+    }
+
+    /// Crank–Nicolson's multiplier is above −1 just below its rounding limit and −1 at it;
+    /// the limit is near a = 2⁵⁵ and scales as 1/λ_max; no other integrator has one.
+    #[test]
+    fn crank_nicolson_rounding_limit() {
+        let cn = IntegratorKind::CrankNicolson;
+        let limit = cn.rounding_limit(1.0).unwrap();
+        assert!(cn.modal_form(limit, 1.0, 1.0).0 == -1.0);
+        assert!(cn.modal_form(limit * (1.0 - 1e-12), 1.0, 1.0).0 > -1.0);
+        assert!((2f64.powi(53)..2f64.powi(57)).contains(&limit), "{limit:e}");
+        assert_eq!(cn.rounding_limit(4.0), Some(limit / 4.0));
+        for kind in IntegratorKind::ALL.into_iter().filter(|&k| k != cn) {
+            assert_eq!(kind.rounding_limit(1.0), None, "{kind}");
+        }
     }
 }

@@ -855,12 +855,18 @@ impl PlateModes {
         self.modes.iter().find(|m| m.continuum == Some(mode))
     }
 
+    /// The index of the acoustic mode of `mode` among the modes (for [`Self::mode_vector`]),
+    /// if the mesh resolves it.
+    pub fn position(&self, mode: MembraneMode) -> Option<usize> {
+        self.modes.iter().position(|m| m.continuum == Some(mode))
+    }
+
     /// The column of the acoustic mode of `mode` in [`Self::generalized_modes`] (its index
     /// among the modes, less one past the periodic zero mode, which the dense modes leave
     /// out), if the mesh resolves it. By label, so that equal rates (a square's (1, 2) and
     /// (2, 1)) are told apart.
     pub fn dense_column(&self, mode: MembraneMode) -> Option<usize> {
-        let i = self.modes.iter().position(|m| m.continuum == Some(mode))?;
+        let i = self.position(mode)?;
         Some(i - usize::from(self.zero_mode().is_some_and(|z| z < i)))
     }
 

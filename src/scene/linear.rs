@@ -1064,9 +1064,13 @@ impl Setup<'_> {
         let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
         let object = self.fem_object()?;
         let system = object.system();
-        // An explicit step above its limit fails at once (λ_max by an O(n)
-        // inertia bisection), before the O(n³) eigen-decomposition.
-        if spec.integrator.stability_limit(1.0).is_some() {
+        // An explicit step above its limit, or a Crank–Nicolson step whose fastest
+        // multiplier rounds to −1, fails at once (λ_max by an O(n) inertia bisection),
+        // before the O(n³) eigen-decomposition.
+        let limited = |kind: IntegratorKind| {
+            kind.stability_limit(1.0).is_some() || kind.rounding_limit(1.0).is_some()
+        };
+        if limited(spec.integrator) {
             build_integrator(
                 spec.integrator,
                 system,

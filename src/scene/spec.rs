@@ -743,15 +743,16 @@ impl Scene {
                 ),
             },
             Error::UnstableTimeStep {
-                integrator,
+                integrator: _,
                 dt,
                 limit,
+                bound,
                 suggestion,
             } => Error::Scene {
                 file: self.path.clone(),
                 key: key("dt_tau1"),
                 message: format!(
-                    "must be < {} (the stability limit 2/lambda_max of {integrator} for this mesh, in units of tau1), got {}; use a smaller dt_tau1 or a stable integrator such as {suggestion}",
+                    "must be < {} ({bound} for this mesh, in units of tau1), got {}; use a smaller dt_tau1 or {suggestion}",
                     Num(limit / tau1),
                     // The value as written in the file when it is the step that was
                     // refused (dt/tau1 may differ from it in the last digit).

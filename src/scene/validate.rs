@@ -121,6 +121,65 @@ const COMPRESSION_CHECKS: &str =
     "force-strain, force-distribution or dt-halving for model = \"compression\"";
 
 /// The error for `key` of `scene`'s file: "must be {allowed}, got {value}".
+/// The counts of a membrane mesh (a scene's `mesh`, or a sidecar's `discretization`:
+/// `prefix`), `elements` and `elements_y` (default: `elements`), each in
+/// [1, [`MAX_MEMBRANE_ELEMENTS_PER_SIDE`]] ([2, …] periodic: one element would join its
+/// own opposite edges), their product at most [`MAX_MEMBRANE_ELEMENTS`]; the first
+/// violation as (key, value, allowed), or `None`.
+pub(crate) fn membrane_mesh_violation(
+    boundary: MembraneBoundary,
+    nx: usize,
+    elements_y: Option<usize>,
+    prefix: &str,
+) -> Option<(String, usize, String)> {
+    let (lo, allowed) = match boundary {
+        MembraneBoundary::SimplySupported => (
+            1,
+            format!("in [1, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a membrane"),
+        ),
+        MembraneBoundary::Periodic => (
+            2,
+            format!(
+                "in [2, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a periodic membrane (one element would join its own opposite edges, leaving only the uniform displacement, which is not a mode)"
+            ),
+        ),
+    };
+    let (kx, ky) = (format!("{prefix}.elements"), format!("{prefix}.elements_y"));
+    let range = lo..=MAX_MEMBRANE_ELEMENTS_PER_SIDE;
+    if !range.contains(&nx) {
+        return Some((kx, nx, allowed));
+    }
+    if let Some(ny) = elements_y
+        && !range.contains(&ny)
+    {
+        return Some((ky, ny, allowed));
+    }
+    let ny = elements_y.unwrap_or(nx);
+    if nx * ny <= MAX_MEMBRANE_ELEMENTS {
+        return None;
+    }
+    Some(match elements_y {
+        Some(ny) => (
+            ky.clone(),
+            ny,
+            format!(
+                "at most {} (a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: {kx} x {ky} = {nx} x {ny} = {})",
+                MAX_MEMBRANE_ELEMENTS / nx,
+                nx * ny
+            ),
+        ),
+        None => (
+            kx.clone(),
+            nx,
+            format!(
+                "at most {} when {ky} is left out (it defaults to {kx}, and a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: {nx} x {nx} = {})",
+                MAX_MEMBRANE_ELEMENTS.isqrt(),
+                nx * nx
+            ),
+        ),
+    })
+}
+
 fn bad(scene: &Scene, key: &str, value: &dyn Display, allowed: &str) -> Error {
     Error::Scene {
         file: scene.path.clone(),
@@ -421,55 +480,12 @@ impl Scene {
         Ok(())
     }
 
-    /// The mesh of a membrane: `elements` and `elements_y` each in
-    /// [1, [`MAX_MEMBRANE_ELEMENTS_PER_SIDE`]] ([2, …] periodic: one element would join
-    /// its own opposite edges), their product at most [`MAX_MEMBRANE_ELEMENTS`], and a
-    /// uniform mesh (`grading = 1`).
+    /// The mesh of a membrane: [`membrane_mesh_violation`] of `mesh.elements` and
+    /// `mesh.elements_y`, and a uniform mesh (`grading = 1`).
     fn validate_membrane_mesh(&self, m: &MembraneParams) -> Result<()> {
-        let (lo, allowed) = match m.boundary {
-            MembraneBoundary::SimplySupported => (
-                1,
-                format!("in [1, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a membrane"),
-            ),
-            MembraneBoundary::Periodic => (
-                2,
-                format!(
-                    "in [2, {MAX_MEMBRANE_ELEMENTS_PER_SIDE}] for a periodic membrane (one element would join its own opposite edges, leaving only the uniform displacement, which is not a mode)"
-                ),
-            ),
-        };
-        let (nx, ny) = (self.mesh.elements, self.mesh.elements_along_y());
-        let range = lo..=MAX_MEMBRANE_ELEMENTS_PER_SIDE;
-        if !range.contains(&nx) {
-            return Err(bad(self, "mesh.elements", &nx, &allowed));
-        }
-        if let Some(ny) = self.mesh.elements_y
-            && !range.contains(&ny)
-        {
-            return Err(bad(self, "mesh.elements_y", &ny, &allowed));
-        }
-        if nx * ny > MAX_MEMBRANE_ELEMENTS {
-            let (key, value, allowed) = match self.mesh.elements_y {
-                Some(ny) => (
-                    "mesh.elements_y",
-                    ny,
-                    format!(
-                        "at most {} (a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: mesh.elements x mesh.elements_y = {nx} x {ny} = {})",
-                        MAX_MEMBRANE_ELEMENTS / nx,
-                        nx * ny
-                    ),
-                ),
-                None => (
-                    "mesh.elements",
-                    nx,
-                    format!(
-                        "at most {} when mesh.elements_y is left out (it defaults to mesh.elements, and a membrane mesh has at most {MAX_MEMBRANE_ELEMENTS} elements: {nx} x {nx} = {})",
-                        MAX_MEMBRANE_ELEMENTS.isqrt(),
-                        nx * nx
-                    ),
-                ),
-            };
-            return Err(bad(self, key, &value, &allowed));
+        let (nx, ny) = (self.mesh.elements, self.mesh.elements_y);
+        if let Some((key, value, allowed)) = membrane_mesh_violation(m.boundary, nx, ny, "mesh") {
+            return Err(bad(self, &key, &value, &allowed));
         }
         let g = self.mesh.grading;
         if g != 1.0 {

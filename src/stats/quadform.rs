@@ -135,8 +135,11 @@ pub trait SquareSumLaw {
         at(u).map(|cu| (u, cu))
     }
 
-    /// `P(S ≥ s)` by the Lugannani–Rice formula (module docs); `None` if the saddle point
-    /// cannot be found (e.g. a non-finite `s`).
+    /// `P(S ≥ s)` by the Lugannani–Rice formula (module docs); `None` for a non-finite `s`.
+    /// Where the saddle point cannot be resolved in f64 (`s` so far in a tail, e.g. a
+    /// variance 10³⁰ times the reference's, that `K′` reaches it only within rounding of
+    /// the domain's end), the tail's Chernoff bound instead ([`Self::chernoff_bound`]): an
+    /// upper bound on the tail's probability, so that the p-value it gives is conservative.
     fn upper_tail(&self, s: f64) -> Option<f64> {
         if !s.is_finite() {
             return None;
@@ -144,7 +147,11 @@ pub trait SquareSumLaw {
         if s <= 0.0 && self.lower_bound().is_none() {
             return Some(1.0);
         }
-        let (u, cu) = self.saddle_point(s)?;
+        let Some((u, cu)) = self.saddle_point(s) else {
+            let upper = s > self.mean();
+            let bound = self.chernoff_bound(s, upper)?;
+            return Some(if upper { bound } else { 1.0 - bound });
+        };
         let normal = Normal::standard();
         let w2 = 2.0 * (u * s - cu.k);
         let w = u.signum() * w2.max(0.0).sqrt();
@@ -154,6 +161,61 @@ pub trait SquareSumLaw {
         let ut = u * cu.k2.sqrt();
         let p = normal.sf(w) + normal.pdf(w) * (1.0 / ut - 1.0 / w);
         Some(p.clamp(0.0, 1.0))
+    }
+
+    /// The Chernoff bound on the tail beyond `s`: `P(S ≥ s) ≤ exp(K(u) − us)` for every
+    /// `u > 0` of the domain (`upper`), `P(S ≤ s) ≤ exp(K(u) − us)` for every `u < 0`
+    /// (Markov's inequality for `e^{uS}`), at the best `u` of a grid geometric towards
+    /// both ends of the half-domain (`end·2^{−j}` and `end·(1 − 2^{−j})`, `j ≤ 60`, with
+    /// the end found by bisection; `u = −2^k/(2λ)` where a sum of squares has none).
+    /// `K(u) − us` is convex in `u` and least at the saddle point, so where the saddle
+    /// point lies within rounding of the domain's end, so does the best bound. `None` if no
+    /// `u` of the domain gives a finite bound.
+    fn chernoff_bound(&self, s: f64, upper: bool) -> Option<f64> {
+        let exponent = |u: f64| {
+            self.cumulants(u)
+                .map(|cu| cu.k - u * s)
+                .filter(|g| g.is_finite())
+        };
+        let scale = self.bracket_scale();
+        let end = if upper {
+            // Double to a point past the domain's end, then bisect onto it.
+            let (mut inside, mut outside) = (0.0, scale);
+            while self.cumulants(outside).is_some() {
+                inside = outside;
+                outside *= 2.0;
+                if !outside.is_finite() {
+                    return None;
+                }
+            }
+            for _ in 0..200 {
+                let mid = 0.5 * (inside + outside);
+                if mid == inside || mid == outside {
+                    break;
+                }
+                if self.cumulants(mid).is_some() {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            Some(outside)
+        } else {
+            self.lower_bound()
+        };
+        let grid: Vec<f64> = match end {
+            Some(end) => (1..=60)
+                .flat_map(|j| {
+                    let f = 0.5_f64.powi(j);
+                    [end * f, end * (1.0 - f)]
+                })
+                .collect(),
+            None => (-60..=1100).map(|k| -scale * 2.0_f64.powi(k)).collect(),
+        };
+        grid.into_iter()
+            .filter_map(exponent)
+            .min_by(f64::total_cmp)
+            .map(|g| g.exp().min(1.0))
     }
 }
 
@@ -626,6 +688,48 @@ mod tests {
         assert!((cu.k - k).abs() <= 1e-10 * k.abs());
         assert!((cu.k1 - k1).abs() <= 1e-10 * k1.abs());
         assert!((cu.k2 - k2).abs() <= 1e-10 * k2.abs());
+    }
+
+    /// The Chernoff bound is a bound: at or above the exact χ²₁₀ tails, both sides.
+    #[test]
+    fn the_chernoff_bound_bounds_exact_chi_square_tails() {
+        let law = WeightedChiSquares::new(vec![(1.0, 10.0)]).unwrap();
+        let chi = ChiSquared::new(10.0).unwrap();
+        for s in [12.0, 20.0, 40.0, 80.0] {
+            let b = law.chernoff_bound(s, true).unwrap();
+            assert!(chi.sf(s) <= b && b < 1.0, "{s}: {b} vs {}", chi.sf(s));
+        }
+        for s in [0.5, 2.0, 8.0] {
+            let b = law.chernoff_bound(s, false).unwrap();
+            assert!(chi.cdf(s) <= b && b < 1.0, "{s}: {b} vs {}", chi.cdf(s));
+        }
+        // Far in the tail, where the best u = (1 − k/s)/2 nears the domain's end 1/2, the
+        // grid finds the optimal bound e^{−(s−k)/2} (s/k)^{k/2} within a factor e.
+        let s = 1000.0;
+        let optimal = -(s - 10.0) / 2.0 + 5.0 * (s / 10.0_f64).ln();
+        let got = law.chernoff_bound(s, true).unwrap().ln();
+        assert!(optimal <= got && got <= optimal + 1.0, "{got} vs {optimal}");
+    }
+
+    /// A variance 10³⁰ times too small or too large: the saddle point is not resolvable in
+    /// f64 and the test says p = 0 from the Chernoff bound, instead of failing.
+    #[test]
+    fn unresolvable_tails_give_a_zero_p_value() {
+        let x: Vec<f64> = (0..1000)
+            .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
+            .collect();
+        let s: f64 = x.iter().map(|v| v * v).sum();
+        for variance in [1e-30, 1e30] {
+            let law = Ar1SquareSum::new(variance, 0.5, &[x.len()]).unwrap();
+            if variance < 1.0 {
+                assert!(law.saddle_point(s).is_none(), "the fallback is exercised");
+            }
+            let (out, _, _) = square_sum_test(&[&x], &law).unwrap();
+            assert_eq!(out.p_value, 0.0, "{variance}");
+        }
+        // Where the saddle point is found, nothing changes: the truth is accepted.
+        let law = Ar1SquareSum::new(s / x.len() as f64, 0.0, &[x.len()]).unwrap();
+        assert!(square_sum_test(&[&x], &law).unwrap().0.p_value > 0.9);
     }
 
     #[test]

@@ -31,6 +31,7 @@ use crate::scene::linear::{
     Continuum, LinearReference, LinearRun, ModeReference, RigidReference, TangentReference,
     TrajectoryRecord, TwoTimeReference, rigid_coordinates,
 };
+use crate::scene::validate::membrane_mesh_violation;
 use crate::scene::{CheckKind, CompressionSpec, MeshScheme, ModelKind, RunSpec, Scene};
 use crate::stats::moments::MIN_SERIES_LEN;
 use crate::theory::DomainInput;
@@ -1133,6 +1134,14 @@ fn discrete_run(
         .noise_model()
         .ok_or_else(|| unknown("discretization.noise"))?;
     fits(scene, data, (model, scheme, elements, dt / tau1)).map_err(|(key, m)| key_err(key, m))?;
+    // A membrane's counts are bounded as a scene file's mesh is (the sidecar's own range
+    // is the filament's).
+    if let Some(m) = &scene.membrane
+        && let Some((key, value, allowed)) =
+            membrane_mesh_violation(m.boundary, elements, d.elements_y, "discretization")
+    {
+        return Err(key_err(&key, format!("must be {allowed}, got {value}")));
+    }
     let mut scene = scene.clone();
     scene.model = model;
     scene.mesh.scheme = scheme;
