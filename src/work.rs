@@ -14,7 +14,10 @@
 //! number of modes for the spectral model), and `components × n²` for the dense exact
 //! modal update (two n × n products per step). The banded θ-schemes and the modal
 //! Metropolis chain cost O(n) per step, so DOF-steps are proportional to CPU time; the
-//! message converts them to a wall time at [`NOMINAL_DOF_STEPS_PER_SECOND`].
+//! message converts them to a wall time at [`NOMINAL_DOF_STEPS_PER_SECOND`]. `run` adds
+//! the rows it writes, each deflection value at its model's cost
+//! (`LinearRun::deflection_cost`). A preparation's set-up (modes, references) is not
+//! counted.
 //!
 //! **Memory** is that of the samples held at once: runs (or study values, or map cells)
 //! run one after the other and drop their samples, so the peak is that of the largest

@@ -696,6 +696,43 @@ fn data_thirty_orders_off_the_reference_fail_their_checks() {
     assert_eq!(far["p_value"], 0.0, "{far}");
 }
 
+/// What: `run`'s projected work counts the rows it writes, not only the steps: the
+/// spectral reference's 8 quick trajectories at `--every 1` (its default cadence here:
+/// 1.8e6 rows of 65 positions, each a sum over 64 modes, measured 138 s) project about
+/// 7.6e9 DOF-steps (they projected 1.2e8, "about 2.3 s", whatever the rows); at
+/// `--every 200` the projection drops by the rows' share.
+/// Tolerance: the projection's order (within 2× of the measured cost).
+#[test]
+fn run_projection_counts_the_rows_it_writes() {
+    let dir = TempDir::new("run-row-cost");
+    let out = dir.join_str("out");
+    let projected = |every: &str| -> f64 {
+        let args = [
+            "run",
+            "-q",
+            "--scene",
+            "spectral-reference",
+            "--trajectories",
+            "8",
+            "--every",
+            every,
+            "--max-work",
+            "1",
+            "--out",
+            &out,
+        ];
+        let o = run(&args);
+        assert_refused(&o, &args, &["DOF-steps to evaluate them"]);
+        let err = stderr_of(&o);
+        let got = err.split("got ").nth(1).and_then(|t| t.split(' ').next());
+        got.and_then(|g| g.parse().ok())
+            .unwrap_or_else(|| panic!("no projection in {err}"))
+    };
+    let (dense, sparse) = (projected("1"), projected("200"));
+    assert!((7e9..1.5e10).contains(&dense), "{dense:e}");
+    assert!(sparse < 0.1 * dense, "{sparse:e} vs {dense:e}");
+}
+
 /// What: `run`'s work refusal names `--trajectories` and `--duration-tau1` (with their
 /// values) when they drive the work, not the scene's budget keys they replace.
 /// Tolerance: exact substrings.

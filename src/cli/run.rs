@@ -491,7 +491,7 @@ fn prepare_linear(job: &Job) -> Result<(Vec<LinearRun>, Vec<RowPlan>)> {
         .chosen
         .iter()
         .map(|&k| {
-            LinearRun::prepare(scene, &scene.runs[k])
+            LinearRun::prepare_for_writing(scene, &scene.runs[k])
                 .map_err(|e| scene.run_error(k, "integrator", e))
         })
         .collect::<Result<Vec<_>>>()?;
@@ -523,7 +523,7 @@ fn run_linear(job: &Job) -> Result<i32> {
     let scene = &job.scene;
     let (runs, plans) = prepare_linear(job)?;
     // This shard's share of the work.
-    let work = projection(job, &plans).scaled(job.share().fraction());
+    let work = projection(job, &runs, &plans).scaled(job.share().fraction());
     job.limits.check(&work)?;
     check_output_size(job, &plans)?;
     let mut sink = job.begin()?;
@@ -654,15 +654,15 @@ fn linear_data_run(
 /// The projected work of the whole run: per chosen run, every trajectory's steps
 /// (burn-in included) times the unknowns each updates, at the cost per step of the
 /// scene's own projection.
-fn projection(job: &Job, plans: &[RowPlan]) -> WorkProjection {
+fn projection(job: &Job, runs: &[LinearRun], plans: &[RowPlan]) -> WorkProjection {
     let parts = job.scene.projected_work(job.budget());
     WorkProjection {
         command: "run".to_string(),
         parts: job
             .chosen
             .iter()
-            .zip(plans)
-            .map(|(&k, plan)| {
+            .zip(runs.iter().zip(plans))
+            .map(|(&k, (run, plan))| {
                 let mut part = parts[k].clone();
                 let w = part.work;
                 let per_step = if w.trajectory_steps > 0.0 {
@@ -672,17 +672,24 @@ fn projection(job: &Job, plans: &[RowPlan]) -> WorkProjection {
                 };
                 let n = job.ensemble(k).0 as f64;
                 let steps = n * (plan.rows * plan.every) as f64;
+                // Writing a row evaluates every deflection column (a spectral model sums
+                // its modes at each position): at `--every 1` this, not the step, is
+                // the cost.
+                let rows = n * plan.rows as f64;
+                let values = (job.scene.components() * plan.positions.len()) as f64;
+                let row_work = rows * values * run.deflection_cost();
                 part.work = RunWork {
                     trajectory_steps: steps,
-                    dof_steps: steps * per_step,
+                    dof_steps: steps * per_step + row_work,
                     samples: (plan.columns.len() * LANES) as f64,
                 };
                 part.drivers = format!(
-                    "{}; {} trajectories x {} rows of {} columns written",
+                    "{}; {} trajectories x {} rows of {} columns written ({} DOF-steps to evaluate them)",
                     part.drivers,
                     n,
                     plan.rows,
-                    plan.columns.len()
+                    plan.columns.len(),
+                    langevin_fem::work::count(row_work)
                 );
                 flag_driven(job, part)
             })

@@ -225,6 +225,16 @@ pub(crate) fn probe_of(
     vectors: &DMatrix<f64>,
     value: impl Fn(&[f64]) -> f64,
 ) -> DVector<f64> {
+    probe_of_transposed(n, &vectors.transpose(), value)
+}
+
+/// [`probe_of`] with `Φᵀ` given (`vectors_t`), for many probes of one set of modes: the
+/// same product, bit for bit, without an n × n transpose per probe.
+pub(crate) fn probe_of_transposed(
+    n: usize,
+    vectors_t: &DMatrix<f64>,
+    value: impl Fn(&[f64]) -> f64,
+) -> DVector<f64> {
     let mut e = vec![0.0; n];
     let mut v = DVector::zeros(n);
     for k in 0..n {
@@ -232,7 +242,7 @@ pub(crate) fn probe_of(
         v[k] = value(&e);
         e[k] = 0.0;
     }
-    vectors.transpose() * v
+    vectors_t * v
 }
 
 /// RMS slope (rad) above which the small-slope models are flagged: the geometric terms
@@ -688,12 +698,12 @@ fn rigid_references(
 }
 
 /// The exact laws of the tangent-angle cosine amplitudes n = 1 … `count` of `beam`
-/// ([`TangentReference`]) under the discrete law `law` of its generalized modes `gm`, and
-/// the functionals' rows that sample them.
+/// ([`TangentReference`]) under the discrete law `law` of its generalized modes (`vectors_t`:
+/// `Φᵀ`; the values NaN without a law), and the functionals' rows that sample them.
 fn tangent_references(
     beam: &BeamModel,
-    gm: &GeneralizedModes,
-    law: &DiscreteLaw,
+    vectors_t: &DMatrix<f64>,
+    law: Option<&DiscreteLaw>,
     count: usize,
 ) -> (Vec<TangentReference>, Option<DMatrix<f64>>) {
     let p = beam.params();
@@ -703,14 +713,22 @@ fn tangent_references(
     for n in 1..=count {
         let f = beam.tangent_cosine_functional(n);
         rows.row_mut(n - 1).copy_from_slice(&f);
-        let a = probe_of(n_dofs, &gm.vectors, |e| {
-            f.iter().zip(e).map(|(x, y)| x * y).sum()
-        });
-        let terms = autocovariance_terms(law, &a);
+        let (variance_discrete, terms) = match law {
+            Some(law) => {
+                let a = probe_of_transposed(n_dofs, vectors_t, |e| {
+                    f.iter().zip(e).map(|(x, y)| x * y).sum()
+                });
+                (
+                    a.dot(&(&law.stationary * &a)),
+                    autocovariance_terms(law, &a),
+                )
+            }
+            None => (f64::NAN, Vec::new()),
+        };
         let q = n as f64 * std::f64::consts::PI / p.length;
         refs.push(TangentReference {
             n,
-            variance_discrete: a.dot(&(&law.stationary * &a)),
+            variance_discrete,
             variance_continuum: p.kt / (p.bending_rigidity * q * q),
             terms,
         });
@@ -866,6 +884,9 @@ struct Setup<'s> {
     tau1: f64,
     dt: f64,
     profile_x: Vec<f64>,
+    /// Whether the finite elements' discrete reference values are computed (the
+    /// O(n³) [`DiscreteLaw`]); `false` for [`LinearRun::prepare_for_writing`].
+    values: bool,
 }
 
 impl Setup<'_> {
@@ -1061,14 +1082,16 @@ impl Setup<'_> {
     /// exact discrete references from the generalized modes
     /// ([`DiscreteLaw`]: the same law whichever object assembled the system).
     fn fem(&self) -> Result<Prepared> {
-        let (p, spec, dt) = (self.scene.filament, self.spec, self.dt);
+        let (spec, dt) = (self.spec, self.dt);
         let object = self.fem_object()?;
         let system = object.system();
-        // An explicit step above its limit, or a Crank–Nicolson step whose fastest
+        // An explicit step above its limit, or a beam's Crank–Nicolson step whose fastest
         // multiplier rounds to −1, fails at once (λ_max by an O(n) inertia bisection),
-        // before the O(n³) eigen-decomposition.
+        // before the O(n³) eigen-decomposition. (A plate's separable modes cost less
+        // than its wide-band bisection: its Crank–Nicolson step is checked on them.)
+        let beam = !matches!(object, FemObject::Plate { .. });
         let limited = |kind: IntegratorKind| {
-            kind.stability_limit(1.0).is_some() || kind.rounding_limit(1.0).is_some()
+            kind.stability_limit(1.0).is_some() || (beam && kind.rounding_limit(1.0).is_some())
         };
         if limited(spec.integrator) {
             build_integrator(
@@ -1084,63 +1107,45 @@ impl Setup<'_> {
         let max_rate = gm.rates.max();
         // Fails early with the stability limit if the step is too large.
         build_integrator(spec.integrator, system, spec.noise, dt, max_rate, Some(&gm))?;
-        let law = DiscreteLaw::new(system, &gm, spec.integrator, spec.noise, dt)?;
-        let refs = self.fem_mode_references(&law, system.kt());
+        // The law's O(n³) covariances only where reference values are wanted
+        // (`Setup::values`).
+        let law = self
+            .values
+            .then(|| DiscreteLaw::new(system, &gm, spec.integrator, spec.noise, dt))
+            .transpose()?;
+        let law = law.as_ref();
+        let refs = self.fem_mode_references(law, &gm.rates, system.kt());
         // Probe vectors: w(x) = p_xᵀ w, and their images Φᵀ p_x in modal space.
-        let probe = |x: f64| probe_of(system.n_dofs(), &gm.vectors, |e| object.value_at(e, x));
+        let vectors_t = gm.vectors.transpose();
+        let probe =
+            |x: f64| probe_of_transposed(system.n_dofs(), &vectors_t, |e| object.value_at(e, x));
         // ⟨w²(x)⟩ = aᵀSa, and the terms of its autocovariance.
         let (profile_discrete, profile_terms) = self
             .profile_x
             .iter()
-            .map(|&x| {
-                let a = probe(x);
-                (law.point_covariance(&a, &a), autocovariance_terms(&law, &a))
+            .map(|&x| match law {
+                Some(law) => {
+                    let a = probe(x);
+                    (law.point_covariance(&a, &a), autocovariance_terms(law, &a))
+                }
+                None => (f64::NAN, Vec::new()),
             })
             .unzip();
-        let two_time = self.fem_two_time(&law, &probe)?;
+        let two_time = self.fem_two_time(law, &probe)?;
         let modal = self.modal_path(&object, &gm, &two_time, &probe);
         let projector = gm.projector(system, self.scene.sampling.modes);
         let keep_modes = spec.integrator.needs_modes();
-        // The trajectory data format's amplitudes: the C-normalized modal coordinate q of
-        // a mode whose field is close to c·φ (φ the continuum mode, ξ∫(cφ)² = 1) is the
-        // amplitude a = c·q of φ, c = 1/√(ξ‖φ‖²): √(2/(ξL)) for the filament's sines
-        // (signed as the sine at L/(2n)), 1/√(ξ‖φ‖²) for a membrane's real modes
-        // (‖φ‖² = A/4 or A/2, (M3); signs free).
         let rigid = match &object {
             FemObject::Beam(beam) => rigid_references(beam, spec.noise, spec.integrator)?,
             FemObject::Chain(_) | FemObject::Plate { .. } => Vec::new(),
         };
         let (tangent, tangent_rows) = match object.beam() {
             Some(beam) if spec.checks(self.scene).contains(&CheckKind::TangentAngle) => {
-                tangent_references(beam, &gm, &law, self.scene.sampling.modes)
+                tangent_references(beam, &vectors_t, law, self.scene.sampling.modes)
             }
             _ => (Vec::new(), None),
         };
-        let amplitude_scale = match &object {
-            // Other ends: the modes are signed by their continuum mode already
-            // (generalized_modes), whose normalization ∫φ² = L/2 is the sine's.
-            FemObject::Beam(b) if !b.ends().is_hinged() => {
-                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
-            }
-            // The chain's modes are signed by their sine already (ChainModel::modes).
-            FemObject::Chain(_) => {
-                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
-            }
-            FemObject::Beam(_) => {
-                let scale = (2.0 / (p.drag * p.length)).sqrt();
-                (1..=self.scene.sampling.modes)
-                    .map(|n| {
-                        let at = probe(p.length / (2.0 * n as f64))[n - 1];
-                        if at < 0.0 { -scale } else { scale }
-                    })
-                    .collect()
-            }
-            FemObject::Plate { plate, .. } => {
-                let membrane = Membrane::new(*plate.params())?;
-                let scale = 1.0 / (membrane.params.drag * membrane.mode_norm_sq()).sqrt();
-                vec![scale; self.scene.sampling.modes]
-            }
-        };
+        let amplitude_scale = self.amplitude_scale(&object, &probe)?;
         Ok(Prepared {
             rigid,
             tangent,
@@ -1195,19 +1200,65 @@ impl Setup<'_> {
         })
     }
 
+    /// The trajectory data format's amplitudes, per checked mode: the C-normalized modal
+    /// coordinate q of a mode whose field is close to c·φ (φ the continuum mode,
+    /// ξ∫(cφ)² = 1) is the amplitude a = c·q of φ, c = 1/√(ξ‖φ‖²): √(2/(ξL)) for the
+    /// filament's sines (the hinged beam's signed as the sine at L/(2n), by `probe`),
+    /// 1/√(ξ‖φ‖²) for a membrane's real modes (‖φ‖² = A/4 or A/2, (M3); signs free).
+    fn amplitude_scale(
+        &self,
+        object: &FemObject,
+        probe: &dyn Fn(f64) -> DVector<f64>,
+    ) -> Result<Vec<f64>> {
+        let p = self.scene.filament;
+        Ok(match object {
+            // Other ends: the modes are signed by their continuum mode already
+            // (generalized_modes), whose normalization ∫φ² = L/2 is the sine's.
+            FemObject::Beam(b) if !b.ends().is_hinged() => {
+                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
+            }
+            // The chain's modes are signed by their sine already (ChainModel::modes).
+            FemObject::Chain(_) => {
+                vec![(2.0 / (p.drag * p.length)).sqrt(); self.scene.sampling.modes]
+            }
+            FemObject::Beam(_) => {
+                let scale = (2.0 / (p.drag * p.length)).sqrt();
+                (1..=self.scene.sampling.modes)
+                    .map(|n| {
+                        let at = probe(p.length / (2.0 * n as f64))[n - 1];
+                        if at < 0.0 { -scale } else { scale }
+                    })
+                    .collect()
+            }
+            FemObject::Plate { plate, .. } => {
+                let membrane = Membrane::new(*plate.params())?;
+                let scale = 1.0 / (membrane.params.drag * membrane.mode_norm_sq()).sqrt();
+                vec![scale; self.scene.sampling.modes]
+            }
+        })
+    }
+
     /// The references of every checked mode under the discrete law `law`, with the
     /// continuum's beside them (thermal energy `kt`).
-    fn fem_mode_references(&self, law: &DiscreteLaw, kt: f64) -> Vec<ModeReference> {
+    fn fem_mode_references(
+        &self,
+        law: Option<&DiscreteLaw>,
+        rates: &DVector<f64>,
+        kt: f64,
+    ) -> Vec<ModeReference> {
         (0..self.scene.sampling.modes)
             .map(|i| {
                 let n = i + 1;
+                // The law's multiplier, equipartition and rate, bit for bit
+                // ([`DiscreteLaw::new`], [`DiscreteLaw::decay_rate`]).
+                let (m, _) = self.spec.integrator.modal_form(rates[i], self.dt, kt);
                 ModeReference {
                     n,
-                    variance_discrete: law.mode_variance(i),
-                    variance_equipartition: law.equipartition(i),
+                    variance_discrete: law.map_or(f64::NAN, |law| law.mode_variance(i)),
+                    variance_equipartition: kt / rates[i],
                     variance_continuum: kt / self.continuum.mode_rate(n),
-                    multiplier: law.multipliers[i],
-                    rate_discrete: law.decay_rate(i),
+                    multiplier: m,
+                    rate_discrete: (m > 0.0).then(|| -m.ln() / self.dt),
                     rate_continuum: self.continuum.mode_rate(n),
                     label: self.continuum.mode_label(n),
                 }
@@ -1245,7 +1296,7 @@ impl Setup<'_> {
     /// discrete law `law`, with the modal probe vectors `probe(x)`.
     fn fem_two_time(
         &self,
-        law: &DiscreteLaw,
+        law: Option<&DiscreteLaw>,
         probe: &dyn Fn(f64) -> DVector<f64>,
     ) -> Result<Vec<TwoTimeReference>> {
         let (length, dt, tau1) = (self.continuum.line_length(), self.dt, self.tau1);
@@ -1257,7 +1308,19 @@ impl Setup<'_> {
                 self.steps(q[3] * tau1).max(1),
             );
             let (t, eta) = (ts as f64 * dt, es as f64 * dt);
-            let (ax, ay) = (probe(x), probe(y));
+            let (discrete, variances) = match law {
+                Some(law) => {
+                    let (ax, ay) = (probe(x), probe(y));
+                    (
+                        law.two_time(ts, es, &ax, &ay),
+                        (
+                            law.two_time(ts, ts, &ax, &ax),
+                            law.two_time(es, es, &ay, &ay),
+                        ),
+                    )
+                }
+                None => (f64::NAN, (f64::NAN, f64::NAN)),
+            };
             tt.push(TwoTimeReference {
                 x,
                 y,
@@ -1265,11 +1328,8 @@ impl Setup<'_> {
                 eta,
                 t_step: ts,
                 eta_step: es,
-                discrete: law.two_time(ts, es, &ax, &ay),
-                variances: (
-                    law.two_time(ts, ts, &ax, &ax),
-                    law.two_time(es, es, &ay, &ay),
-                ),
+                discrete,
+                variances,
                 continuum: self.continuum.correlation(x, y, t, eta)?,
             });
         }
@@ -1285,6 +1345,23 @@ impl LinearRun {
     /// [`Error::UnstableTimeStep`] for an explicit integrator above its limit; numerical
     /// failures of the reference computations.
     pub fn prepare(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
+        Self::prepare_with(scene, spec, true)
+    }
+
+    /// Prepares run `spec` of `scene` to write its trajectories only (`run`): as
+    /// [`Self::prepare`], the same model, integrator, modes and row cadence (the
+    /// trajectories are bit for bit those of a prepared run), but without the finite
+    /// elements' discrete reference values (variances, profile, two-time and tangent
+    /// references are NaN): their O(n³) law is what a large mesh's preparation costs.
+    ///
+    /// # Errors
+    /// As [`Self::prepare`].
+    pub fn prepare_for_writing(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
+        Self::prepare_with(scene, spec, false)
+    }
+
+    /// [`Self::prepare`], with the discrete reference values if `values`.
+    fn prepare_with(scene: &Scene, spec: &RunSpec, values: bool) -> Result<LinearRun> {
         let continuum = Continuum::of(scene)?;
         let tau1 = scene.tau1();
         let dt = spec.dt_tau1 * tau1;
@@ -1306,6 +1383,7 @@ impl LinearRun {
             tau1,
             dt,
             profile_x,
+            values,
         };
         let prepared = match scene.model {
             ModelKind::Compression => {

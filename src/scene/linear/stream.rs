@@ -92,6 +92,23 @@ impl LinearRun {
         })
     }
 
+    /// The cost of one deflection value of a row, in DOF-steps (for `run`'s projection of
+    /// its rows, [`crate::work`]; measured on the reference machine): a spectral model
+    /// sums a sine per mode at the position (about 18 ns a mode, a DOF-step each), a
+    /// plate on its modal path dots its modal probe (about 1.2 ns a mode, 1/16 of a
+    /// DOF-step), finite elements interpolate locally (counted as 1).
+    pub fn deflection_cost(&self) -> f64 {
+        match &self.model {
+            Model::Fem {
+                modal: Some(path), ..
+            } => path.rates.len() as f64 / 16.0,
+            Model::Fem { .. } => 1.0,
+            Model::Spectral { n_modes, .. } => *n_modes as f64,
+            Model::SpectralMembrane { simulator, .. } => simulator.modes().len() as f64,
+            Model::Data => 0.0,
+        }
+    }
+
     /// Simulates the trajectories `range` of the ensemble seeded `seed` (the same
     /// trajectories as [`Self::simulate_ensemble`]: `0..count` for a whole run, one
     /// shard's share for `run --shard`, [`crate::shard`]) and writes each, as `plan`
