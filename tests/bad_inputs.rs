@@ -1113,6 +1113,12 @@ fn filament_cases() -> Vec<Case> {
 /// Mesh, sampling and run keys of a linear scene.
 fn linear_cases() -> Vec<Case> {
     vec![
+        // The parser's recursion limit: its message was "recursion limit".
+        scene(
+            "key-nested-1000-deep",
+            &[("[filament]", DEEP_KEY_1000)],
+            &["nested too deeply", "scene keys"],
+        ),
         scene(
             "elements-negative",
             &[("elements = 4", "elements = -1")],
@@ -2135,6 +2141,8 @@ fn name_cases() -> Vec<Case> {
 
 /// Stands for a `profile_points` list of 200 entries (see [`expand`]).
 const PROFILE_POINTS_200: &str = "<200 profile points>";
+/// A dotted key 1000 levels deep before `[filament]`.
+const DEEP_KEY_1000: &str = "<a key 1000 levels deep>";
 /// Stands for a `two_time` list of 200 points.
 const TWO_TIME_200: &str = "<200 two-time points>";
 /// Stands for a `strain_ratios` list of 200 strains.
@@ -2147,6 +2155,7 @@ fn expand(to: &str) -> String {
         PROFILE_POINTS_200 => list("profile_points", "0.5"),
         TWO_TIME_200 => list("two_time", "[0.5, 0.5, 0.5, 1.0]"),
         STRAINS_200 => format!("strain_ratios = [0.0, 2.0{}]", ", 1.0".repeat(198)),
+        DEEP_KEY_1000 => format!("x{} = 1\n[filament]", ".x".repeat(1000)),
         _ => to.to_string(),
     }
 }

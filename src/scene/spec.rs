@@ -999,6 +999,9 @@ fn user_words(message: &str) -> String {
         .replace("expected a sequence", "expected an array [...]")
         .replace("invalid type: map", "invalid type: table")
         .replace("invalid type: sequence", "invalid type: array");
+    if m == "recursion limit" {
+        m = "keys, tables or arrays nested too deeply for the TOML parser; a scene file's keys are at most four levels deep (e.g. runs[0].quick.trajectories): see `langevin-fem scene keys`".into();
+    }
     if let Some(i) = m.find("expected struct ") {
         let end = m[i + 16..]
             .find(|c: char| !c.is_alphanumeric())
