@@ -16,8 +16,9 @@
 //! Metropolis chain cost O(n) per step, so DOF-steps are proportional to CPU time; the
 //! message converts them to a wall time at [`NOMINAL_DOF_STEPS_PER_SECOND`]. `run` adds
 //! the rows it writes, each deflection value at its model's cost
-//! (`LinearRun::deflection_cost`). A preparation's set-up (modes, references) is not
-//! counted.
+//! (`LinearRun::deflection_cost`). A scene's finite-element run adds the O(n³) set-up
+//! of its exact discrete references ([`Scene::setup_cost`]); `run`, whose preparation
+//! skips them and is done before it projects, counts its steps and rows only.
 //!
 //! **Memory** is that of the samples held at once: runs (or study values, or map cells)
 //! run one after the other and drop their samples, so the peak is that of the largest
@@ -29,6 +30,7 @@
 //! and `--max-memory-gib` raise (or lower) them for one command.
 //!
 //! [`Scene::projected_work`]: crate::scene::Scene::projected_work
+//! [`Scene::setup_cost`]: crate::scene::Scene::setup_cost
 
 use crate::error::{Error, Result};
 use std::path::PathBuf;

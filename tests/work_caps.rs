@@ -872,8 +872,9 @@ fn a_cheap_job_is_refused_just_below_its_projection_and_runs_at_it() {
     let p = scene_projection(&path);
     let work = p.dof_steps();
     let gib = p.peak_bytes() / GIB;
-    // 4 trajectories x (500 + 3200 steps) x 8 DOFs; 4 x 3 series x 3200 samples.
-    assert_eq!(work, 4.0 * 3700.0 * 8.0);
+    // 4 trajectories x (500 + 3200 steps) x 8 DOFs, and the set-up of the discrete
+    // references, 0.1 n³ for a beam of n = 8 unknowns; 4 x 3 series x 3200 samples.
+    assert_eq!(work, 4.0 * 3700.0 * 8.0 + 0.1 * 8.0_f64.powi(3));
     assert_eq!(p.peak_samples(), 4.0 * 3.0 * 3200.0);
     let out = dir.join("out");
     let cases: [(&str, String, String, Option<&str>); 4] = [
@@ -917,7 +918,7 @@ fn a_cheap_job_is_refused_just_below_its_projection_and_runs_at_it() {
             Some(suggestion) => {
                 assert_eq!(o.status.code(), Some(2), "{what}: {d}");
                 assert!(m.contains("key `runs[0].quick`"), "{what}: {d}");
-                assert!(m.contains("got 118400 DOF-steps"), "{what}: {d}");
+                assert!(m.contains("got 118451 DOF-steps"), "{what}: {d}");
                 assert!(m.contains(suggestion), "{what}: {d}");
                 assert!(!out.join("summary.json").exists(), "{what}: {d}");
             }

@@ -664,12 +664,8 @@ fn projection(job: &Job, runs: &[LinearRun], plans: &[RowPlan]) -> WorkProjectio
             .zip(runs.iter().zip(plans))
             .map(|(&k, (run, plan))| {
                 let mut part = parts[k].clone();
-                let w = part.work;
-                let per_step = if w.trajectory_steps > 0.0 {
-                    w.dof_steps / w.trajectory_steps
-                } else {
-                    0.0
-                };
+                // The step's cost alone: the preparation (set-up) is done by now.
+                let per_step = job.scene.step_cost(&job.scene.runs[k]);
                 let n = job.ensemble(k).0 as f64;
                 let steps = n * (plan.rows * plan.every) as f64;
                 // Writing a row evaluates every deflection column (a spectral model sums
