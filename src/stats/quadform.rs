@@ -149,8 +149,7 @@ pub trait SquareSumLaw {
         }
         let Some((u, cu)) = self.saddle_point(s) else {
             let upper = s > self.mean();
-            let bound = self.chernoff_bound(s, upper)?;
-            return Some(if upper { bound } else { 1.0 - bound });
+            return Some(bounded_tail(self.chernoff_bound(s, upper)?, upper));
         };
         let normal = Normal::standard();
         let w2 = 2.0 * (u * s - cu.k);
@@ -217,6 +216,15 @@ pub trait SquareSumLaw {
             .min_by(f64::total_cmp)
             .map(|g| g.exp().min(1.0))
     }
+}
+
+/// `P(S ≥ s)` to report from a bound `bound` on the tail beyond `s` (the upper tail if
+/// `upper`, else the lower), such that the two-sided p-value `2·min(P(S ≥ s), P(S ≤ s))`
+/// comes out as `2·min(bound, ½)`: at or above the truth whatever the bound's slack
+/// (unclamped, a loose bound above ½ would make the other tail look small).
+fn bounded_tail(bound: f64, upper: bool) -> f64 {
+    let b = bound.min(0.5);
+    if upper { b } else { 1.0 - b }
 }
 
 /// The law of `S = Σ_series Σ_t x_t²` for independent stationary Gaussian AR(1) series
@@ -709,6 +717,19 @@ mod tests {
         let optimal = -(s - 10.0) / 2.0 + 5.0 * (s / 10.0_f64).ln();
         let got = law.chernoff_bound(s, true).unwrap().ln();
         assert!(optimal <= got && got <= optimal + 1.0, "{got} vs {optimal}");
+    }
+
+    /// A bound's p-value is never below the truth: a loose bound gives p = 1 on either
+    /// side, a tight one twice itself.
+    #[test]
+    fn bounded_tails_give_conservative_p_values() {
+        let p = |upper_tail: f64| 2.0 * upper_tail.min(1.0 - upper_tail);
+        for upper in [true, false] {
+            assert_eq!(p(bounded_tail(0.9, upper)), 1.0);
+            assert_eq!(p(bounded_tail(1.0, upper)), 1.0);
+            assert!((p(bounded_tail(1e-3, upper)) - 2e-3).abs() < 1e-15);
+            assert_eq!(p(bounded_tail(0.0, upper)), 0.0);
+        }
     }
 
     /// A variance 10³⁰ times too small or too large: the saddle point is not resolvable in
