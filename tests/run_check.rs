@@ -557,6 +557,23 @@ fn identical_trajectories_are_refused_and_a_frozen_amplitude_fails() {
     );
 }
 
+/// `run -q --scene scene --trajectories n --out data` (exit 0); the sidecar's path.
+fn run_fixture(scene: &str, n: &str, data: &str) -> std::path::PathBuf {
+    let args = [
+        "run",
+        "-q",
+        "--scene",
+        scene,
+        "--trajectories",
+        n,
+        "--out",
+        data,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    Path::new(data).join("data.json")
+}
+
 /// What: membrane data whose sidecar names another boundary than the scene's (here
 /// simply supported against a periodic patch) are refused with exit 2 naming
 /// `membrane.boundary` and both boundaries, before any reference is computed (the
@@ -568,19 +585,7 @@ fn membrane_data_of_another_boundary_are_refused() {
     let (data, out) = (dir.join_str("data"), dir.join_str("out"));
     let scene = fixture("tests/scenes/good/membrane-pbc.toml");
     let scene = scene.to_str().unwrap();
-    let args = [
-        "run",
-        "-q",
-        "--scene",
-        scene,
-        "--trajectories",
-        "2",
-        "--out",
-        &data,
-    ];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
-    let side = Path::new(&data).join("data.json");
+    let side = run_fixture(scene, "2", &data);
     let text = std::fs::read_to_string(&side).unwrap();
     assert!(text.contains("\"periodic\""), "{text}");
     std::fs::write(
@@ -608,19 +613,7 @@ fn membrane_data_beyond_a_membrane_mesh_are_refused_naming_the_key() {
     let (data, out) = (dir.join_str("data"), dir.join_str("out"));
     let scene = fixture("tests/scenes/good/membrane-pbc.toml");
     let scene = scene.to_str().unwrap();
-    let args = [
-        "run",
-        "-q",
-        "--scene",
-        scene,
-        "--trajectories",
-        "2",
-        "--out",
-        &data,
-    ];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
-    let side = Path::new(&data).join("data.json");
+    let side = run_fixture(scene, "2", &data);
     let original: serde_json::Value = json(&side);
     for (edit, key, needles) in [
         (
@@ -665,19 +658,7 @@ fn data_thirty_orders_off_the_reference_fail_their_checks() {
     let (data, out) = (dir.join_str("data"), dir.join_str("out"));
     let scene = fixture("tests/scenes/good/tiny-linear.toml");
     let scene = scene.to_str().unwrap();
-    let args = [
-        "run",
-        "-q",
-        "--scene",
-        scene,
-        "--trajectories",
-        "4",
-        "--out",
-        &data,
-    ];
-    let o = run(&args);
-    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
-    let side = Path::new(&data).join("data.json");
+    let side = run_fixture(scene, "4", &data);
     let mut d: serde_json::Value = json(&side);
     d["filament"]["kt"] = serde_json::json!(1e-30);
     std::fs::write(&side, serde_json::to_string(&d).unwrap()).unwrap();

@@ -360,58 +360,80 @@ fn membrane_fem(
         "max_rate": max_rate,
     });
     if let Some(dt) = args.dt {
-        require_positive("--dt", dt)?;
-        let integrator: IntegratorKind = args
-            .integrator
-            .parse()
-            .map_err(as_flag_named("--integrator"))?;
-        if !IntegratorKind::LINEAR.contains(&integrator) {
+        out["discrete"] = membrane_discrete(
+            args,
+            &plate,
+            dt,
+            (rate, max_rate),
+            (variance, uniform_ratio),
+        )?;
+    }
+    Ok(out)
+}
+
+/// The `discrete` part of `theory membrane --elements --dt`: the exact discrete law
+/// ([`ModeLaw`]) of the plate mode of generalized rate `rate` under `--integrator` and
+/// `--noise` at step `dt` (`max_rate`: the mesh's λ_max), its variance in the continuum's
+/// convention (`variance` at equipartition) and, for the element-uniform load, its noise
+/// ratio `uniform_ratio`.
+fn membrane_discrete(
+    args: &MembraneArgs,
+    plate: &PlateModel,
+    dt: f64,
+    (rate, max_rate): (f64, f64),
+    (variance, uniform_ratio): (f64, f64),
+) -> Result<serde_json::Value> {
+    require_positive("--dt", dt)?;
+    let integrator: IntegratorKind = args
+        .integrator
+        .parse()
+        .map_err(as_flag_named("--integrator"))?;
+    if !IntegratorKind::LINEAR.contains(&integrator) {
+        return Err(Error::invalid(
+            "--integrator",
+            integrator,
+            IntegratorKind::list(&IntegratorKind::LINEAR),
+        ));
+    }
+    let noise = match args.noise.as_str() {
+        "consistent" => NoiseModel::Consistent,
+        "element-uniform" => NoiseModel::ElementUniform,
+        other => {
             return Err(Error::invalid(
-                "--integrator",
-                integrator,
-                IntegratorKind::list(&IntegratorKind::LINEAR),
+                "--noise",
+                other,
+                "consistent or element-uniform",
             ));
         }
-        let noise = match args.noise.as_str() {
-            "consistent" => NoiseModel::Consistent,
-            "element-uniform" => NoiseModel::ElementUniform,
-            other => {
-                return Err(Error::invalid(
-                    "--noise",
-                    other,
-                    "consistent or element-uniform",
-                ));
-            }
-        };
-        if let Some(limit) = integrator.stability_limit(max_rate)
-            && dt >= limit
-        {
-            return Err(Error::invalid(
-                "--dt",
-                dt,
-                format!("< {limit:e}, the {integrator} stability limit 2/lambda_max of this mesh"),
-            ));
-        }
-        let noise_variance = match noise {
-            NoiseModel::Consistent => 1.0,
-            NoiseModel::ElementUniform => uniform_ratio,
-        };
-        let law = ModeLaw::new(rate, noise_variance, integrator, dt, plate.kt())?;
-        let ratio = law.variance / law.equipartition;
-        out["discrete"] = json!({
-            "dt": dt,
-            "integrator": integrator.name(),
-            "noise": noise.name(),
-            "multiplier": law.multiplier,
-            "variance": ratio * variance,
-            "variance_ratio_to_equipartition": ratio,
-        });
-        match law.decay_rate {
-            Some(r) => out["discrete"]["decay_rate"] = json!(r),
-            None => {
-                out["discrete"]["decay_rate_note"] =
-                    json!("multiplier <= 0: the mode alternates in sign and has no decay rate")
-            }
+    };
+    if let Some(limit) = integrator.stability_limit(max_rate)
+        && dt >= limit
+    {
+        return Err(Error::invalid(
+            "--dt",
+            dt,
+            format!("< {limit:e}, the {integrator} stability limit 2/lambda_max of this mesh"),
+        ));
+    }
+    let noise_variance = match noise {
+        NoiseModel::Consistent => 1.0,
+        NoiseModel::ElementUniform => uniform_ratio,
+    };
+    let law = ModeLaw::new(rate, noise_variance, integrator, dt, plate.kt())?;
+    let ratio = law.variance / law.equipartition;
+    let mut out = json!({
+        "dt": dt,
+        "integrator": integrator.name(),
+        "noise": noise.name(),
+        "multiplier": law.multiplier,
+        "variance": ratio * variance,
+        "variance_ratio_to_equipartition": ratio,
+    });
+    match law.decay_rate {
+        Some(r) => out["decay_rate"] = json!(r),
+        None => {
+            out["decay_rate_note"] =
+                json!("multiplier <= 0: the mode alternates in sign and has no decay rate")
         }
     }
     Ok(out)

@@ -87,11 +87,9 @@ impl DiscreteLaw {
         self.kt / self.rates[i]
     }
 
-    /// The discrete decay rate `−ln(m_i)/Δt` of mode `i`, `None` if `m_i ≤ 0` (the mode
-    /// alternates in sign and has no rate).
+    /// The discrete decay rate of mode `i` ([`decay_rate`]).
     pub fn decay_rate(&self, i: usize) -> Option<f64> {
-        let m = self.multipliers[i];
-        (m > 0.0).then(|| -m.ln() / self.dt)
+        decay_rate(self.multipliers[i], self.dt)
     }
 
     /// Stationary `⟨w(x) w(y)⟩ = a_yᵀ S a_x` for modal probes `a_x`, `a_y`.
@@ -119,6 +117,12 @@ impl DiscreteLaw {
         }
         (ay.transpose() * &st * ax)[(0, 0)]
     }
+}
+
+/// The discrete decay rate `−ln(m)/Δt` of a mode of one-step multiplier `m`, `None` if
+/// `m ≤ 0` (the mode alternates in sign and has no rate).
+pub fn decay_rate(m: f64, dt: f64) -> Option<f64> {
+    (m > 0.0).then(|| -m.ln() / dt)
 }
 
 /// The exact discrete law of one mode alone (the diagonal of [`DiscreteLaw`], module docs):
@@ -160,7 +164,7 @@ impl ModeLaw {
             multiplier: m,
             variance: s[(0, 0)],
             equipartition: kt / rate,
-            decay_rate: (m > 0.0).then(|| -m.ln() / dt),
+            decay_rate: decay_rate(m, dt),
         })
     }
 }

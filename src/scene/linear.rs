@@ -10,7 +10,7 @@
 //! the *continuum* reference is the modal solution of eq. (2) (per-mode variance
 //! 2kTL³/(π⁴n⁴EI), rate λ_n, profile kT x²(L−x)²/(3EI L), eq. 4).
 
-use crate::dynamics::discrete::DiscreteLaw;
+use crate::dynamics::discrete::{DiscreteLaw, decay_rate};
 use crate::dynamics::{
     BatchTrajectory, ComponentBatch, Components, Driver, Integrator, IntegratorKind, LaneOf,
     ModalStep, Observer, ThetaBatch, Trajectory, build_integrator, par_indexed,
@@ -1250,7 +1250,7 @@ impl Setup<'_> {
             .map(|i| {
                 let n = i + 1;
                 // The law's multiplier, equipartition and rate, bit for bit
-                // ([`DiscreteLaw::new`], [`DiscreteLaw::decay_rate`]).
+                // ([`DiscreteLaw::new`], [`decay_rate`]).
                 let (m, _) = self.spec.integrator.modal_form(rates[i], self.dt, kt);
                 ModeReference {
                     n,
@@ -1258,7 +1258,7 @@ impl Setup<'_> {
                     variance_equipartition: kt / rates[i],
                     variance_continuum: kt / self.continuum.mode_rate(n),
                     multiplier: m,
-                    rate_discrete: (m > 0.0).then(|| -m.ln() / self.dt),
+                    rate_discrete: decay_rate(m, self.dt),
                     rate_continuum: self.continuum.mode_rate(n),
                     label: self.continuum.mode_label(n),
                 }

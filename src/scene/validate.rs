@@ -1354,6 +1354,94 @@ impl Scene {
             .map(|_| 0.5 * first.dt_tau1)
     }
 
+    /// The keys (with their values) that drive the work of run `i` with ensemble `e` at
+    /// `budget` (`inherited`: its sampling step from the Δt-halving pair), for
+    /// [`Self::projected_work`]'s messages.
+    fn work_drivers(
+        &self,
+        i: usize,
+        budget: Budget,
+        e: &Ensemble,
+        inherited: Option<f64>,
+    ) -> Vec<String> {
+        let b = budget.name();
+        let run = &self.runs[i];
+        let k = |key: &str| format!("runs[{i}].{b}.{key}");
+        let mut keys = Vec::new();
+        if let Some(c) = &self.compression {
+            keys.push(format!(
+                "compression.strain_ratios ({} strains)",
+                c.strain_ratios.len()
+            ));
+        }
+        keys.push(format!("{} = {}", k("trajectories"), e.trajectories));
+        match e.precision_target() {
+            Some(t) if !e.duration_given() => {
+                keys.push(format!("{} = {}", k("pilot_tau1"), Num(t.pilot_tau1)));
+                keys.push(format!(
+                    "{} = {}",
+                    k("max_duration_tau1"),
+                    Num(t.max_duration_tau1)
+                ));
+                if let Some(s) = t.step_search {
+                    keys.push(format!("{} = {}", k("max_dt_tau1"), Num(s.max_dt_tau1)));
+                }
+            }
+            _ => keys.push(format!("{} = {}", k("duration_tau1"), Num(e.duration_tau1))),
+        }
+        if e.two_time_trajectories > 0 && !self.sampling.two_time.is_empty() {
+            keys.push(format!(
+                "{} = {}",
+                k("two_time_trajectories"),
+                e.two_time_trajectories
+            ));
+        }
+        keys.push(format!("runs[{i}].dt_tau1 = {}", Num(run.dt_tau1)));
+        if let Some(h) = inherited {
+            keys.push(format!(
+                "sampling at dt_tau1 >= {} (half the steps of the first run of compression.halving)",
+                Num(h)
+            ));
+        }
+        match &self.compression {
+            Some(c) => {
+                keys.push(format!(
+                    "compression.burn_in_tau1 = {}",
+                    Num(c.burn_in_tau1)
+                ));
+                keys.push(format!(
+                    "compression.sample_every_tau1 = {}",
+                    Num(c.sample_every_tau1)
+                ));
+            }
+            None => {
+                let s = &self.sampling;
+                keys.push(format!("sampling.burn_in_tau1 = {}", Num(s.burn_in_tau1)));
+                keys.push(format!(
+                    "sampling.modes = {} and {} profile points",
+                    s.modes,
+                    s.profile_points.len()
+                ));
+            }
+        }
+        let elements_y = if self.is_membrane() {
+            format!(", mesh.elements_y = {}", self.mesh.elements_along_y())
+        } else {
+            String::new()
+        };
+        keys.push(format!(
+            "mesh.elements = {}{elements_y}, dims = {}{}",
+            self.mesh.elements,
+            self.dims,
+            if self.dense_step(run) {
+                " (exact-modal: n^2 per step)"
+            } else {
+                ""
+            }
+        ));
+        keys
+    }
+
     /// The projected work of every run of the scene at `budget`, one [`Part`] per run
     /// (the runs run one after the other), each naming the keys that drive it.
     pub fn projected_work(&self, budget: Budget) -> Vec<Part> {
@@ -1364,79 +1452,7 @@ impl Scene {
             .map(|(i, run)| {
                 let e = run.ensemble(budget);
                 let inherited = self.inherited_dt(i, budget);
-                let k = |key: &str| format!("runs[{i}].{b}.{key}");
-                let mut keys = Vec::new();
-                if let Some(c) = &self.compression {
-                    keys.push(format!(
-                        "compression.strain_ratios ({} strains)",
-                        c.strain_ratios.len()
-                    ));
-                }
-                keys.push(format!("{} = {}", k("trajectories"), e.trajectories));
-                match e.precision_target() {
-                    Some(t) if !e.duration_given() => {
-                        keys.push(format!("{} = {}", k("pilot_tau1"), Num(t.pilot_tau1)));
-                        keys.push(format!(
-                            "{} = {}",
-                            k("max_duration_tau1"),
-                            Num(t.max_duration_tau1)
-                        ));
-                        if let Some(s) = t.step_search {
-                            keys.push(format!("{} = {}", k("max_dt_tau1"), Num(s.max_dt_tau1)));
-                        }
-                    }
-                    _ => keys.push(format!("{} = {}", k("duration_tau1"), Num(e.duration_tau1))),
-                }
-                if e.two_time_trajectories > 0 && !self.sampling.two_time.is_empty() {
-                    keys.push(format!(
-                        "{} = {}",
-                        k("two_time_trajectories"),
-                        e.two_time_trajectories
-                    ));
-                }
-                keys.push(format!("runs[{i}].dt_tau1 = {}", Num(run.dt_tau1)));
-                if let Some(h) = inherited {
-                    keys.push(format!(
-                        "sampling at dt_tau1 >= {} (half the steps of the first run of compression.halving)",
-                        Num(h)
-                    ));
-                }
-                match &self.compression {
-                    Some(c) => {
-                        keys.push(format!(
-                            "compression.burn_in_tau1 = {}",
-                            Num(c.burn_in_tau1)
-                        ));
-                        keys.push(format!(
-                            "compression.sample_every_tau1 = {}",
-                            Num(c.sample_every_tau1)
-                        ));
-                    }
-                    None => {
-                        let s = &self.sampling;
-                        keys.push(format!("sampling.burn_in_tau1 = {}", Num(s.burn_in_tau1)));
-                        keys.push(format!(
-                            "sampling.modes = {} and {} profile points",
-                            s.modes,
-                            s.profile_points.len()
-                        ));
-                    }
-                }
-                let elements_y = if self.is_membrane() {
-                    format!(", mesh.elements_y = {}", self.mesh.elements_along_y())
-                } else {
-                    String::new()
-                };
-                keys.push(format!(
-                    "mesh.elements = {}{elements_y}, dims = {}{}",
-                    self.mesh.elements,
-                    self.dims,
-                    if self.dense_step(run) {
-                        " (exact-modal: n^2 per step)"
-                    } else {
-                        ""
-                    }
-                ));
+                let mut keys = self.work_drivers(i, budget, &e, inherited);
                 let mut work = self.run_work(i, &e, inherited);
                 let setup = self.setup_cost();
                 work.dof_steps += setup;
