@@ -1238,9 +1238,21 @@ impl Default for Evaluation {
 /// The lower Cholesky factor `L` and the determinant of the symmetric `k × k` matrix `a`
 /// (row-major, stride 4, `k ≤ 4`); `None` unless positive definite.
 fn cholesky(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
+    match k {
+        1 => cholesky_k::<1>(a),
+        2 => cholesky_k::<2>(a),
+        3 => cholesky_k::<3>(a),
+        4 => cholesky_k::<4>(a),
+        _ => None,
+    }
+}
+
+/// [`cholesky`] at a block size `K` known at compile time, so that the loops unroll (the
+/// same operations in the same order as for any `k`).
+fn cholesky_k<const K: usize>(a: &[f64; 16]) -> Option<([f64; 16], f64)> {
     let mut l = [0.0; 16];
     let mut det = 1.0;
-    for j in 0..k {
+    for j in 0..K {
         let d = a[5 * j] - (0..j).map(|p| l[4 * j + p] * l[4 * j + p]).sum::<f64>();
         if d.is_nan() || d <= 0.0 {
             return None;
@@ -1248,7 +1260,7 @@ fn cholesky(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
         let ljj = d.sqrt();
         l[5 * j] = ljj;
         det *= d;
-        for i in j + 1..k {
+        for i in j + 1..K {
             let s = a[4 * i + j] - (0..j).map(|p| l[4 * i + p] * l[4 * j + p]).sum::<f64>();
             l[4 * i + j] = s / ljj;
         }
@@ -1259,20 +1271,32 @@ fn cholesky(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
 /// The inverse and determinant of the symmetric `k × k` matrix `a` (row-major, stride 4,
 /// `k ≤ 4`) by Cholesky; `None` unless positive definite.
 fn spd_inverse(a: &[f64; 16], k: usize) -> Option<([f64; 16], f64)> {
-    let (l, det) = cholesky(a, k)?;
+    match k {
+        1 => spd_inverse_k::<1>(a),
+        2 => spd_inverse_k::<2>(a),
+        3 => spd_inverse_k::<3>(a),
+        4 => spd_inverse_k::<4>(a),
+        _ => None,
+    }
+}
+
+/// [`spd_inverse`] at a block size known at compile time (the same operations in the
+/// same order as for any `k`).
+fn spd_inverse_k<const K: usize>(a: &[f64; 16]) -> Option<([f64; 16], f64)> {
+    let (l, det) = cholesky_k::<K>(a)?;
     // columns of L⁻¹ by forward substitution, then A⁻¹ = L⁻ᵀ L⁻¹
     let mut li = [0.0; 16];
-    for c in 0..k {
-        for i in c..k {
+    for c in 0..K {
+        for i in c..K {
             let rhs = if i == c { 1.0 } else { 0.0 };
             let s = rhs - (c..i).map(|p| l[4 * i + p] * li[4 * p + c]).sum::<f64>();
             li[4 * i + c] = s / l[5 * i];
         }
     }
     let mut inv = [0.0; 16];
-    for r in 0..k {
-        for c in 0..k {
-            inv[4 * r + c] = (r.max(c)..k).map(|p| li[4 * p + r] * li[4 * p + c]).sum();
+    for r in 0..K {
+        for c in 0..K {
+            inv[4 * r + c] = (r.max(c)..K).map(|p| li[4 * p + r] * li[4 * p + c]).sum();
         }
     }
     Some((inv, det))
