@@ -1066,7 +1066,8 @@ fn theory_membrane_rejects_bad_input_with_exit_2() {
 /// side, and with --dt the exact discrete law (Crank–Nicolson, consistent noise: ratio to
 /// equipartition 1, element-uniform noise: the noise's own ratio; Euler–Maruyama:
 /// 1/(1 − λΔt/2) for the mode's own λ). Refusals: an explicit step at its
-/// stability limit, a mode the mesh does not resolve, too many elements, exit 2 naming
+/// stability limit, a Crank–Nicolson step past which the mode's multiplier rounds to −1
+/// (named as --dt, not as the multiplier), a mode the mesh does not resolve, too many elements, exit 2 naming
 /// the flag. Reference: the continuum of `theory membrane` and the closed forms above.
 /// Tolerance: 1e-9 relative for the closed forms (rounding), the order band for the
 /// convergence.
@@ -1146,6 +1147,28 @@ fn theory_membrane_finite_elements() {
                 "euler-maruyama",
             ],
             "--dt must be <",
+        ),
+        (
+            vec![
+                "--elements",
+                "8",
+                "--dt",
+                "1e20",
+                "--integrator",
+                "crank-nicolson",
+            ],
+            "--dt must be < ",
+        ),
+        (
+            vec![
+                "--elements",
+                "8",
+                "--dt",
+                "1e20",
+                "--integrator",
+                "crank-nicolson",
+            ],
+            "multiplier rounds to -1 in f64",
         ),
         (
             vec!["--elements", "2", "--m", "3"],

@@ -415,6 +415,19 @@ fn membrane_discrete(
             format!("< {limit:e}, the {integrator} stability limit 2/lambda_max of this mesh"),
         ));
     }
+    // Crank–Nicolson is A-stable, but this mode's multiplier (1 − a/2)/(1 + a/2) rounds
+    // to −1 in f64 once a = rate·Δt passes about 2⁵⁵: its stationary variance is 0/0.
+    if let Some(limit) = integrator.rounding_limit(rate)
+        && dt >= limit
+    {
+        return Err(Error::invalid(
+            "--dt",
+            format!("{dt:e}"),
+            format!(
+                "< {limit:e}: past it this mode's {integrator} multiplier rounds to -1 in f64 (rate x dt about 2^55) and its stationary variance is 0/0; give a smaller --dt, or --integrator backward-euler or exact-modal"
+            ),
+        ));
+    }
     let noise_variance = match noise {
         NoiseModel::Consistent => 1.0,
         NoiseModel::ElementUniform => uniform_ratio,
