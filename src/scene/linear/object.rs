@@ -18,6 +18,56 @@ use crate::fem::system::LinearSystem;
 use crate::spectral::EndedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode};
 use nalgebra::{DMatrix, DVector};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
+
+/// Objects of fewer unknowns decompose faster than [`memoized`] keys them.
+const MEMO_MIN_DOFS: usize = 100;
+/// Decompositions [`memoized`] keeps (a 1000-element beam's: 32 MB each).
+const MEMO_ENTRIES: usize = 2;
+
+/// A dense decomposition of [`memoized`]: its key and its modes, computed once (`None`
+/// if the decomposition failed).
+type MemoEntry = (String, Arc<OnceLock<Option<GeneralizedModes>>>);
+
+/// The last [`MEMO_ENTRIES`] dense decompositions ([`memoized`]).
+static MODES_MEMO: Mutex<Vec<MemoEntry>> = Mutex::new(Vec::new());
+
+/// `decompose()`, the dense generalized modes of `object` (O(n³)), computed once for
+/// runs on one discretization: the runs of a scene or of a data set, the steps of a
+/// convergence study over Δt. The modes do not depend on the integrator, the noise or
+/// the step, and they are a pure function of the object, so the memo is keyed by the
+/// object's whole state (its `Debug` text: every parameter, node, DOF number and
+/// matrix entry, each float exactly): a hit is the same modes bit for bit. Two threads
+/// asking for one key decompose it once. A failed decomposition is not kept (it is
+/// repeated, to give its error).
+fn memoized<T: std::fmt::Debug + std::ops::Deref<Target = LinearSystem>>(
+    object: &T,
+    decompose: impl Fn() -> Result<GeneralizedModes>,
+) -> Result<GeneralizedModes> {
+    if object.n_dofs() < MEMO_MIN_DOFS {
+        return decompose();
+    }
+    let key = format!("{object:?}");
+    let cell = {
+        // A poisoned memo only lost an entry being written: its entries are whole.
+        let mut memo = MODES_MEMO.lock().unwrap_or_else(PoisonError::into_inner);
+        match memo.iter().find(|(k, _)| *k == key) {
+            Some((_, cell)) => Arc::clone(cell),
+            None => {
+                let cell = Arc::new(OnceLock::new());
+                if memo.len() == MEMO_ENTRIES {
+                    memo.remove(0);
+                }
+                memo.push((key, Arc::clone(&cell)));
+                cell
+            }
+        }
+    };
+    match cell.get_or_init(|| decompose().ok()) {
+        Some(modes) => Ok(modes.clone()),
+        None => decompose(),
+    }
+}
 
 /// Relative tolerance of the membrane's continuum mode sums (their rigorous truncation
 /// bound, relative to the variance of the slowest mode).
@@ -223,8 +273,8 @@ impl FemObject {
     /// As [`generalized_modes`].
     pub(crate) fn modes(&self) -> Result<GeneralizedModes> {
         match self {
-            FemObject::Beam(b) => generalized_modes(b),
-            FemObject::Chain(c) => c.modes(),
+            FemObject::Beam(b) => memoized(b.as_ref(), || generalized_modes(b)),
+            FemObject::Chain(c) => memoized(c.as_ref(), || c.modes()),
             FemObject::Plate { modes, checked, .. } => {
                 let all = modes.generalized_modes()?;
                 // The checked modes' acoustic columns first, in the continuum's order,
@@ -297,6 +347,49 @@ impl FemObject {
 mod tests {
     use super::*;
     use crate::spectral::membrane::{MembraneBoundary, MembraneParams};
+
+    /// The memoized dense modes are those of a fresh decomposition, bit for bit, for
+    /// every object asked in turn (beams that differ only in rigidity, only in drag,
+    /// only in their ends; a chain), whether the object is new to the memo or was just
+    /// asked: a key missing any of the object's state would hand one object another's
+    /// modes.
+    #[test]
+    fn memoized_modes_are_the_objects_own() {
+        use crate::params::{Ends, FilamentParams};
+        let p = FilamentParams::default();
+        let beam = |p: FilamentParams, ends: Ends| {
+            let mesh = crate::fem::mesh::Mesh::uniform(p.length, 60).unwrap();
+            FemObject::Beam(Box::new(BeamModel::with_ends(p, mesh, ends).unwrap()))
+        };
+        let stiffer = FilamentParams {
+            bending_rigidity: 2.0 * p.bending_rigidity,
+            ..p
+        };
+        let draggier = FilamentParams {
+            drag: 3.0 * p.drag,
+            ..p
+        };
+        let objects = [
+            beam(p, Ends::default()),
+            beam(stiffer, Ends::default()),
+            beam(draggier, Ends::default()),
+            beam(p, "clamped-clamped".parse().unwrap()),
+            FemObject::Chain(Box::new(ChainModel::new(p, 150).unwrap())),
+        ];
+        for obj in objects.iter().chain(objects.iter().rev()) {
+            assert!(obj.system().n_dofs() >= MEMO_MIN_DOFS);
+            let fresh = match obj {
+                FemObject::Beam(b) => generalized_modes(b).unwrap(),
+                FemObject::Chain(c) => c.modes().unwrap(),
+                FemObject::Plate { .. } => unreachable!(),
+            };
+            for _ in 0..2 {
+                let got = obj.modes().unwrap();
+                assert_eq!(got.rates, fresh.rates);
+                assert_eq!(got.vectors, fresh.vectors);
+            }
+        }
+    }
 
     /// The membrane's continuum on its midline is the membrane's own (M3)–(M4) at y = b/2,
     /// its checked modes slowest first.
