@@ -1298,3 +1298,48 @@ fn fit_recovers_the_parameters_with_intervals() {
     let o = run(&args);
     assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
 }
+
+/// What: `check` shows progress on stderr while it prepares references that take
+/// seconds, weighted by each run's projected set-up (`0.1 n³` DOF-steps for a beam of n
+/// unknowns, a tenth of that for a run on a discretization already decomposed): two runs
+/// declaring 500 elements project 0.1·1000³·(1 + 0.1) = 1.1e8 DOF-steps. Nothing with
+/// `-q`, and nothing for data whose references take no time (10 elements).
+#[test]
+fn check_shows_progress_over_a_long_preparation() {
+    let dir = TempDir::new("run-check-progress");
+    let (data, out) = (dir.join_str("data"), dir.join_str("out"));
+    let side = run_fixture("hinged-linear-2d", "4", &data);
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", "-s", "hinged-linear-2d", "-d", &data, "-o", &out];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(
+            matches!(o.status.code(), Some(0 | 1)),
+            "{}",
+            describe(&args, &o)
+        );
+        stderr_of(&o)
+    };
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    let runs = v["runs"].as_array_mut().unwrap();
+    runs.retain(|r| r["discretization"]["integrator"] == "crank-nicolson");
+    assert_eq!(runs.len(), 2, "{runs:?}");
+    std::fs::write(&side, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let small = check(&[]);
+    assert!(!small.contains("progress:"), "{small}");
+    for r in v["runs"].as_array_mut().unwrap() {
+        r["discretization"]["elements"] = serde_json::json!(500);
+    }
+    std::fs::write(&side, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let large = check(&[]);
+    let first = large.lines().find(|l| l.starts_with("progress:"));
+    let first = first.unwrap_or_else(|| panic!("no progress line: {large}"));
+    assert!(
+        first.contains("hinged-linear-2d/") && first.contains("(references)"),
+        "{first}"
+    );
+    assert!(first.contains("of 1.1e8 DOF-steps"), "{first}");
+    let quiet = check(&["-q"]);
+    assert!(!quiet.contains("progress:"), "{quiet}");
+}

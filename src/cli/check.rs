@@ -7,6 +7,7 @@ use clap::Args;
 use langevin_fem::data::DataSidecar;
 use langevin_fem::error::{Error, Result};
 use langevin_fem::output::ReportRun;
+use langevin_fem::progress::ProgressOptions;
 use langevin_fem::report::write_report;
 use langevin_fem::scene::Scene;
 use langevin_fem::verify::check_data;
@@ -59,7 +60,7 @@ pub struct CheckArgs {
 pub fn run(args: CheckArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
     let sidecar = load_data(&args)?;
-    let (_, summary, report) = evaluate(&args, &sidecar)?;
+    let (_, summary, report) = evaluate(&args, &sidecar, verbosity.progress())?;
     write_report(report, &summary)?;
     print_verdict(&args, &summary, verbosity, start, &[]);
     Ok(if summary.passed { 0 } else { 1 })
@@ -114,13 +115,15 @@ pub(super) fn load_data(args: &CheckArgs) -> Result<DataSidecar> {
 }
 
 /// The checks of `args` on the data `sidecar` describes (from [`load_data`]): the scene,
-/// the summary and the report (its files written, its index and summary not yet).
+/// the summary and the report (its files written, its index and summary not yet), with
+/// `progress` over a long preparation of the references.
 ///
 /// # Errors
 /// An invalid scene or data; the checks' errors (as [`check_data`]).
 pub(super) fn evaluate(
     args: &CheckArgs,
     sidecar: &DataSidecar,
+    progress: ProgressOptions,
 ) -> Result<(Scene, Summary, ReportRun)> {
     let scene = langevin_fem::scene::load_scene(&args.scene, args.scene_dir.as_deref())?;
     let (summary, report) = check_data(
@@ -130,6 +133,7 @@ pub(super) fn evaluate(
         &args.out,
         args.alpha,
         super::gib_bytes(args.max_memory_gib),
+        progress,
     )?;
     Ok((scene, summary, report))
 }

@@ -52,7 +52,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             "filament data (a `filament` table in data.json): fit estimates EI and xi of a filament",
         ));
     };
-    let (scene, mut summary, report) = evaluate(&args, &sidecar)?;
+    let (scene, mut summary, report) = evaluate(&args, &sidecar, verbosity.progress())?;
     if scene.compression.is_some() {
         return Err(Error::invalid(
             "--scene",

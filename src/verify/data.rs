@@ -1142,12 +1142,7 @@ fn discrete_run(
     {
         return Err(key_err(&key, format!("must be {allowed}, got {value}")));
     }
-    let mut scene = scene.clone();
-    scene.model = model;
-    scene.mesh.scheme = scheme;
-    scene.mesh.elements = elements;
-    scene.mesh.elements_y = d.elements_y.filter(|_| scene.is_membrane());
-    scene.mesh.grading = 1.0;
+    let scene = discretized(scene, (model, scheme), elements, d.elements_y);
     let spec = RunSpec {
         integrator,
         noise,
@@ -1162,6 +1157,44 @@ fn discrete_run(
             Error::InvalidParameter { .. } => key_err("discretization", e.to_string()),
             other => other,
         })
+}
+
+/// `scene` on the producer's discretization: its model and mesh scheme, `elements` (and
+/// `elements_y` for a membrane) on a uniform mesh.
+fn discretized(
+    scene: &Scene,
+    (model, scheme): (ModelKind, MeshScheme),
+    elements: usize,
+    elements_y: Option<usize>,
+) -> Scene {
+    let mut scene = scene.clone();
+    scene.model = model;
+    scene.mesh.scheme = scheme;
+    scene.mesh.elements = elements;
+    scene.mesh.elements_y = elements_y.filter(|_| scene.is_membrane());
+    scene.mesh.grading = 1.0;
+    scene
+}
+
+/// The projected set-up of linear data run `data`'s exact discrete references on
+/// `scene`, in DOF-steps ([`Scene::setup_cost`] of the producer's finite-element
+/// discretization, O(n³)); 0 for continuum or spectral references. What `check`'s
+/// progress is weighted by.
+pub fn data_setup_cost(scene: &Scene, data: &DataRun) -> f64 {
+    let Some(d) = &data.discretization else {
+        return 0.0;
+    };
+    let scheme = match d.model.as_str() {
+        "fem" => MeshScheme::Hermite,
+        _ if d.is_chain() => MeshScheme::Chain,
+        _ => return 0.0,
+    };
+    match d.elements {
+        Some(elements) => {
+            discretized(scene, (ModelKind::Fem, scheme), elements, d.elements_y).setup_cost()
+        }
+        None => 0.0,
+    }
 }
 
 /// Whether the modelled discretization `(model, scheme, elements, dt/τ₁)` of data run `data`

@@ -1386,15 +1386,14 @@ pub fn check_data(
     out: &Path,
     alpha: f64,
     max_bytes: u64,
+    progress: ProgressOptions,
 ) -> Result<(Summary, ReportRun)> {
     crate::verify::data::check_data_kind(scene, sidecar, data_dir)?;
     crate::verify::data::require_data_size(sidecar, data_dir, max_bytes)?;
     if scene.compression.is_some() {
         return check_compression_data(scene, sidecar, data_dir, out, alpha, max_bytes);
     }
-    let prepared = (0..sidecar.runs.len())
-        .map(|k| crate::verify::data::prepare_data_check(scene, sidecar, data_dir, k, max_bytes))
-        .collect::<Result<Vec<_>>>()?;
+    let prepared = prepare_data_checks(scene, sidecar, data_dir, max_bytes, progress)?;
     let report = begin_check(scene, out)?;
     let start = Instant::now();
     let dir = out.join(&scene.name);
@@ -1518,6 +1517,64 @@ fn finish_check(
 /// of the scene (and the distribution of F, against the producer's discretization)
 /// with the force checks of `verify`, `<run>-force-strain.csv` and the scene's
 /// force–strain figure.
+/// Least projected set-up, in DOF-steps (about 2 s), that `check` shows progress for.
+const CHECK_PROGRESS_MIN_WORK: f64 = 1e8;
+
+/// The linear data runs of `sidecar` read and their references prepared, in order
+/// ([`crate::verify::data::prepare_data_check`]), with progress on stderr weighted by
+/// each run's projected set-up when the whole takes seconds (a large mesh's exact
+/// references cost O(n³): 1000 elements, about 20 s a run).
+fn prepare_data_checks(
+    scene: &Scene,
+    sidecar: &crate::data::DataSidecar,
+    data_dir: &Path,
+    max_bytes: u64,
+    progress: ProgressOptions,
+) -> Result<Vec<crate::verify::data::DataCheck>> {
+    // A discretization decomposed for an earlier run costs a tenth: its modes are kept
+    // (the last two; see `FemObject::modes`), only its discrete law is new.
+    let mut recent: Vec<(String, Option<usize>, Option<usize>)> = Vec::new();
+    let weights: Vec<f64> = sidecar
+        .runs
+        .iter()
+        .map(|r| {
+            let cost = crate::verify::data::data_setup_cost(scene, r);
+            let Some(d) = &r.discretization else {
+                return cost;
+            };
+            let key = (d.model.clone(), d.elements, d.elements_y);
+            if recent.contains(&key) {
+                return 0.1 * cost;
+            }
+            recent.push(key);
+            if recent.len() > 2 {
+                recent.remove(0);
+            }
+            cost
+        })
+        .collect();
+    let total: f64 = weights.iter().sum();
+    let bar = if total >= CHECK_PROGRESS_MIN_WORK {
+        Progress::new(progress, total, "DOF-steps")
+    } else {
+        Progress::hidden()
+    };
+    let prepared = weights
+        .iter()
+        .enumerate()
+        .map(|(k, &w)| {
+            let label = format!("{}/{} (references)", scene.name, sidecar.runs[k].name);
+            bar.begin_run(&scene.name, &label, w);
+            let check =
+                crate::verify::data::prepare_data_check(scene, sidecar, data_dir, k, max_bytes);
+            bar.advance(w);
+            check
+        })
+        .collect();
+    bar.finish();
+    prepared
+}
+
 fn check_compression_data(
     scene: &Scene,
     sidecar: &crate::data::DataSidecar,
