@@ -383,8 +383,9 @@ fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// answer in valid but too short data) and one refused (exit 2: `--out` holding the
 /// data) leave an earlier report in `--out`, and the data, byte for byte (issue #25:
 /// the run's files wait in a staging folder until it succeeds).
-/// Set-up: a passing check of 8 trajectories × 40 τ1, then data of 2 trajectories × 5 τ1
-/// (too few samples for the mode-distribution check's bins). Tolerance: exact bytes.
+/// Set-up: a passing check of 8 trajectories × 40 τ1, then compression data of 2
+/// trajectories × 2 τ1 checked into the same `--out` (33 samples of the force: too
+/// short for its integrated autocorrelation time). Tolerance: exact bytes.
 #[test]
 fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
     let dir = TempDir::new("run-check-failed");
@@ -398,19 +399,26 @@ fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
         "run",
         "-q",
         "--scene",
-        "hinged-linear-2d",
-        "--run",
-        "crank-nicolson",
+        "compression-2d",
         "--trajectories",
         "2",
         "--duration-tau1",
-        "5",
+        "2",
         "--out",
         &short,
     ];
     let o = run(&args);
     assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
-    let (o, args) = check(&short, &report);
+    let args = [
+        "check",
+        "--scene",
+        "compression-2d",
+        "--data",
+        &short,
+        "--out",
+        &report,
+    ];
+    let o = run(&args);
     assert_eq!(o.status.code(), Some(3), "{}", describe(&args, &o));
     assert_eq!(tree_bytes(Path::new(&report)), before, "after exit 3");
     let data = tree_bytes(Path::new(&good));
@@ -1342,4 +1350,56 @@ fn check_shows_progress_over_a_long_preparation() {
     assert!(first.contains("of 1.1e8 DOF-steps"), "{first}");
     let quiet = check(&["-q"]);
     assert!(!quiet.contains("progress:"), "{quiet}");
+}
+
+/// What: a scene's own data of one trajectory (what `run --trajectories 1` writes) are
+/// checked, not aborted: the checks their size cannot serve are skipped with the reason
+/// — the χ² goodness of fit of a mode (fewer thinned samples than 4 bins of 5), the
+/// two-time correlations (one value per point) — and the rest are reported (exit 0, a
+/// report). They aborted the whole check with exit 3 and no report: the tool chose 4
+/// bins and then refused its own choice.
+#[test]
+fn one_trajectory_of_data_skips_what_it_cannot_serve() {
+    let dir = TempDir::new("run-check-one");
+    let (data, out) = (dir.join_str("data"), dir.join_str("out"));
+    run_fixture("hinged-linear-2d", "1", &data);
+    let args = [
+        "check",
+        "-q",
+        "-s",
+        "hinged-linear-2d",
+        "-d",
+        &data,
+        "-o",
+        &out,
+    ];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    let summary = json(&Path::new(&out).join("summary.json"));
+    let scene = &summary["scenes"][0];
+    let skipped = scene["skipped"].as_array().unwrap();
+    let reason = |kind: &str| {
+        skipped
+            .iter()
+            .find(|s| s["name"].as_str().unwrap().contains(kind))
+            .map(|s| s["reason"].as_str().unwrap().to_string())
+            .unwrap_or_else(|| panic!("no skipped {kind}: {skipped:?}"))
+    };
+    assert!(
+        reason("/mode-chi2-gof/").contains("needs at least 20 thinned samples"),
+        "{skipped:?}"
+    );
+    assert!(
+        reason("/two-time/").contains("needs at least 2 independent values"),
+        "{skipped:?}"
+    );
+    let checks = scene["checks"].as_array().unwrap();
+    for kind in ["/mode-ks/", "/mode-variance/"] {
+        assert!(
+            checks
+                .iter()
+                .any(|c| c["name"].as_str().unwrap().contains(kind)),
+            "no {kind} check: {checks:?}"
+        );
+    }
 }

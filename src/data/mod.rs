@@ -819,8 +819,13 @@ impl DataRun {
             return Err((
                 key("name"),
                 format!(
-                    "must be 1 to 64 letters, digits, '-' or '_' (it names files), got {:?}",
-                    self.name
+                    "must be 1 to {} letters, digits, '-' or '_' (it names files), got {}",
+                    crate::scene::validate::MAX_NAME_LEN,
+                    match self.name.chars().count() {
+                        n if n > crate::scene::validate::MAX_NAME_LEN =>
+                            format!("a name of {n} characters"),
+                        _ => format!("{:?}", self.name),
+                    }
                 ),
             ));
         }
@@ -985,6 +990,28 @@ mod tests {
             .discretization
             .clone();
         assert_eq!(d.unwrap().noise, None);
+    }
+
+    /// A run name names files: 1 to 64 characters of `[A-Za-z0-9_-]`, as a scene's run
+    /// names (a longer one would exceed a file system's 255 bytes with its suffixes).
+    #[test]
+    fn run_names_are_path_names_of_at_most_64_characters() {
+        let name = |n: usize| format!("\"name\": \"{}\"", "x".repeat(n));
+        assert!(load("name64", &VALID.replacen("\"name\": \"cn\"", &name(64), 1)).is_ok());
+        refused_with(
+            "\"name\": \"cn\"",
+            &name(65),
+            &[
+                "`runs[0].name`",
+                "1 to 64 letters",
+                "a name of 65 characters",
+            ],
+        );
+        refused_with(
+            "\"name\": \"cn\"",
+            "\"name\": \"../cn\"",
+            &["`runs[0].name`", "\"../cn\""],
+        );
     }
 
     /// Non-finite literals and nulls at numeric keys, named with their keys.

@@ -188,10 +188,12 @@ fn bad(scene: &Scene, key: &str, value: &dyn Display, allowed: &str) -> Error {
     }
 }
 
-/// Whether `name` is safe as one path component of the outputs: non-empty and made of
-/// `[A-Za-z0-9_-]` only (so no `/`, `..` or hidden file).
+/// Whether `name` is safe as one path component of the outputs: 1 to [`MAX_NAME_LEN`]
+/// characters of `[A-Za-z0-9_-]` only (so no `/`, `..` or hidden file, and room for the
+/// suffixes of the file names it prefixes within a file system's 255 bytes).
 pub fn is_path_name(name: &str) -> bool {
     !name.is_empty()
+        && name.len() <= MAX_NAME_LEN
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
@@ -1546,6 +1548,8 @@ full = { trajectories = 4, duration_tau1 = 10.0 }
         for bad in ["", ".", "..", "../x", "a/b", "a b", "a.b", "é"] {
             assert!(!is_path_name(bad), "{bad}");
         }
+        assert!(is_path_name(&"x".repeat(MAX_NAME_LEN)));
+        assert!(!is_path_name(&"x".repeat(MAX_NAME_LEN + 1)));
     }
 
     #[test]

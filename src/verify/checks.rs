@@ -592,6 +592,19 @@ fn mode_distribution_check(ctx: &mut LinearContext<'_>, m: &mut ModeData<'_>) ->
         ),
     ));
     let bins = stats::gof_bins(thinned.len());
+    // Data too short for the fewest bins (4, each expecting 5 samples): the χ² is
+    // skipped, noted, and the KS above stands (`verify` refuses such budgets up front).
+    if thinned.len() < 5 * bins {
+        ctx.est.skipped.push(SkippedCheck {
+            name: format!("{prefix}/mode-chi2-gof/n={}", mr.n),
+            reason: format!(
+                "needs at least {} thinned samples ({bins} equiprobable bins expecting 5 each), the data have {}",
+                5 * bins,
+                thinned.len()
+            ),
+        });
+        return Ok(());
+    }
     let o = stats::chi2_gof_normal(thinned, 0.0, sd, bins)?;
     ctx.out.push(check(
         format!("{prefix}/mode-chi2-gof/n={}", mr.n),
@@ -698,6 +711,22 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
             .iter()
             .flat_map(|t| (0..c).map(move |k| t[k * nt + j]))
             .collect();
+        let name = format!(
+            "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
+            q.x, q.y, q.t, q.eta
+        );
+        // One trajectory's value has no ensemble mean to report (`verify` refuses such
+        // budgets up front): skipped, noted.
+        if values.len() < 2 {
+            ctx.est.skipped.push(SkippedCheck {
+                name,
+                reason: format!(
+                    "needs at least 2 independent values (trajectories x components), the data have {}",
+                    values.len()
+                ),
+            });
+            continue;
+        }
         let m = stats::ensemble_mean(&values)?;
         // At one point and one time the products are squares of a zero-mean normal
         // deflection: n·mean/reference is exactly χ²(n). A t-test on such skewed values
@@ -729,10 +758,7 @@ fn two_time_check(ctx: &mut LinearContext<'_>) -> Result<()> {
         // χ² and the quadratic-form tests, from the spread over the samples for the t-test.
         ctx.est.two_time.push((m.mean, se));
         ctx.out.push(check(
-            format!(
-                "{prefix}/two-time/x={:.3},y={:.3},t={:.4e},eta={:.4e}",
-                q.x, q.y, q.t, q.eta
-            ),
+            name,
             kind,
             (m.mean, q.discrete, se),
             &o,

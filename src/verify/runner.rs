@@ -1513,10 +1513,6 @@ fn finish_check(
     })
 }
 
-/// [`check_data`] of a compression scene: per run name of the data, ⟨F⟩ at every strain
-/// of the scene (and the distribution of F, against the producer's discretization)
-/// with the force checks of `verify`, `<run>-force-strain.csv` and the scene's
-/// force–strain figure.
 /// Least projected set-up, in DOF-steps (about 2 s), that `check` shows progress for.
 const CHECK_PROGRESS_MIN_WORK: f64 = 1e8;
 
@@ -1531,8 +1527,8 @@ fn prepare_data_checks(
     max_bytes: u64,
     progress: ProgressOptions,
 ) -> Result<Vec<crate::verify::data::DataCheck>> {
-    // A discretization decomposed for an earlier run costs a tenth: its modes are kept
-    // (the last two; see `FemObject::modes`), only its discrete law is new.
+    // A beam's discretization decomposed for an earlier run costs a tenth: its modes are
+    // kept (the last two; see `FemObject::modes`), only its discrete law is new.
     let mut recent: Vec<(String, Option<usize>, Option<usize>)> = Vec::new();
     let weights: Vec<f64> = sidecar
         .runs
@@ -1543,7 +1539,7 @@ fn prepare_data_checks(
                 return cost;
             };
             let key = (d.model.clone(), d.elements, d.elements_y);
-            if recent.contains(&key) {
+            if !scene.is_membrane() && recent.contains(&key) {
                 return 0.1 * cost;
             }
             recent.push(key);
@@ -1575,6 +1571,10 @@ fn prepare_data_checks(
     prepared
 }
 
+/// [`check_data`] of a compression scene: per run name of the data, ⟨F⟩ at every strain
+/// of the scene (and the distribution of F, against the producer's discretization)
+/// with the force checks of `verify`, `<run>-force-strain.csv` and the scene's
+/// force–strain figure.
 fn check_compression_data(
     scene: &Scene,
     sidecar: &crate::data::DataSidecar,
