@@ -615,6 +615,46 @@ fn unwritable_out_is_refused_before_running() {
     }
 }
 
+/// What: an `--out` that is a symbolic link leading nowhere (dangling, or a loop of
+/// links), or a path below one, is refused before anything runs: exit 2 naming `--out`,
+/// the link and the cause; the link is left as it was. It failed with exit 3 "File
+/// exists (os error 17)". Tolerance: exact substrings.
+#[cfg(unix)]
+#[test]
+fn out_through_a_link_to_nowhere_is_refused() {
+    let dir = TempDir::new("out-link");
+    let dangling = dir.path().join("dangling");
+    std::os::unix::fs::symlink(dir.path().join("nowhere"), &dangling).unwrap();
+    let looped = dir.path().join("loop");
+    std::os::unix::fs::symlink(&looped, &looped).unwrap();
+    let below = dangling.join("reports");
+    for (out, link) in [
+        (&dangling, &dangling),
+        (&looped, &looped),
+        (&below, &dangling),
+    ] {
+        for cmd in ["verify", "run"] {
+            let args = [
+                cmd,
+                "--scene",
+                "hinged-linear-2d",
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            let o = run(&args);
+            assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+            let err = stderr_of(&o);
+            assert!(
+                err.contains("--out")
+                    && err.contains(&link.display().to_string())
+                    && err.contains("symbolic link that leads to no file or directory"),
+                "{err}"
+            );
+            assert!(std::fs::symlink_metadata(link).unwrap().is_symlink());
+        }
+    }
+}
+
 /// What: a negative value after a space (`--bending-rigidity -1`, the usual spelling) must
 /// be reported like `--bending-rigidity=-1`: exit 2 naming the flag and its range.
 /// Today clap takes `-1` for a flag ("unexpected argument '-1' found"): the exit code

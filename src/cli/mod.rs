@@ -258,6 +258,13 @@ fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<Option<Outp
     };
     let mut existing = out;
     while !existing.as_os_str().is_empty() && !existing.exists() {
+        // A path that is there but leads nowhere: a dangling symbolic link, or a loop.
+        if std::fs::symlink_metadata(existing).is_ok() {
+            return Err(fail(format!(
+                "{} is a symbolic link that leads to no file or directory (dangling, or a loop): remove it, point it at a directory, or give another --out",
+                existing.display()
+            )));
+        }
         existing = existing.parent().unwrap_or(Path::new(""));
     }
     let existing = if existing.as_os_str().is_empty() {
