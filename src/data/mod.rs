@@ -71,7 +71,7 @@
 //!   that the checks use and is larger than 1e100 in magnitude in their units (its
 //!   squares would overflow: no physical value is near it); a column `t` off the
 //!   cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at 0; a `.npy`
-//!   header whose shape does not match the file's size.
+//!   header whose shape does not match the file's size, or that gives a key twice.
 
 mod npy;
 mod table;

@@ -170,9 +170,17 @@ pub(super) fn parse_npy(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<
 /// header; on failure, why.
 fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), String> {
     let field = |name: &str| -> std::result::Result<&str, String> {
+        let key = format!("'{name}'");
         let at = header
-            .find(&format!("'{name}'"))
+            .find(&key)
             .ok_or(format!("no '{name}' in the header"))?;
+        // NumPy's parser keeps the last of a repeated key, this one would read the first:
+        // the file's meaning would depend on the reader.
+        if header[at + key.len()..].contains(&key) {
+            return Err(format!(
+                "the header gives '{name}' twice (NumPy would read the last, so what the file holds is ambiguous): write each key once"
+            ));
+        }
         let rest = &header[at + name.len() + 2..];
         let colon = rest.find(':').ok_or("malformed header")?;
         Ok(rest[colon + 1..].trim_start())
@@ -369,5 +377,26 @@ mod tests {
         bytes.extend(1.5f64.to_be_bytes());
         bytes.extend((-2.0f64).to_be_bytes());
         assert_eq!(parse_npy(&bytes).unwrap(), (2, 1, vec![1.5, -2.0]));
+    }
+
+    /// A header that gives a key twice is refused, naming the key: NumPy reads the last
+    /// value (here float32), a first-match reader the first (float64). Once, it is read.
+    #[test]
+    fn a_repeated_header_key_is_refused() {
+        let file = |dict: &str| {
+            let pad = 64 - (10 + dict.len() + 1) % 64;
+            let header = format!("{dict}{}\n", " ".repeat(pad));
+            let mut bytes = MAGIC.to_vec();
+            bytes.extend([1, 0]);
+            bytes.extend((header.len() as u16).to_le_bytes());
+            bytes.extend(header.as_bytes());
+            bytes.extend(1.5f64.to_le_bytes());
+            bytes
+        };
+        let twice = "{'descr': '<f8', 'descr': '<f4', 'fortran_order': False, 'shape': (1,), }";
+        let err = parse_npy(&file(twice)).unwrap_err();
+        assert!(err.contains("'descr' twice"), "{err}");
+        let once = "{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }";
+        assert_eq!(parse_npy(&file(once)).unwrap(), (1, 1, vec![1.5]));
     }
 }
