@@ -698,14 +698,15 @@ impl ShardSet {
     /// [`Error::InvalidParameter`] naming a flag, e.g. `--trajectories`), as a refusal
     /// of this set naming the first manifest's `settings` (exit 2): the flags were checked
     /// when the shards ran, so a value out of range here is a damaged or edited manifest.
-    /// Other errors are returned as they are.
+    /// Other errors are returned as they are, and so is one naming `--out`: the merge's
+    /// own output directory (`merge -o`), not the shards'.
     pub fn settings_error(&self, e: Error) -> Error {
         match e {
             Error::InvalidParameter {
                 name,
                 value,
                 allowed,
-            } if name.starts_with("--") => self.refuse(
+            } if name.starts_with("--") && name != "--out" => self.refuse(
                 &settings_key(&name),
                 format!(
                     "the shards ran with {name} = {value}, but {name} must be {allowed}: a damaged or edited manifest; rerun the shards"

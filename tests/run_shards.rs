@@ -346,6 +346,37 @@ fn run_merge_refuses_missing_duplicated_and_foreign_shards() {
     );
 }
 
+/// What: `merge -o DIR` where DIR holds another command's report is refused naming
+/// `--out` (the merge's own), not the shards' manifest: the shards never ran with that
+/// directory. It named `shard.json`'s `settings.out` and called the manifest damaged.
+/// Reference: exit 2; the message names `--out`, the directory and the report's command.
+#[test]
+fn merge_into_another_commands_report_names_its_own_out() {
+    let tmp = TempDir::new("run-shards-out");
+    let dirs = shards(LINEAR, &tmp.join("set"), 2, &[]);
+    let report = tmp.join("report");
+    let o = common::run(&[
+        "verify",
+        "-q",
+        "-s",
+        fixture(LINEAR).to_str().unwrap(),
+        "-o",
+        report.to_str().unwrap(),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr_of(&o));
+    let o = merge(&dirs, &report);
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--out") && err.contains(report.to_str().unwrap()) && err.contains("`verify`"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("settings.out") && !err.contains("damaged"),
+        "{err}"
+    );
+}
+
 /// What: `run --shard` outside 1 ≤ I ≤ N is refused before anything runs.
 /// Reference: exit 2 naming the flag and the rule; nothing written.
 #[test]
