@@ -618,7 +618,8 @@ fn unwritable_out_is_refused_before_running() {
 /// What: an `--out` that is a symbolic link leading nowhere (dangling, or a loop of
 /// links), or a path below one, is refused before anything runs: exit 2 naming `--out`,
 /// the link and the cause; the link is left as it was. It failed with exit 3 "File
-/// exists (os error 17)". Tolerance: exact substrings.
+/// exists (os error 17)". A `--scene` file that is such a link is named as one.
+/// Tolerance: exact substrings.
 #[cfg(unix)]
 #[test]
 fn out_through_a_link_to_nowhere_is_refused() {
@@ -653,6 +654,17 @@ fn out_through_a_link_to_nowhere_is_refused() {
             assert!(std::fs::symlink_metadata(link).unwrap().is_symlink());
         }
     }
+    // A scene file that is such a link is named as one (it read "there is no file").
+    let scene = dir.path().join("scene.toml");
+    std::os::unix::fs::symlink(&scene, &scene).unwrap();
+    let args = ["verify", "--scene", scene.to_str().unwrap()];
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
+    let err = stderr_of(&o);
+    assert!(
+        err.contains("--scene") && err.contains("is a symbolic link that leads to no file"),
+        "{err}"
+    );
 }
 
 /// What: a negative value after a space (`--bending-rigidity -1`, the usual spelling) must

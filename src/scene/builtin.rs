@@ -201,12 +201,20 @@ pub fn resolve(name_or_path: &str, scene_dir: Option<&Path>) -> Result<SceneSour
         if path.exists() {
             return Ok(SceneSource::File(path));
         }
+        // There, but leading nowhere: a dangling symbolic link or a loop of links.
+        let why = if std::fs::symlink_metadata(&path).is_ok() {
+            format!(
+                "{} is a symbolic link that leads to no file (dangling, or a loop)",
+                path.display()
+            )
+        } else {
+            format!("there is no file {}", path.display())
+        };
         return Err(Error::invalid(
             "--scene",
             name_or_path,
             format!(
-                "an existing scene file (there is no file {}) or a scene name, one of: {}",
-                path.display(),
+                "an existing scene file ({why}) or a scene name, one of: {}",
                 available(scene_dir)?
             ),
         ));
