@@ -1134,7 +1134,7 @@ fn theory_membrane_finite_elements() {
     let got = num(&em["discrete"], "variance_ratio_to_equipartition");
     assert!((got / want - 1.0).abs() < 1e-9, "{got} vs {want}");
     let limit = format!("{:e}", 2.0 / num(&f, "max_rate"));
-    for (extra, needle) in [
+    for (extra, needles) in [
         (
             vec![
                 "--tension",
@@ -1146,7 +1146,7 @@ fn theory_membrane_finite_elements() {
                 "--integrator",
                 "euler-maruyama",
             ],
-            "--dt must be <",
+            &["--dt must be <"][..],
         ),
         (
             vec![
@@ -1157,30 +1157,19 @@ fn theory_membrane_finite_elements() {
                 "--integrator",
                 "crank-nicolson",
             ],
-            "--dt must be < ",
-        ),
-        (
-            vec![
-                "--elements",
-                "8",
-                "--dt",
-                "1e20",
-                "--integrator",
-                "crank-nicolson",
-            ],
-            "multiplier rounds to -1 in f64",
+            &["--dt must be < ", "multiplier rounds to -1 in f64"][..],
         ),
         (
             vec!["--elements", "2", "--m", "3"],
-            "--m/--n must be a mode the 2 x 2 mesh",
+            &["--m/--n must be a mode the 2 x 2 mesh"][..],
         ),
         (
             vec!["--elements", "65"],
-            "--elements must be in [1, 64], got 65",
+            &["--elements must be in [1, 64], got 65"][..],
         ),
         (
             vec!["--elements", "4", "--dt", "1e-3", "--noise", "white"],
-            "--noise must be",
+            &["--noise must be"][..],
         ),
     ] {
         let full: Vec<&str> = ["theory", "membrane"]
@@ -1191,6 +1180,9 @@ fn theory_membrane_finite_elements() {
         let o = run(&full);
         assert_no_panic(&full, &o);
         assert_eq!(o.status.code(), Some(2), "{}", describe(&full, &o));
-        assert!(stderr_of(&o).contains(needle), "{}", describe(&full, &o));
+        let err = stderr_of(&o);
+        for needle in needles {
+            assert!(err.contains(needle), "{}", describe(&full, &o));
+        }
     }
 }

@@ -1328,8 +1328,7 @@ fn check_shows_progress_over_a_long_preparation() {
         );
         stderr_of(&o)
     };
-    let mut v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    let mut v = json(&side);
     let runs = v["runs"].as_array_mut().unwrap();
     runs.retain(|r| r["discretization"]["integrator"] == "crank-nicolson");
     assert_eq!(runs.len(), 2, "{runs:?}");

@@ -364,18 +364,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn reads_one_dimension_and_big_endian() {
-        // A 1-D big-endian array as NumPy writes it: np.array([1.5, -2.0], dtype='>f8').
-        let dict = "{'descr': '>f8', 'fortran_order': False, 'shape': (2,), }";
+    /// A version-1 `.npy` file of header dictionary `dict` (padded as NumPy pads it) and
+    /// data bytes `data`.
+    fn npy_file(dict: &str, data: &[u8]) -> Vec<u8> {
         let pad = 64 - (10 + dict.len() + 1) % 64;
         let header = format!("{dict}{}\n", " ".repeat(pad));
         let mut bytes = MAGIC.to_vec();
         bytes.extend([1, 0]);
         bytes.extend((header.len() as u16).to_le_bytes());
         bytes.extend(header.as_bytes());
-        bytes.extend(1.5f64.to_be_bytes());
-        bytes.extend((-2.0f64).to_be_bytes());
+        bytes.extend(data);
+        bytes
+    }
+
+    #[test]
+    fn reads_one_dimension_and_big_endian() {
+        // A 1-D big-endian array as NumPy writes it: np.array([1.5, -2.0], dtype='>f8').
+        let dict = "{'descr': '>f8', 'fortran_order': False, 'shape': (2,), }";
+        let data = [1.5f64.to_be_bytes(), (-2.0f64).to_be_bytes()].concat();
+        let bytes = npy_file(dict, &data);
         assert_eq!(parse_npy(&bytes).unwrap(), (2, 1, vec![1.5, -2.0]));
     }
 
@@ -383,16 +390,7 @@ mod tests {
     /// value (here float32), a first-match reader the first (float64). Once, it is read.
     #[test]
     fn a_repeated_header_key_is_refused() {
-        let file = |dict: &str| {
-            let pad = 64 - (10 + dict.len() + 1) % 64;
-            let header = format!("{dict}{}\n", " ".repeat(pad));
-            let mut bytes = MAGIC.to_vec();
-            bytes.extend([1, 0]);
-            bytes.extend((header.len() as u16).to_le_bytes());
-            bytes.extend(header.as_bytes());
-            bytes.extend(1.5f64.to_le_bytes());
-            bytes
-        };
+        let file = |dict: &str| npy_file(dict, &1.5f64.to_le_bytes());
         let twice = "{'descr': '<f8', 'descr': '<f4', 'fortran_order': False, 'shape': (1,), }";
         let err = parse_npy(&file(twice)).unwrap_err();
         assert!(err.contains("'descr' twice"), "{err}");

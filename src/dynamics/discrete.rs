@@ -105,23 +105,20 @@ impl DiscreteLaw {
         // `m_i m_j` is symmetric in (i, j) exactly, and so is its power: one `powf` per
         // pair, and one per mode for the decay `m_i^{es−ts}`.
         let decay: Vec<f64> = m.iter().map(|mi| mi.powf((es - ts) as f64)).collect();
-        // The transients 1 − (m_i m_j)^ts first, then each entry scaled in place.
         let mut st = DMatrix::zeros(n, n);
         for j in 0..n {
             for i in j..n {
                 let mm = m[i] * m[j];
-                st[(i, j)] = if mm == 1.0 {
+                let transient = if mm == 1.0 {
                     0.0
                 } else {
                     1.0 - mm.powf(ts as f64)
                 };
-                st[(j, i)] = st[(i, j)];
-            }
-        }
-        for j in 0..n {
-            for i in 0..n {
-                let mm = m[i] * m[j];
-                st[(i, j)] = g[i] * g[j] * sigma_q[(i, j)] * st[(i, j)] / (1.0 - mm) * decay[i];
+                let entry = |r: usize, c: usize| {
+                    g[r] * g[c] * sigma_q[(r, c)] * transient / (1.0 - mm) * decay[r]
+                };
+                st[(i, j)] = entry(i, j);
+                st[(j, i)] = entry(j, i);
             }
         }
         (ay.transpose() * &st * ax)[(0, 0)]

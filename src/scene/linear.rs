@@ -36,6 +36,7 @@ mod stream;
 
 pub(crate) use object::Continuum;
 pub(crate) use object::FemObject;
+pub(crate) use object::MEMO_ENTRIES;
 
 pub use stream::RowPlan;
 

@@ -1528,7 +1528,7 @@ fn prepare_data_checks(
     progress: ProgressOptions,
 ) -> Result<Vec<crate::verify::data::DataCheck>> {
     // A beam's discretization decomposed for an earlier run costs a tenth: its modes are
-    // kept (the last two; see `FemObject::modes`), only its discrete law is new.
+    // kept (the last `MEMO_ENTRIES`; see `FemObject::modes`), only its discrete law is new.
     let mut recent: Vec<(String, Option<usize>, Option<usize>)> = Vec::new();
     let weights: Vec<f64> = sidecar
         .runs
@@ -1543,7 +1543,7 @@ fn prepare_data_checks(
                 return 0.1 * cost;
             }
             recent.push(key);
-            if recent.len() > 2 {
+            if recent.len() > crate::scene::linear::MEMO_ENTRIES {
                 recent.remove(0);
             }
             cost

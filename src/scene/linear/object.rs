@@ -23,7 +23,7 @@ use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 /// Objects of fewer unknowns decompose faster than [`memoized`] keys them.
 const MEMO_MIN_DOFS: usize = 100;
 /// Decompositions [`memoized`] keeps (a 1000-element beam's: 32 MB each).
-const MEMO_ENTRIES: usize = 2;
+pub(crate) const MEMO_ENTRIES: usize = 2;
 
 /// A dense decomposition of [`memoized`]: its key and its modes, computed once (`None`
 /// if the decomposition failed).
