@@ -49,7 +49,7 @@ pub use ensemble::par_indexed;
 pub use integrator::{ExactModal, Integrator, ThetaScheme, build_integrator};
 pub use modal_metropolis::{ModalMetropolis, Proposal};
 pub use modal_step::ModalStep;
-pub use nonlinear::{NonlinearIntegrator, NonlinearStep};
+pub use nonlinear::{NonlinearBatch, NonlinearIntegrator, NonlinearStep};
 
 use crate::error::Error;
 use serde::{Deserialize, Serialize};

@@ -37,6 +37,9 @@ use crate::fem::vonkarman::{AxialScratch, CompressedFilament};
 use crate::rng::TrajectoryRng;
 use rand::RngExt;
 
+mod batch;
+pub use batch::NonlinearBatch;
+
 /// Which nonlinear scheme.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Scheme {

@@ -94,6 +94,59 @@ impl SymBanded {
         }
     }
 
+    /// `y = A x` for [`LANES`] vectors at once (structure-of-arrays): per lane the
+    /// floating-point operations of [`Self::mul_vec`] in the same order, so every lane is
+    /// bit-identical to its one-vector product.
+    ///
+    /// # Panics
+    /// If the half-bandwidth is not 1, 2 or 3 or `x`, `y` do not have `n` rows.
+    pub fn mul_lanes(&self, x: &[Lanes], y: &mut [Lanes]) {
+        assert!(
+            (1..=3).contains(&self.bw) && x.len() == self.n && y.len() == self.n,
+            "mul_lanes: unsupported band or wrong length"
+        );
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU supports AVX (just checked).
+            unsafe { self.mul_lanes_avx(x, y) };
+            return;
+        }
+        self.mul_lanes_band(x, y);
+    }
+
+    /// [`Self::mul_lanes_band`] compiled for AVX (no fused multiply-add: bit-identical).
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn mul_lanes_avx(&self, x: &[Lanes], y: &mut [Lanes]) {
+        self.mul_lanes_band(x, y);
+    }
+
+    /// [`Self::mul_lanes`] after its checks, by half-bandwidth.
+    #[inline(always)]
+    fn mul_lanes_band(&self, x: &[Lanes], y: &mut [Lanes]) {
+        match self.bw {
+            1 => self.mul_lanes_fixed::<2>(x, y),
+            2 => self.mul_lanes_fixed::<3>(x, y),
+            _ => self.mul_lanes_fixed::<4>(x, y),
+        }
+    }
+
+    /// [`Self::mul_lanes`] for half-bandwidth `W − 1`, row by row ([`lanes_product`]).
+    #[inline(always)]
+    fn mul_lanes_fixed<const W: usize>(&self, x: &[Lanes], y: &mut [Lanes]) {
+        let rows = band_rows::<W>(&self.data, self.n);
+        for_rows::<W>(
+            self.n,
+            #[inline(always)]
+            |i, lower, upper| {
+                y[i] = lanes_product(rows, x, i, lower, upper);
+            },
+        );
+    }
+
     /// [`Self::mul_vec`] for half-bandwidth `W − 1`: one pass, row by row
     /// ([`product_row`]).
     fn mul_vec_fixed<const W: usize>(&self, x: &[f64], y: &mut [f64]) {
@@ -776,30 +829,77 @@ impl BandedCholesky {
                 y[i] = lanes_forward_row(&rows[i], &mut window, b, inv[i]);
             }
         }
-        // the backward rows as `backward_row` sums them, k = i + 1, i + 2, …
-        let tail = n.saturating_sub(bw);
-        for i in (tail..n).rev() {
-            let mut s = y[i];
-            for d in 1..n - i {
-                lanes_sub_product(&mut s, rows[i + d][d], &x[i + d]);
-            }
-            x[i] = lanes_scaled(inv[i], &s);
+        lanes_backward(rows, inv, y, x);
+    }
+
+    /// `x ← L⁻ᵀ L⁻¹ b` for [`LANES`] vectors at once (structure-of-arrays), `y` holding
+    /// `b` on entry and `L⁻¹ b` on return: per lane the floating-point operations, in the
+    /// same order, of [`Self::solve_in_place`], so every lane is bit-identical to its
+    /// one-vector solve (the θ-step of an ensemble of nonlinear filaments in lockstep,
+    /// whose right-hand side is not a banded product plus a term).
+    ///
+    /// # Panics
+    /// If the half-bandwidth is not 1, 2 or 3 or `y`, `x` do not have `n` rows.
+    pub fn solve_lanes(&self, y: &mut [Lanes], x: &mut [Lanes]) {
+        assert!(
+            (1..=3).contains(&self.bw) && y.len() == self.n && x.len() == self.n,
+            "solve_lanes: unsupported band or wrong length"
+        );
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU supports AVX (just checked).
+            unsafe { self.solve_lanes_avx(y, x) };
+            return;
         }
-        if tail > 0 {
+        self.solve_lanes_band(y, x);
+    }
+
+    /// [`Self::solve_lanes_band`] compiled for AVX (bit-identical, as
+    /// [`Self::sweeps_lanes_avx`]).
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn solve_lanes_avx(&self, y: &mut [Lanes], x: &mut [Lanes]) {
+        self.solve_lanes_band(y, x);
+    }
+
+    /// [`Self::solve_lanes`] after its checks, by half-bandwidth.
+    #[inline(always)]
+    fn solve_lanes_band(&self, y: &mut [Lanes], x: &mut [Lanes]) {
+        match self.bw {
+            1 => self.solve_lanes_fixed::<2>(y, x),
+            2 => self.solve_lanes_fixed::<3>(y, x),
+            _ => self.solve_lanes_fixed::<4>(y, x),
+        }
+    }
+
+    /// [`Self::solve_lanes`] for half-bandwidth `W − 1`: the forward sweep of
+    /// [`Self::solve_in_place`] in place in `y` (its rows as `forward_row_edge`, then
+    /// `far_terms` + `near_term` subtract them, `k` ascending), then [`lanes_backward`].
+    #[inline(always)]
+    fn solve_lanes_fixed<const W: usize>(&self, y: &mut [Lanes], x: &mut [Lanes]) {
+        let n = self.n;
+        let (rows, inv) = (band_rows::<W>(&self.data, n), &self.inv_diag[..n]);
+        let head = (W - 1).min(n);
+        for i in 0..head {
+            let mut b = y[i];
+            for d in (1..=i).rev() {
+                lanes_sub_product(&mut b, rows[i][d], &y[i - d]);
+            }
+            y[i] = lanes_scaled(inv[i], &b);
+        }
+        if head < n {
             let mut window = [[0.0; LANES]; W];
             for d in 1..W {
-                window[d - 1] = x[tail - 1 + d];
+                window[d - 1] = y[head - d];
             }
-            for i in (0..tail).rev() {
-                let mut s = y[i];
-                for d in 1..W {
-                    lanes_sub_product(&mut s, rows[i + d][d], &window[d - 1]);
-                }
-                let v = lanes_scaled(inv[i], &s);
-                x[i] = v;
-                push(&mut window, v);
+            for i in head..n {
+                y[i] = lanes_forward_row(&rows[i], &mut window, y[i], inv[i]);
             }
         }
+        lanes_backward(rows, inv, y, x);
     }
 
     /// The backward sweep for half-bandwidth `W − 1`, from `y` into `x`, or in place in
@@ -1013,6 +1113,20 @@ fn lanes_rhs<const W: usize>(
     upper: usize,
     g: Lanes,
 ) -> Lanes {
+    let mut b = lanes_product(a_rows, x, i, lower, upper);
+    lanes_add(&mut b, &g);
+    b
+}
+
+/// Row `i` of `A x` for [`LANES`] vectors, summed as [`product_row`] sums it.
+#[inline(always)]
+fn lanes_product<const W: usize>(
+    a_rows: &[[f64; W]],
+    x: &[Lanes],
+    i: usize,
+    lower: usize,
+    upper: usize,
+) -> Lanes {
     let row = &a_rows[i];
     let mut b = lanes_scaled(row[0], &x[i]);
     for d in (1..=lower).rev() {
@@ -1021,8 +1135,38 @@ fn lanes_rhs<const W: usize>(
     for d in 1..=upper {
         lanes_add_product(&mut b, a_rows[i + d][d], &x[i + d]);
     }
-    lanes_add(&mut b, &g);
     b
+}
+
+/// The backward sweep `Lᵀ x = y` for [`LANES`] vectors (band rows `rows`, reciprocal
+/// pivots `inv`), its rows as `backward_row_edge` and `backward_row` sum them
+/// (`k = i + 1, i + 2, …`), the last values in registers.
+#[inline(always)]
+fn lanes_backward<const W: usize>(rows: &[[f64; W]], inv: &[f64], y: &[Lanes], x: &mut [Lanes]) {
+    let n = rows.len();
+    let tail = n.saturating_sub(W - 1);
+    for i in (tail..n).rev() {
+        let mut s = y[i];
+        for d in 1..n - i {
+            lanes_sub_product(&mut s, rows[i + d][d], &x[i + d]);
+        }
+        x[i] = lanes_scaled(inv[i], &s);
+    }
+    if tail > 0 {
+        let mut window = [[0.0; LANES]; W];
+        for d in 1..W {
+            window[d - 1] = x[tail - 1 + d];
+        }
+        for i in (0..tail).rev() {
+            let mut s = y[i];
+            for d in 1..W {
+                lanes_sub_product(&mut s, rows[i + d][d], &window[d - 1]);
+            }
+            let v = lanes_scaled(inv[i], &s);
+            x[i] = v;
+            push(&mut window, v);
+        }
+    }
 }
 
 /// An interior row of the forward sweep for [`LANES`] vectors: `y_i = (b − Σ_k L_ik y_k)·inv`,
@@ -1390,6 +1534,45 @@ mod tests {
                                     "bw {bw} n {n} noise {noise} lane {l} row {i}"
                                 );
                             }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The lane product and the lane solve, through the AVX and the plain path, equal
+    /// [`SymBanded::mul_vec`] and [`BandedCholesky::solve_in_place`] bit for bit in every
+    /// lane, for every served half-bandwidth and for sizes below, at and above the band.
+    #[test]
+    fn lane_products_and_solves_equal_one_vector_ones_bit_for_bit() {
+        for bw in 1..=3 {
+            for n in [1, 2, 3, 4, 5, 9, 20] {
+                let a = spd(n, bw);
+                let chol = a.cholesky().unwrap();
+                let x: Vec<Lanes> = (0..n)
+                    .map(|i| std::array::from_fn(|l| ((i * 11 + l * 5) as f64 * 0.41).cos()))
+                    .collect();
+                for plain in [false, true] {
+                    let (mut ax, mut y, mut sol) =
+                        (vec![[0.0; LANES]; n], x.clone(), vec![[f64::NAN; LANES]; n]);
+                    if plain {
+                        a.mul_lanes_band(&x, &mut ax);
+                        chol.solve_lanes_band(&mut y, &mut sol);
+                    } else {
+                        a.mul_lanes(&x, &mut ax);
+                        chol.solve_lanes(&mut y, &mut sol);
+                    }
+                    for l in 0..LANES {
+                        let xl: Vec<f64> = x.iter().map(|v| v[l]).collect();
+                        let mut expected = vec![0.0; n];
+                        a.mul_vec(&xl, &mut expected);
+                        let mut solved = xl.clone();
+                        chol.solve_in_place(&mut solved);
+                        for i in 0..n {
+                            let at = format!("bw {bw} n {n} plain {plain} lane {l} row {i}");
+                            assert_eq!(ax[i][l].to_bits(), expected[i].to_bits(), "{at}");
+                            assert_eq!(sol[i][l].to_bits(), solved[i].to_bits(), "{at}");
                         }
                     }
                 }

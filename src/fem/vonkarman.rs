@@ -23,8 +23,9 @@
 //! integrators are in [`crate::dynamics::nonlinear`].
 
 use crate::error::{Error, Result};
+use crate::fem::banded::{LANES, Lanes};
 use crate::fem::beam::BeamModel;
-use crate::fem::hermite::geometric_matrix;
+use crate::fem::hermite::{ElementMatrix, geometric_matrix};
 use crate::theory::compression::GlobalConstraint;
 
 /// The global constraint at an imposed strain, shared by the von Kármán filament and the
@@ -72,6 +73,50 @@ pub struct CompressedFilament {
     beam: BeamModel,
     components: usize,
     strain: f64,
+    axial: AxialOperator,
+}
+
+/// What step (i) ([`CompressedFilament::axial_equilibrium_into`]) needs of the mesh and
+/// EA alone, formed once: per element its length, geometric matrix and DOFs, the axial
+/// stiffnesses `k_e = EA/h_e`, and the Thomas elimination of the tridiagonal system
+/// (pivots and multipliers depend on `k` only). The same values, in the same order, as
+/// forming them at every step.
+#[derive(Debug, Clone)]
+struct AxialOperator {
+    h: Vec<f64>,
+    g: Vec<ElementMatrix>,
+    dofs: Vec<[Option<usize>; 4]>,
+    k: Vec<f64>,
+    /// Pivots of the eliminated system (interior nodes 1..N−1).
+    diag: Vec<f64>,
+    /// Multipliers `f_i = −k_i/diag_{i−1}` (`f_0` unused).
+    mult: Vec<f64>,
+}
+
+impl AxialOperator {
+    fn new(beam: &BeamModel) -> Self {
+        let mesh = beam.mesh();
+        let ne = mesh.n_elements();
+        let ea = beam.params().stretch_rigidity;
+        let h: Vec<f64> = (0..ne).map(|e| mesh.element_length(e)).collect();
+        let k: Vec<f64> = h.iter().map(|h| ea / h).collect();
+        let m = ne.saturating_sub(1);
+        let mut diag: Vec<f64> = (0..m).map(|i| k[i] + k[i + 1]).collect();
+        let mut mult = vec![0.0; m];
+        for i in 1..m {
+            let f = -k[i] / diag[i - 1];
+            diag[i] -= f * -k[i];
+            mult[i] = f;
+        }
+        AxialOperator {
+            g: h.iter().map(|&h| geometric_matrix(h)).collect(),
+            dofs: (0..ne).map(|e| beam.element_dofs(e)).collect(),
+            h,
+            k,
+            diag,
+            mult,
+        }
+    }
 }
 
 /// Work space of [`CompressedFilament::axial_equilibrium_into`]: the element-mean half
@@ -81,11 +126,17 @@ pub struct AxialScratch {
     s: Vec<f64>,
     /// Nodal axial displacements u_0 = 0, …, u_N = −Δ (after a solve).
     pub u: Vec<f64>,
-    k: Vec<f64>,
-    diag: Vec<f64>,
     rhs: Vec<f64>,
     /// Axial force N per element (tension positive; after a solve).
     pub element_force: Vec<f64>,
+}
+
+/// Work space of [`CompressedFilament::axial_force_lanes`].
+#[derive(Debug, Clone, Default)]
+pub struct AxialLanes {
+    s: Vec<Lanes>,
+    u: Vec<Lanes>,
+    rhs: Vec<Lanes>,
 }
 
 /// Result of the axial equilibrium solve (step i).
@@ -111,6 +162,7 @@ impl CompressedFilament {
             return Err(Error::invalid("strain", strain, "finite"));
         }
         Ok(CompressedFilament {
+            axial: AxialOperator::new(&beam),
             beam,
             components: dims - 1,
             strain,
@@ -198,24 +250,19 @@ impl CompressedFilament {
     /// the same bits; allocation-free once the buffers have their size): the paper's
     /// explicit scheme solves step (i) at every step.
     pub fn axial_equilibrium_into(&self, w: &[Vec<f64>], scratch: &mut AxialScratch) {
-        let mesh = self.beam.mesh();
-        let ne = mesh.n_elements();
+        let op = &self.axial;
+        let ne = op.h.len();
         let ea = self.beam.params().stretch_rigidity;
-        let delta = self.strain * mesh.length();
+        let delta = self.strain * self.beam.mesh().length();
         let AxialScratch {
             s,
             u,
-            k,
-            diag,
             rhs,
             element_force,
         } = scratch;
         // Element-mean half squared slope s_e.
         s.clear();
-        s.extend((0..ne).map(|e| {
-            let h = mesh.element_length(e);
-            let g = geometric_matrix(h);
-            let dofs = self.beam.element_dofs(e);
+        s.extend(op.h.iter().zip(&op.g).zip(&op.dofs).map(|((&h, g), dofs)| {
             let mut acc = 0.0;
             for c in w {
                 let loc = dofs.map(|d| d.map_or(0.0, |i| c[i]));
@@ -232,18 +279,14 @@ impl CompressedFilament {
         u[ne] = -delta;
         let m = ne - 1; // interior unknowns u_1..u_{N-1}
         if m > 0 {
-            k.clear();
-            k.extend((0..ne).map(|e| ea / mesh.element_length(e)));
-            // Row i (node i+1): −k_i u_i + (k_i + k_{i+1}) u_{i+1} − k_{i+1} u_{i+2} = EA(s_{i+1} − s_i).
-            diag.clear();
-            diag.extend((0..m).map(|i| k[i] + k[i + 1]));
+            let (k, diag) = (&op.k, &op.diag);
+            // Row i (node i+1): −k_i u_i + (k_i + k_{i+1}) u_{i+1} − k_{i+1} u_{i+2} = EA(s_{i+1} − s_i),
+            // eliminated once ([`AxialOperator`]); here the right-hand side follows it.
             rhs.clear();
             rhs.extend((0..m).map(|i| ea * (s[i + 1] - s[i])));
             rhs[m - 1] += k[ne - 1] * u[ne];
             for i in 1..m {
-                let f = -k[i] / diag[i - 1];
-                diag[i] -= f * -k[i];
-                rhs[i] -= f * rhs[i - 1];
+                rhs[i] -= op.mult[i] * rhs[i - 1];
             }
             u[m] = rhs[m - 1] / diag[m - 1];
             for i in (1..m).rev() {
@@ -251,8 +294,77 @@ impl CompressedFilament {
             }
         }
         element_force.clear();
-        element_force
-            .extend((0..ne).map(|e| ea * ((u[e + 1] - u[e]) / mesh.element_length(e) + s[e])));
+        element_force.extend((0..ne).map(|e| ea * ((u[e + 1] - u[e]) / op.h[e] + s[e])));
+    }
+
+    /// The compressive force `F = −N_0` of step (i) for [`LANES`] states at once (`w[c][i][l]`:
+    /// component `c`, DOF `i`, lane `l`), as the paper's explicit scheme takes it: per lane
+    /// the floating-point operations of [`Self::axial_equilibrium_into`] that lead to the
+    /// first element's force, in the same order, so every lane is bit-identical to it.
+    ///
+    /// Plain loops, inlined into its caller: called from code compiled for AVX, it runs in
+    /// 4-wide vectors (no fused multiply-add, so with the same bits).
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // lane loops indexed as the scalar code's entries
+    pub fn axial_force_lanes(&self, w: &[Vec<Lanes>], scratch: &mut AxialLanes) -> Lanes {
+        let op = &self.axial;
+        let ne = op.h.len();
+        let ea = self.beam.params().stretch_rigidity;
+        let delta = self.strain * self.beam.mesh().length();
+        let AxialLanes { s, u, rhs } = scratch;
+        s.resize(ne, [0.0; LANES]);
+        for e in 0..ne {
+            let (g, dofs) = (&op.g[e], &op.dofs[e]);
+            let mut acc = [0.0; LANES];
+            for c in w {
+                let loc = dofs.map(|d| d.map_or([0.0; LANES], |i| c[i]));
+                for a in 0..4 {
+                    for b in 0..4 {
+                        for l in 0..LANES {
+                            acc[l] += loc[a][l] * g[a][b] * loc[b][l];
+                        }
+                    }
+                }
+            }
+            let two_h = 2.0 * op.h[e];
+            for l in 0..LANES {
+                s[e][l] = acc[l] / two_h;
+            }
+        }
+        u.resize(ne + 1, [0.0; LANES]);
+        u[0] = [0.0; LANES];
+        u[ne] = [-delta; LANES];
+        let m = ne - 1;
+        if m > 0 {
+            let (k, diag) = (&op.k, &op.diag);
+            rhs.resize(m, [0.0; LANES]);
+            for i in 0..m {
+                for l in 0..LANES {
+                    rhs[i][l] = ea * (s[i + 1][l] - s[i][l]);
+                }
+            }
+            for l in 0..LANES {
+                rhs[m - 1][l] += k[ne - 1] * u[ne][l];
+            }
+            for i in 1..m {
+                for l in 0..LANES {
+                    rhs[i][l] -= op.mult[i] * rhs[i - 1][l];
+                }
+            }
+            for l in 0..LANES {
+                u[m][l] = rhs[m - 1][l] / diag[m - 1];
+            }
+            for i in (1..m).rev() {
+                for l in 0..LANES {
+                    u[i][l] = (rhs[i - 1][l] + k[i] * u[i + 1][l]) / diag[i - 1];
+                }
+            }
+        }
+        let mut force = [0.0; LANES];
+        for l in 0..LANES {
+            force[l] = -(ea * ((u[1][l] - u[0][l]) / op.h[0] + s[0][l]));
+        }
+        force
     }
 
     /// The axial equilibrium residual of state `w` against the compressive force `force`

@@ -5,10 +5,13 @@
 //! projected area ([`AreaMembrane`], issue #28), whose compressive stress `F = −σ` is
 //! recorded in units of `σ_c0 = κq²_min` exactly as the filament's force in units of F_c0.
 
-use crate::dynamics::{Driver, Family, IntegratorKind, ModalMetropolis, NonlinearState, Observer};
+use crate::dynamics::{
+    Driver, Family, IntegratorKind, LaneOf, ModalMetropolis, NonlinearBatch, NonlinearState,
+    Observer,
+};
 use crate::error::{Error, Result};
 use crate::fem::area::AreaMembrane;
-use crate::fem::banded::BandedCholesky;
+use crate::fem::banded::{BandedCholesky, LANES};
 use crate::fem::beam::BeamModel;
 use crate::fem::mesh::Mesh;
 use crate::fem::noise::NoiseModel;
@@ -210,11 +213,35 @@ struct ForceRecorder<'m> {
     rec: ForceRecord,
     /// Whether to record [`ForceRecord::buckled_mode`].
     buckled_mode: bool,
+    /// A lane's state, copied out of a [`NonlinearBatch`] at each sample.
+    lane: Vec<Vec<f64>>,
 }
 
-impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
-    fn on_sample(&mut self, _: usize, _: u64, state: &NonlinearState<NonlinearIntegrator<'_>>) {
-        let (model, w) = (self.model, &state.w);
+impl ForceRecorder<'_> {
+    /// The observer of one trajectory of `model` (one strain of `run`) with step plan
+    /// `plan`.
+    fn new<'m>(
+        run: &CompressionRun,
+        model: &'m CompressedFilament,
+        plan: StepPlan,
+        sampled_steps: u64,
+    ) -> ForceRecorder<'m> {
+        ForceRecorder {
+            model,
+            euler_load: run.euler_load,
+            rec: ForceRecord {
+                force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
+                slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
+                ..Default::default()
+            },
+            buckled_mode: run.buckled_mode,
+            lane: Vec::new(),
+        }
+    }
+
+    /// Records the sample `w`.
+    fn record(&mut self, w: &[Vec<f64>]) {
+        let model = self.model;
         let f = model.compressive_force(model.stored_length(w));
         self.rec.force_ratio.push(f / self.euler_load);
         if self.buckled_mode {
@@ -230,10 +257,27 @@ impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
         }
         self.rec.slope_samples += 1;
     }
+}
+
+impl Observer<NonlinearState<NonlinearIntegrator<'_>>> for ForceRecorder<'_> {
+    fn on_sample(&mut self, _: usize, _: u64, state: &NonlinearState<NonlinearIntegrator<'_>>) {
+        self.record(&state.w);
+    }
 
     fn on_finish(&mut self, _: usize, state: &NonlinearState<NonlinearIntegrator<'_>>) {
         self.rec.proposed = state.integrator.proposed;
         self.rec.accepted = state.integrator.accepted;
+    }
+}
+
+/// A lane of a batch of θ-scheme trajectories: the θ-schemes propose nothing, so the
+/// counts stay 0 as [`NonlinearIntegrator`]'s.
+impl Observer<LaneOf<'_, NonlinearBatch<'_>>> for ForceRecorder<'_> {
+    fn on_sample(&mut self, _: usize, _: u64, view: &LaneOf<'_, NonlinearBatch<'_>>) {
+        let mut w = std::mem::take(&mut self.lane);
+        view.batch.lane_state(view.lane, &mut w);
+        self.record(&w);
+        self.lane = w;
     }
 }
 
@@ -885,32 +929,79 @@ impl CompressionRun {
             integrator,
             w: self.equilibrium_start(rng)?,
         };
-        let mut recorder = ForceRecorder {
-            model,
-            euler_load: self.euler_load,
-            rec: ForceRecord {
-                force_ratio: Vec::with_capacity((sampled_steps / plan.sample_every) as usize),
-                slope_squares: vec![0.0; model.beam().mesh().n_nodes()],
-                ..Default::default()
-            },
-            buckled_mode: self.buckled_mode,
-        };
-        let burn_in_steps = (self.burn_in / plan.dt).round() as u64;
-        Driver::new(plan.dt, burn_in_steps, sampled_steps, plan.sample_every).run(
+        let mut recorder = ForceRecorder::new(self, model, plan, sampled_steps);
+        self.nodal_driver(plan, sampled_steps).run(
             point,
             &mut state,
             rng,
             &mut recorder,
-            |_| {
-                format!(
-                    "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
-                    self.spec.integrator,
-                    model.strain(),
-                    self.spec.dt_tau1
-                )
-            },
+            |_| self.nodal_divergence(model),
         )?;
         Ok(recorder.rec)
+    }
+
+    /// The schedule of a nodal trajectory with step plan `plan`.
+    fn nodal_driver(&self, plan: StepPlan, sampled_steps: u64) -> Driver {
+        let burn_in_steps = (self.burn_in / plan.dt).round() as u64;
+        Driver::new(plan.dt, burn_in_steps, sampled_steps, plan.sample_every)
+    }
+
+    /// What a diverged nodal trajectory of `model` reports.
+    fn nodal_divergence(&self, model: &CompressedFilament) -> String {
+        format!(
+            "non-finite deflection with {} at strain {:.4e} (dt = {:.3e} tau1)",
+            self.spec.integrator,
+            model.strain(),
+            self.spec.dt_tau1
+        )
+    }
+
+    /// The trajectories `js` of strain index `point` (the stream of trajectory `j` is
+    /// `trajectory_rng(seed, j)`) as one [`NonlinearBatch`] in lockstep, or `None` if the
+    /// run is no nodal θ-scheme the lane kernels serve. Each lane is bit-identical to
+    /// [`Self::simulate`] of its trajectory: the same start, draws and operations.
+    fn simulate_batch(
+        &self,
+        point: usize,
+        seed: u64,
+        js: std::ops::Range<u64>,
+        sampled_steps: u64,
+    ) -> Result<Option<Vec<Result<ForceRecord>>>> {
+        let Strained::Filament {
+            models,
+            paired: None,
+            ..
+        } = &self.object
+        else {
+            return Ok(None);
+        };
+        let (model, plan) = (&models[point], self.plans[point]);
+        let Some(mut batch) =
+            NonlinearBatch::new(model, self.spec.integrator, self.spec.noise, plan.dt)?
+        else {
+            return Ok(None);
+        };
+        let mut rngs: Vec<TrajectoryRng> = js.clone().map(|j| trajectory_rng(seed, j)).collect();
+        for (lane, rng) in rngs.iter_mut().enumerate() {
+            batch.set_lane(lane, &self.equilibrium_start(rng)?);
+        }
+        let mut recorders: Vec<ForceRecorder> = js
+            .map(|_| ForceRecorder::new(self, model, plan, sampled_steps))
+            .collect();
+        let results = self.nodal_driver(plan, sampled_steps).run_batch(
+            point,
+            &mut batch,
+            &mut rngs,
+            &mut recorders,
+            |_| self.nodal_divergence(model),
+        );
+        Ok(Some(
+            results
+                .into_iter()
+                .zip(recorders)
+                .map(|(r, o)| r.map(|()| o.rec))
+                .collect(),
+        ))
     }
 
     /// [`Self::simulate`] for `metropolis-crank-nicolson` on the paired modal form
@@ -1097,6 +1188,9 @@ impl CompressionRun {
         if nt == 0 {
             return Ok(vec![Vec::new(); self.points()]);
         }
+        if let Some(records) = self.simulate_batches(&seed, range.clone(), sampled_steps, &tick)? {
+            return Ok(records);
+        }
         let flat = crate::dynamics::par_indexed(self.points() as u64 * nt, |t| {
             let (i, j) = ((t / nt) as usize, range.start + t % nt);
             let rec = self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps[i]);
@@ -1104,6 +1198,54 @@ impl CompressionRun {
             rec
         })?;
         Ok(flat.chunks(nt as usize).map(<[_]>::to_vec).collect())
+    }
+
+    /// [`Self::simulate_share_per_point`] in lockstep batches ([`Self::simulate_batch`])
+    /// for a nodal θ-scheme, `None` for any other run. Up to [`LANES`] trajectories of one
+    /// strain per batch, fewer when the ensemble would leave a core idle. The records are
+    /// those of the trajectory-by-trajectory run bit for bit, and so is the error: the
+    /// first in strain-major trajectory order (a batch that cannot be built fails at its
+    /// first trajectory, as the first of its trajectories run alone would).
+    fn simulate_batches(
+        &self,
+        seed: &(impl Fn(usize) -> u64 + Sync),
+        range: std::ops::Range<u64>,
+        sampled_steps: &[u64],
+        tick: &(impl Fn() + Sync),
+    ) -> Result<Option<Vec<Vec<ForceRecord>>>> {
+        let nodal = matches!(self.object, Strained::Filament { paired: None, .. });
+        if !nodal || !matches!(self.spec.integrator.family(), Family::Theta(_)) {
+            return Ok(None);
+        }
+        let (points, nt) = (self.points() as u64, range.end - range.start);
+        let threads = rayon::current_num_threads().max(1) as u64;
+        let lanes = (points * nt)
+            .div_ceil(threads)
+            .clamp(1, LANES as u64)
+            .min(nt);
+        let per_point = nt.div_ceil(lanes);
+        let batches = crate::dynamics::par_indexed(points * per_point, |b| {
+            let i = (b / per_point) as usize;
+            let start = range.start + (b % per_point) * lanes;
+            let js = start..(start + lanes).min(range.end);
+            let recs = match self.simulate_batch(i, seed(i), js.clone(), sampled_steps[i]) {
+                Ok(Some(recs)) => recs,
+                Ok(None) => js
+                    .clone()
+                    .map(|j| self.simulate(i, &mut trajectory_rng(seed(i), j), sampled_steps[i]))
+                    .collect(),
+                Err(e) => vec![Err(e)],
+            };
+            js.for_each(|_| tick());
+            Ok(recs)
+        })?;
+        let mut out = vec![Vec::with_capacity(nt as usize); points as usize];
+        for (b, recs) in batches.into_iter().enumerate() {
+            for rec in recs {
+                out[b / per_point as usize].push(rec?);
+            }
+        }
+        Ok(Some(out))
     }
 
     /// The step search of a budget by target precision at strain `point` (see
@@ -1458,5 +1600,70 @@ mod tests {
         assert_eq!(rec.force_ratio.len() as u64, 100 / run.sample_every);
         assert!(rec.force_ratio.iter().all(|f| f.is_finite()));
         assert!(rec.slope_squares.is_empty() && rec.axial_residual.is_none());
+    }
+
+    /// The paper's explicit scheme and Crank–Nicolson with explicit stretching (2D and 3D,
+    /// both noises) run in lockstep batches: every strain's records (forces, slopes,
+    /// axial residuals, buckled mode) equal those of each trajectory simulated alone, bit
+    /// for bit, with 1 and 3 worker threads and for a shard's share of the trajectories.
+    #[test]
+    fn batched_ensembles_are_the_trajectories_run_alone() {
+        let bits = |r: &ForceRecord| -> Vec<u64> {
+            let mut v: Vec<u64> = [&r.force_ratio, &r.slope_squares, &r.buckled_mode]
+                .iter()
+                .flat_map(|s| s.iter().map(|x| x.to_bits()))
+                .collect();
+            v.extend([r.slope_samples as u64, r.axial_states, r.proposed]);
+            v.push(r.axial_residual.map_or(u64::MAX, f64::to_bits));
+            v
+        };
+        for (name, integrator) in [
+            ("fig2-paper-2d", IntegratorKind::EulerMaruyama),
+            ("fig2-paper-3d", IntegratorKind::EulerMaruyama),
+            ("fig2-paper-2d", IntegratorKind::CrankNicolson),
+        ] {
+            let scene = crate::scene::builtin::find(name)
+                .expect("built in")
+                .load()
+                .expect("loads");
+            // short: a burn-in of 0.01 tau1 and a sample every 5e-4 tau1 (71 steps)
+            let comp = CompressionSpec {
+                burn_in_tau1: 0.01,
+                sample_every_tau1: 5e-4,
+                ..scene.compression.clone().unwrap()
+            };
+            let mut spec = scene.runs[0].clone();
+            spec.integrator = integrator;
+            if integrator == IntegratorKind::CrankNicolson {
+                spec.noise = NoiseModel::Consistent;
+                spec.dt_tau1 = 1e-3;
+            }
+            let run = CompressionRun::prepare(&scene, &comp, &spec)
+                .unwrap()
+                .with_buckled_mode();
+            let steps = vec![50 * run.sample_every; run.points()];
+            let seed = |i: usize| 40 + i as u64;
+            for (threads, range) in [(1, 0..5), (3, 0..5), (2, 2..5)] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let batched = pool
+                    .install(|| run.simulate_share_per_point(seed, range.clone(), &steps, || {}))
+                    .unwrap();
+                for (i, recs) in batched.iter().enumerate() {
+                    assert_eq!(recs.len(), range.clone().count());
+                    for (rec, j) in recs.iter().zip(range.clone()) {
+                        let alone = run.simulate(i, &mut trajectory_rng(seed(i), j), steps[i]);
+                        assert_eq!(
+                            bits(rec),
+                            bits(&alone.unwrap()),
+                            "{name} {integrator} strain {i} trajectory {j}, {threads} threads"
+                        );
+                        assert_eq!(rec.force_ratio.len(), 50);
+                    }
+                }
+            }
+        }
     }
 }
