@@ -108,7 +108,7 @@ docs-check: numpy-venv
 # test in tests/docs.rs fails when the committed figure differs from that run's, byte for byte),
 # and the README's membrane under imposed projected area (both membrane-area scenes at the
 # standard budget, about 80 s), and the README's cost of Fig. 2 per scheme (work-precision
-# on fig2-paper-2d, about 4 min; CPU times are measured, so this one is not byte-stable).
+# on fig2-paper-2d, about 2.5 min; CPU times are measured, so this one is not byte-stable).
 SCENE_KEYS_PAGE = docs/src/reference/scene-keys.md
 FIG2_IMAGE      = docs/src/images/fig2.svg
 TENSION_IMAGE   = docs/src/images/tension-2d.svg
