@@ -1402,3 +1402,68 @@ fn one_trajectory_of_data_skips_what_it_cannot_serve() {
         );
     }
 }
+
+/// What: `run` warns, before it simulates, when its trajectories would be too short for
+/// its own `check` (the slowest mode sampled fewer than 8 times after the burn-in), with
+/// the numbers `check`'s refusal then gives and a duration that serves; at that duration
+/// it does not warn and `check` reads the files.
+/// Tolerance: exact text (the rows `check` asks for).
+#[test]
+fn run_warns_of_trajectories_too_short_for_check() {
+    let dir = TempDir::new("run-check-short");
+    let out = dir.join_str("out");
+    let written = |duration: &str| {
+        let data = dir.join_str(&format!("data-{duration}"));
+        let args = [
+            "run",
+            "-q",
+            "-s",
+            "hinged-linear-2d",
+            "--run",
+            "crank-nicolson",
+            "--trajectories",
+            "2",
+            "--duration-tau1",
+            duration,
+            "-o",
+            &data,
+        ];
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+        (data, stderr_of(&o))
+    };
+    let check = |data: &str| {
+        let args = [
+            "check",
+            "-q",
+            "-s",
+            "hinged-linear-2d",
+            "-d",
+            data,
+            "-o",
+            &out,
+        ];
+        run(&args)
+    };
+    let (short, warned) = written("2");
+    for needle in [
+        "warning: hinged-linear-2d/crank-nicolson:",
+        "2001 rows after the burn-in",
+        "needs at least 3992",
+        "every 499 rows",
+        "--duration-tau1 4 or more",
+    ] {
+        assert!(warned.contains(needle), "{needle:?} not in {warned}");
+    }
+    let o = check(&short);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr_of(&o));
+    assert!(
+        stderr_of(&o).contains("needs at least 3992 stationary rows"),
+        "{}",
+        stderr_of(&o)
+    );
+    let (long, quiet) = written("4");
+    assert!(!quiet.contains("warning"), "{quiet}");
+    let o = check(&long);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
+}

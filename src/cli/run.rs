@@ -27,6 +27,7 @@ use langevin_fem::scene::compression::CompressionRun;
 use langevin_fem::scene::linear::{LinearRun, RowPlan};
 use langevin_fem::scene::{Budget, ModelKind, Scene};
 use langevin_fem::shard::{Shard, ShardScene, ShardWriter};
+use langevin_fem::stats::moments::MIN_SERIES_LEN;
 use langevin_fem::work::{Origin, Part, RunWork, WorkLimits, WorkProjection};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -522,6 +523,7 @@ fn linear_what(job: &Job) -> String {
 fn run_linear(job: &Job) -> Result<i32> {
     let scene = &job.scene;
     let (runs, plans) = prepare_linear(job)?;
+    warn_short_for_check(job, &runs, &plans);
     // This shard's share of the work.
     let work = projection(job, &runs, &plans).scaled(job.share().fraction());
     job.limits.check(&work)?;
@@ -536,6 +538,24 @@ fn run_linear(job: &Job) -> Result<i32> {
     }
     bar.finish();
     job.finish(sink, data_runs, None, linear_what(job))
+}
+
+/// Warns (stderr, also under `--quiet`) of every chosen run whose trajectories `check`
+/// would refuse as too short for the slowest mode ([`LinearRun::short_for_check`]),
+/// naming the sampled duration that would serve. The files are written all the same: they
+/// may be for the user's own analysis.
+fn warn_short_for_check(job: &Job, runs: &[LinearRun], plans: &[RowPlan]) {
+    let tau1 = job.scene.tau1();
+    for ((&k, run), plan) in job.chosen.iter().zip(runs).zip(plans) {
+        if let Some(s) = run.short_for_check(plan) {
+            let dt_sample = plan.every as f64 * run.reference.dt;
+            let duration = (s.needed as f64 * dt_sample / tau1 * 100.0).ceil() / 100.0;
+            eprintln!(
+                "warning: {}/{}: each trajectory will have {} rows after the burn-in; `langevin-fem check` needs at least {} (mode 1 is taken every {} rows, {MIN_SERIES_LEN} samples at least) and will refuse these files: --duration-tau1 {duration} or more would serve",
+                job.scene.name, job.scene.runs[k].name, s.stationary, s.needed, s.sparsest
+            );
+        }
+    }
 }
 
 /// Bytes in a GiB.

@@ -38,7 +38,7 @@ pub(crate) use object::Continuum;
 pub(crate) use object::FemObject;
 pub(crate) use object::MEMO_ENTRIES;
 
-pub use stream::RowPlan;
+pub use stream::{RowPlan, ShortRows};
 
 /// Exact references for one mode of one run.
 #[derive(Debug, Clone, PartialEq)]
@@ -794,6 +794,14 @@ pub struct TrajectoryRecord {
     pub slope_samples: usize,
 }
 
+/// Steps (or data rows) between the samples of a mode of rate `rate` at spacing `dt`:
+/// about two per relaxation time, at least one. The cadence of [`LinearRun::mode_every`],
+/// for a simulation (`dt` its step) and for data (`dt` its row spacing, as `check` reads
+/// it).
+pub fn sample_every(rate: f64, dt: f64) -> u64 {
+    ((0.5 / rate) / dt).floor().max(1.0) as u64
+}
+
 /// A prepared run of a linear scene: model, references and sampling plan.
 pub struct LinearRun {
     /// The run specification.
@@ -1400,7 +1408,7 @@ impl LinearRun {
         let modes = prepared.modes;
         // Each mode is sampled about twice per relaxation time; the profile four times
         // per relaxation time of mode 1.
-        let every = |rate: f64| ((0.5 / rate) / dt).floor().max(1.0) as u64;
+        let every = |rate: f64| sample_every(rate, dt);
         let mode_every: Vec<u64> = modes
             .iter()
             .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))

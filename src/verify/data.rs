@@ -93,7 +93,7 @@ pub fn prepare_data_check(
     let rigid = rigid_data_references(&data_scene, data, d);
     let tangent = tangent_data_references(&data_scene, (data, &spec), &continuum, d, &mut notes);
     let dts = data.dt_sample;
-    let every = |rate: f64| ((0.5 / rate) / dts).floor().max(1.0) as u64;
+    let every = |rate: f64| crate::scene::linear::sample_every(rate, dts);
     let mode_every: Vec<u64> = modes
         .iter()
         .map(|m| every(m.rate_discrete.unwrap_or(m.rate_continuum)))

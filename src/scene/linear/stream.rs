@@ -6,6 +6,7 @@ use crate::data::TrajectoryFile;
 use crate::dynamics::Observer;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::stats::moments::MIN_SERIES_LEN;
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -22,6 +23,17 @@ pub struct RowPlan {
     pub rows: u64,
     /// Column names ([`crate::data::columns`]).
     pub columns: Vec<String>,
+}
+
+/// Trajectories too short for `check` ([`LinearRun::short_for_check`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShortRows {
+    /// Rows after the burn-in.
+    pub stationary: u64,
+    /// Rows between the samples of the sparsest checked series.
+    pub sparsest: u64,
+    /// Rows after the burn-in `check` asks for: [`MIN_SERIES_LEN`] samples of it.
+    pub needed: u64,
 }
 
 impl LinearRun {
@@ -89,6 +101,31 @@ impl LinearRun {
             every,
             sampled_steps,
             rows: total / every + 1,
+        })
+    }
+
+    /// Whether `check` could read trajectories written as `plan`: `None` if the sparsest
+    /// of the checked series (the slowest mode, sampled at the data's cadence
+    /// [`super::sample_every`] from the first row after the burn-in) has the
+    /// [`MIN_SERIES_LEN`] samples `check` needs; else the rows after the burn-in, the
+    /// rows between that mode's samples and the rows `check` asks for (as its refusal
+    /// states them).
+    pub fn short_for_check(&self, plan: &RowPlan) -> Option<ShortRows> {
+        let dts = plan.every as f64 * self.reference.dt;
+        let sparsest = self
+            .reference
+            .modes
+            .iter()
+            .map(|m| super::sample_every(m.rate_discrete.unwrap_or(m.rate_continuum), dts))
+            .max()?;
+        let stationary = plan
+            .rows
+            .saturating_sub(self.burn_in_steps.div_ceil(plan.every));
+        let min = MIN_SERIES_LEN as u64;
+        (stationary.div_ceil(sparsest) < min).then_some(ShortRows {
+            stationary,
+            sparsest,
+            needed: sparsest * min,
         })
     }
 
