@@ -841,9 +841,13 @@ fn read_records(
     let mut records = Vec::new();
     let mut products = Vec::new();
     let paths = data.paths(dir);
+    // the fewest rows a file has after the burn-in
+    let mut stationary = usize::MAX;
     for (j, path) in paths.iter().enumerate() {
         let key = format!("runs[{k}].files[{j}]");
         let table = read_trajectory(data, path, &key, cols, max_bytes)?;
+        let first = first_row(data, table.get(0, 0));
+        stationary = stationary.min(table.rows.saturating_sub(first));
         let (rec, tt) = read_record(run, data, (path, &key), &table, layout)?;
         records.push(rec);
         products.push(tt);
@@ -862,10 +866,9 @@ fn read_records(
             k,
             "files",
             format!(
-                "each trajectory needs at least {} stationary rows after burn_in = {:?} (mode 1 is taken every {sparsest} rows of dt_sample = {dts:?}, {MIN_SERIES_LEN} samples at least), got {}; write longer trajectories",
+                "each trajectory needs at least {} stationary rows after burn_in = {:?} (mode 1 is taken every {sparsest} rows of dt_sample = {dts:?}, {MIN_SERIES_LEN} samples at least), got {stationary} (a series of {shortest}); write longer trajectories",
                 sparsest.saturating_mul(MIN_SERIES_LEN as u64),
                 data.burn_in,
-                (shortest as u64).saturating_mul(sparsest)
             ),
         ));
     }
