@@ -152,12 +152,11 @@ impl ThetaBatch {
                 );
             }
             None => {
+                let (scale, g) = (self.scale, &mut self.g);
                 for (l, rng) in rngs.iter_mut().enumerate() {
                     let mut zeta = self.noise.stream(rng, &mut self.scratch);
                     zeta.prepare(n);
-                    for g in &mut self.g {
-                        g[l] = self.scale * zeta.next_prepared();
-                    }
+                    zeta.for_each_prepared(|i, v| g[i][l] = scale * v);
                 }
                 for g in &mut self.g {
                     g[rngs.len()..].fill(0.0);

@@ -359,6 +359,38 @@ impl<R: rand::Rng + ?Sized> NoiseStream<'_, R> {
     }
 }
 
+impl<R: ?Sized> NoiseStream<'_, R> {
+    /// Every entry at once, after [`NoiseStream::prepare`]`(n)`: `out(i, ζ_i)` for
+    /// `i = 0, 1, …, n − 1`, the values of [`NoiseStream::next_prepared`] (the same sums in
+    /// the same order) without its checks per entry; the stream is then exhausted.
+    ///
+    /// # Panics
+    /// If an entry has been pulled already or not every entry is prepared.
+    pub fn for_each_prepared(&mut self, mut out: impl FnMut(usize, f64)) {
+        assert_eq!(self.next, 0, "NoiseStream: entries pulled already");
+        match self.source {
+            Source::Consistent(l) => {
+                assert!(self.drawn >= self.n, "NoiseStream: not prepared");
+                for i in 0..self.n {
+                    out(i, l.mul_lower_row(self.scratch, i));
+                }
+            }
+            Source::ElementUniform { by_dof, .. } => {
+                let ready = self.n == 0 || by_dof.elements_needed[self.n - 1] <= self.drawn;
+                assert!(ready, "NoiseStream: not prepared");
+                for (i, w) in by_dof.start.windows(2).enumerate() {
+                    let mut s = 0.0;
+                    for &(e, bv) in &by_dof.entries[w[0]..w[1]] {
+                        s += self.scratch[e] * bv;
+                    }
+                    out(i, s);
+                }
+            }
+        }
+        self.next = self.n;
+    }
+}
+
 /// Stationary variance of the lowest `n_modes` discrete modes relative to equipartition
 /// (`kT/λ_i` of the discrete modes) under the paper's element-uniform noise (eq. 5), on
 /// uniform meshes of each element count in `elements`.
@@ -457,8 +489,9 @@ mod tests {
         assert!(serde_json::from_str::<NoiseModel>("\"uniform\"").is_err());
     }
 
-    /// The streamed draw equals the whole-vector draw bit for bit and leaves the generator
-    /// in the same state, for both models, on meshes of 1 to 12 elements.
+    /// The streamed draw (entry by entry, and all at once after `prepare`) equals the
+    /// whole-vector draw bit for bit and leaves the generator in the same state, for both
+    /// models, on meshes of 1 to 12 elements.
     #[test]
     fn stream_matches_draw_bit_for_bit() {
         use crate::rng::trajectory_rng;
@@ -470,8 +503,11 @@ mod tests {
             for model in NoiseModel::ALL {
                 let g = NoiseGenerator::new(model, &beam).unwrap();
                 let n = g.n_dofs();
-                let (mut r1, mut r2) =
-                    (trajectory_rng(11, ne as u64), trajectory_rng(11, ne as u64));
+                let (mut r1, mut r2, mut r3) = (
+                    trajectory_rng(11, ne as u64),
+                    trajectory_rng(11, ne as u64),
+                    trajectory_rng(11, ne as u64),
+                );
                 for _ in 0..3 {
                     let mut whole = vec![0.0; n];
                     g.draw(&mut r1, &mut whole);
@@ -479,8 +515,17 @@ mod tests {
                     let streamed: Vec<f64> = (0..n).map(|_| stream.next_value()).collect();
                     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                     assert_eq!(bits(&streamed), bits(&whole), "{model} at {ne} elements");
+                    let mut at_once = vec![f64::NAN; n];
+                    let mut stream = g.stream(&mut r3, &mut scratch);
+                    stream.prepare(n);
+                    stream.for_each_prepared(|i, v| at_once[i] = v);
+                    assert_eq!(bits(&at_once), bits(&whole), "{model} at {ne} elements");
                 }
-                assert_eq!(r1.next_u64(), r2.next_u64(), "{model} at {ne} elements");
+                let next = [r1.next_u64(), r2.next_u64(), r3.next_u64()];
+                assert!(
+                    next.iter().all(|&v| v == next[0]),
+                    "{model} at {ne} elements"
+                );
             }
         }
     }
