@@ -26,6 +26,7 @@
 
 mod drift;
 mod independence;
+mod lanes;
 
 use super::driver::Trajectory;
 use crate::error::{Error, Result};
@@ -64,6 +65,9 @@ struct Evaluation {
     inverse: Vec<[f64; 3]>,
     /// The inverse of each general block of `A_a` (row-major, stride 4).
     group_inverse: Vec<[f64; 16]>,
+    /// The determinant of each general block of `A_a`, NaN unless positive definite
+    /// ([`Proposal::CrankNicolson`]).
+    group_det: Vec<f64>,
     /// `d · ln det A_a`, `None` if `A_a` is not positive definite. For
     /// [`Proposal::OrnsteinUhlenbeck`], `−½ ln det Σ_a` of the proposal covariance `Σ_a`
     /// (the same role in the Hastings ratio: `ln q(a → ·)` is this minus `½|noise|²`).
@@ -159,6 +163,9 @@ pub struct ModalMetropolis<'m> {
     singles: Vec<[f64; 2]>,
     /// General blocks (the plate), after the pairs and singles.
     groups: Vec<Group>,
+    /// The indices of the general blocks of each size `k = 1 … 4` (entry `k − 1`), in
+    /// order: inverted [`lanes::BLOCK_LANES`] at a time.
+    groups_by_size: [Vec<usize>; 4],
     /// The rates in modal-coordinate order.
     rates: Vec<f64>,
     components: usize,
@@ -328,6 +335,7 @@ impl<'m> ModalMetropolis<'m> {
             kernel_force: 0.0,
             inverse: vec![[0.0; 3]; blocks],
             group_inverse: vec![[0.0; 16]; groups.len()],
+            group_det: vec![0.0; groups.len()],
             log_det: None,
             dg: Vec::new(),
             sm_denominator: 1.0,
@@ -340,6 +348,11 @@ impl<'m> ModalMetropolis<'m> {
             basis,
             pairs,
             singles,
+            groups_by_size: std::array::from_fn(|s| {
+                (0..groups.len())
+                    .filter(|&g| groups[g].k == s + 1)
+                    .collect()
+            }),
             groups,
             rates,
             components: nc,
@@ -703,28 +716,59 @@ impl<'m> ModalMetropolis<'m> {
             *inv = [1.0 / a, 0.0, 0.0];
             prod *= a;
         }
-        for (inv, grp) in e.group_inverse.iter_mut().zip(&self.groups) {
-            let mut a = [0.0; 16];
-            for r in 0..grp.k {
-                for c in 0..grp.k {
-                    a[4 * r + c] = -h * f * grp.b[4 * r + c];
-                }
-                a[5 * r] += 1.0 + h * grp.rates[r];
+        self.invert_groups(e, f, h);
+        for &det in &e.group_det {
+            if det.is_nan() {
+                ok = false;
+                continue;
             }
-            match spd_inverse(&a, grp.k) {
-                Some((ainv, det)) => {
-                    *inv = ainv;
-                    prod *= det;
-                    if !(PRODUCT_RANGE.0..PRODUCT_RANGE.1).contains(&prod) {
-                        log_det += prod.ln();
-                        prod = 1.0;
-                    }
-                }
-                None => ok = false,
+            prod *= det;
+            if !(PRODUCT_RANGE.0..PRODUCT_RANGE.1).contains(&prod) {
+                log_det += prod.ln();
+                prod = 1.0;
             }
         }
         log_det += prod.ln();
         e.log_det = (ok && log_det.is_finite()).then_some(self.components as f64 * log_det);
+    }
+
+    /// The inverse and determinant of each general block of `A_a = I + ½Δt(Λ − F B)`
+    /// (`f` the kernel force, `h = ½Δt`) into `e.group_inverse` and `e.group_det` (NaN
+    /// unless positive definite), [`lanes::BLOCK_LANES`] blocks of one size at a time
+    /// (the lanes left over hold the identity): per block the operations of
+    /// [`spd_inverse`], so the same bits.
+    fn invert_groups(&self, e: &mut Evaluation, f: f64, h: f64) {
+        use lanes::{BLOCK_LANES, spd_inverse_lanes};
+        for (s, indices) in self.groups_by_size.iter().enumerate() {
+            let k = s + 1;
+            for chunk in indices.chunks(BLOCK_LANES) {
+                let mut a = [[0.0; 16]; BLOCK_LANES];
+                for (q, m) in a.iter_mut().enumerate() {
+                    let Some(grp) = chunk.get(q).map(|&g| &self.groups[g]) else {
+                        for r in 0..k {
+                            m[5 * r] = 1.0;
+                        }
+                        continue;
+                    };
+                    for r in 0..k {
+                        for c in 0..k {
+                            m[4 * r + c] = -h * f * grp.b[4 * r + c];
+                        }
+                        m[5 * r] += 1.0 + h * grp.rates[r];
+                    }
+                }
+                let (inv, det) = match k {
+                    1 => spd_inverse_lanes::<1>(&a),
+                    2 => spd_inverse_lanes::<2>(&a),
+                    3 => spd_inverse_lanes::<3>(&a),
+                    _ => spd_inverse_lanes::<4>(&a),
+                };
+                for (q, &g) in chunk.iter().enumerate() {
+                    e.group_inverse[g] = inv[q];
+                    e.group_det[g] = det[q];
+                }
+            }
+        }
     }
 
     /// The proposal from `self.current` with noise `self.z` into `self.proposal.a`;
@@ -1225,6 +1269,7 @@ impl Default for Evaluation {
             kernel_force: 0.0,
             inverse: Vec::new(),
             group_inverse: Vec::new(),
+            group_det: Vec::new(),
             log_det: None,
             dg: Vec::new(),
             sm_denominator: 1.0,
