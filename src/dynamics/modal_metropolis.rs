@@ -140,6 +140,19 @@ impl Group {
         }
         h
     }
+
+    /// `A_b = I + h(Λ_b − F B_b)` at the kernel force `f`, `h = ½Δt` (row-major, stride
+    /// 4): the block of the Crank–Nicolson and Newton proposals' matrix `A_a`.
+    fn proposal_block(&self, f: f64, h: f64) -> [f64; 16] {
+        let mut a = [0.0; 16];
+        for r in 0..self.k {
+            for c in 0..self.k {
+                a[4 * r + c] = -h * f * self.b[4 * r + c];
+            }
+            a[5 * r] += 1.0 + h * self.rates[r];
+        }
+        a
+    }
 }
 
 /// What the modal coordinates are coordinates of (for the nodal state).
@@ -744,17 +757,9 @@ impl<'m> ModalMetropolis<'m> {
             for chunk in indices.chunks(BLOCK_LANES) {
                 let mut a = [[0.0; 16]; BLOCK_LANES];
                 for (q, m) in a.iter_mut().enumerate() {
-                    let Some(grp) = chunk.get(q).map(|&g| &self.groups[g]) else {
-                        for r in 0..k {
-                            m[5 * r] = 1.0;
-                        }
-                        continue;
-                    };
-                    for r in 0..k {
-                        for c in 0..k {
-                            m[4 * r + c] = -h * f * grp.b[4 * r + c];
-                        }
-                        m[5 * r] += 1.0 + h * grp.rates[r];
+                    match chunk.get(q) {
+                        Some(&g) => *m = self.groups[g].proposal_block(f, h),
+                        None => (0..k).for_each(|r| m[5 * r] = 1.0),
                     }
                 }
                 let (inv, det) = match k {
@@ -1014,14 +1019,7 @@ impl ModalMetropolis<'_> {
         let mut at = 0;
         for (inv, grp) in e.group_inverse.iter_mut().zip(&self.groups) {
             let k = grp.k;
-            let mut a = [0.0; 16];
-            for r in 0..k {
-                for col in 0..k {
-                    a[4 * r + col] = -h * f * grp.b[4 * r + col];
-                }
-                a[5 * r] += 1.0 + h * grp.rates[r];
-            }
-            match sym_inverse(&a, k) {
+            match sym_inverse(&grp.proposal_block(f, h), k) {
                 Some((ainv, det, neg)) => {
                     *inv = ainv;
                     negatives += neg;
