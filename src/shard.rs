@@ -730,12 +730,26 @@ impl ShardSet {
     /// The scenes, rebuilt from their text, and each one's seed note.
     ///
     /// # Errors
-    /// [`Error::Scene`] if a scene's text does not parse.
+    /// [`Error::Scene`] (exit 2) naming the first shard's manifest and the key
+    /// `scenes[k].text: <scene key>` if a scene's text does not parse or validate: the
+    /// text and its SHA-256 edited together after the shard ran (the scene's own file
+    /// or built-in label is not what the user must fix).
     pub fn scenes(&self) -> Result<Vec<(Scene, String)>> {
         self.manifest()
             .scenes
             .iter()
-            .map(|s| Ok((s.scene()?, s.seed_note.clone())))
+            .enumerate()
+            .map(|(k, s)| match s.scene() {
+                Ok(scene) => Ok((scene, s.seed_note.clone())),
+                Err(Error::Scene { key, message, .. }) => Err(self.refuse(
+                    &format!("scenes[{k}].text: {key}"),
+                    format!(
+                        "{message} (the text of scene {}, edited after the shard ran; rerun the shards)",
+                        s.name
+                    ),
+                )),
+                Err(e) => Err(e),
+            })
             .collect()
     }
 

@@ -2539,6 +2539,28 @@ fn manifest_cases() -> Vec<Case> {
                 m["scenes"][0]["text"] = Value::from("this is = = not TOML");
             }),
         ),
+        // The text and its SHA-256 edited together: the text's own key is named, under
+        // the manifest's, not the scene's original file or built-in label.
+        refused(
+            M,
+            VerifySet,
+            "scene-text-and-sha256-edited-everywhere",
+            &[
+                "shard.json",
+                "scenes[0].text: ",
+                "bogus_key",
+                "rerun the shards",
+            ],
+            on_every_manifest(3, |m| {
+                let t = m["scenes"][0]["text"].as_str().unwrap().replacen(
+                    "[filament]",
+                    "[filament]\nbogus_key = 3",
+                    1,
+                );
+                m["scenes"][0]["sha256"] = Value::from(sha256_hex(t.as_bytes()));
+                m["scenes"][0]["text"] = Value::from(t);
+            }),
+        ),
         refused(
             M,
             VerifySet,

@@ -12,6 +12,7 @@ mod common;
 
 use common::shards::{assert_same_outputs, merge, shards_of};
 use common::{TempDir, all_files, describe, fixture, run, stderr_of};
+use sha2::Digest;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -164,8 +165,8 @@ fn refused(dirs: &[&Path], out: &Path, names: &[&str]) {
 }
 
 /// What: merges that must be refused before anything is written: a missing shard, a
-/// duplicated one, one of another seed, budget, shard count or scene set, a damaged
-/// record file, and a directory that is not a shard.
+/// duplicated one, one of another seed, budget, shard count or scene set, a scene text
+/// edited with its hash, a damaged record file, and a directory that is not a shard.
 /// Reference: exit 2, the message naming the shard (its directory and index) and what
 /// differs; the earlier report in the output directory untouched.
 #[test]
@@ -235,6 +236,38 @@ fn merge_refuses_missing_duplicate_foreign_and_damaged_shards() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
     refused(&[&s1, &other, &s3], &out, &["scenes", "tiny-compression"]);
+
+    // A scene's text and its SHA-256 edited together in every manifest: the manifest
+    // and the text's key are named (not the scene's original file).
+    let edited = tmp.join("edited");
+    for k in ["1", "2", "3"] {
+        common::copy_tree(&root.join(k), &edited.join(k));
+        let path = edited.join(k).join("shard.json");
+        let mut m: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        let text = m["scenes"][0]["text"].as_str().unwrap().replacen(
+            "[filament]",
+            "[filament]\nbogus_key = 3",
+            1,
+        );
+        let hash: String = sha2::Sha256::digest(text.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        m["scenes"][0]["sha256"] = hash.into();
+        m["scenes"][0]["text"] = text.into();
+        std::fs::write(&path, serde_json::to_vec(&m).unwrap()).unwrap();
+    }
+    let first = edited.join("1").join("shard.json");
+    refused(
+        &[&edited],
+        &out,
+        &[
+            first.to_str().unwrap(),
+            "scenes[0].text: filament.bogus_key",
+            "rerun the shards",
+        ],
+    );
 
     let record = s2.join("records/tiny-linear/crank-nicolson.lin");
     let mut bytes = std::fs::read(&record).unwrap();
