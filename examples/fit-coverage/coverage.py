@@ -3,7 +3,7 @@
 
 For seeds 1..N: `langevin-fem run` of a scene's run at that seed, then `langevin-fem fit`
 on its output; counts how often each interval covers the true parameter (the sidecar's:
-EI and xi with kT known, kT with EI known) and compares the count with the binomial law
+EI, a membrane's kappa, and xi with kT known, kT with EI known) and compares the count with the binomial law
 of the nominal level: the exact two-sided 99 % range of covered counts. Pure Python
 (standard library only). Exit 0 when every parameter's count is in its range.
 
@@ -64,7 +64,7 @@ def main():
         subprocess.run([args.bin, "-q", "fit", "--scene", args.scene, "--data", data, "--out", out],
                        check=True, stdout=subprocess.DEVNULL)
         side = json.load(open(os.path.join(data, "data.json")))
-        f = side["filament"]
+        f = side.get("filament") or side["membrane"]
         truth = {"bending_rigidity": f["bending_rigidity"], "drag": f["drag"],
                  "kt_given_bending_rigidity": f["kt"]}
         fit = json.load(open(os.path.join(out, "fit.json")))["runs"][0]

@@ -1,13 +1,15 @@
 //! `langevin-fem fit`: the bending rigidity and the drag (and, with EI known, the noise
-//! temperature) that a filament's data imply, with 95 % intervals
+//! temperature) that a filament's or a membrane's data imply, with 95 % intervals
 //! ([`langevin_fem::verify::fit`]), from the checks `check` applies to the same data.
 
 use super::Verbosity;
 use super::check::{CheckArgs, evaluate, load_data, print_verdict};
 use clap::Args;
+use langevin_fem::data::{DataFilament, DataMembrane, DataSidecar};
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
-use langevin_fem::verify::fit::{RunFit, estimate_text, fit_runs};
+use langevin_fem::spectral::membrane::Membrane;
+use langevin_fem::verify::fit::{FitBase, RunFit, ShareOf, estimate_text, fit_runs};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -16,11 +18,15 @@ const EXAMPLES: &str = "\
 Examples:
   langevin-fem run -s hinged-linear-2d --run crank-nicolson -o traj
   langevin-fem fit -s hinged-linear-2d -d traj -o traj-fit
+  langevin-fem run -s membrane-periodic --run crank-nicolson -o mem
+  langevin-fem fit -s membrane-periodic -d mem -o mem-fit       kappa, sigma held known
 
-Prints per run EI (from the mode variances, kT known), xi (from the decay rates with that
-EI) and kT (with EI known instead), each with its 95 % interval; writes them to fit.json in
-the output directory, beside the report of `check` on the same data. Exit 0 when every run
-gave a fit, 3 when a run's checks hold no mode variance to fit, 2 on bad input.";
+Prints per run EI (a membrane: kappa) from the mode variances with kT known, xi from the
+decay rates with that EI, and kT with EI known instead, each with its 95 % interval;
+writes them to fit.json in the output directory, beside the report of `check` on the same
+data. A membrane's tension sigma is held at the sidecar's value: its modes' variances are
+regressed on their bending shares kappa q^4/(kappa q^4 + sigma q^2). Exit 0 when every
+run gave a fit, 3 when a run's checks hold no mode variance to fit, 2 on bad input.";
 
 /// Command-line arguments of `langevin-fem fit`: those of `check`.
 #[derive(Debug, Args)]
@@ -39,19 +45,82 @@ struct FitFile<'a> {
     runs: &'a [RunFit],
 }
 
+/// The object of a data set, as `fit` scales its parameters.
+enum FitObject {
+    /// A filament: EI, every mode's bending share 1.
+    Filament(DataFilament),
+    /// A membrane: κ, with the tension σ held at the sidecar's value.
+    Membrane(DataMembrane, Option<Membrane>),
+}
+
+impl FitObject {
+    /// The object of `sidecar`, if it has one `fit` serves.
+    fn of(sidecar: &DataSidecar) -> Option<FitObject> {
+        match (&sidecar.filament, &sidecar.membrane) {
+            (Some(f), _) => Some(FitObject::Filament(*f)),
+            (None, Some(m)) => Some(FitObject::Membrane(*m, Membrane::new(m.params()).ok())),
+            (None, None) => None,
+        }
+    }
+
+    /// The name of the bending rigidity in the printed fit.
+    fn name(&self) -> &'static str {
+        match self {
+            FitObject::Filament(_) => "EI",
+            FitObject::Membrane(..) => "kappa",
+        }
+    }
+
+    /// What is held known besides kT (`, sigma = 20 held`), or nothing.
+    fn held(&self) -> String {
+        match self {
+            FitObject::Membrane(m, _) if m.tension != 0.0 => {
+                format!(", sigma = {} held", m.tension)
+            }
+            _ => String::new(),
+        }
+    }
+
+    /// The bending share of checked mode `mode` (`n=k`, the k-th slowest,
+    /// [`Membrane::modes`]): [`Membrane::bending_share`].
+    fn share(&self, mode: &str) -> Option<f64> {
+        let FitObject::Membrane(_, Some(m)) = self else {
+            return None;
+        };
+        let k: usize = mode.strip_prefix("n=")?.parse().ok()?;
+        let modes = m.modes(k).ok()?;
+        Some(m.bending_share(*modes.get(k.checked_sub(1)?)?))
+    }
+
+    /// The sidecar's parameters, with `share` (this object's [`Self::share`]) for a
+    /// membrane under tension.
+    fn base<'a>(&self, share: ShareOf<'a>) -> FitBase<'a> {
+        let (bending_rigidity, drag, kt, tension) = match self {
+            FitObject::Filament(f) => (f.bending_rigidity, f.drag, f.kt, 0.0),
+            FitObject::Membrane(m, _) => (m.bending_rigidity, m.drag, m.kt, m.tension),
+        };
+        FitBase {
+            bending_rigidity,
+            drag,
+            kt,
+            shares: (tension != 0.0).then_some(share),
+        }
+    }
+}
+
 /// Runs the checks of `check`, then the fit of every run; prints the fits after the
 /// scene lines.
 pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
     let start = Instant::now();
     let args = args.check;
     let sidecar = load_data(&args)?;
-    let Some(filament) = &sidecar.filament else {
-        return Err(Error::invalid(
+    let object = FitObject::of(&sidecar).ok_or_else(|| {
+        Error::invalid(
             "--data",
             args.data.display(),
-            "filament data (a `filament` table in data.json): fit estimates EI and xi of a filament",
-        ));
-    };
+            "filament or membrane data (a `filament` or `membrane` table in data.json): fit estimates their bending rigidity and drag",
+        )
+    })?;
     let (scene, mut summary, report) = evaluate(&args, &sidecar, verbosity.progress())?;
     if scene.compression.is_some() {
         return Err(Error::invalid(
@@ -60,14 +129,11 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             "a linear scene (mode variances and decay rates): a compression scene's force data do not fit EI this way",
         ));
     }
-    let fits = fit_runs(&summary.scenes[0], filament);
+    let share = |mode: &str| object.share(mode);
+    let fits = fit_runs(&summary.scenes[0], &object.base(&share));
     let mut lines = Vec::new();
     for f in &fits {
-        let (Some(v), Some(ei), Some(kt)) = (
-            &f.variance,
-            &f.bending_rigidity,
-            &f.kt_given_bending_rigidity,
-        ) else {
+        let (Some(v), Some(kt)) = (&f.variance, &f.kt_given_bending_rigidity) else {
             return Err(Error::run_failed(
                 format!("data run {}", f.run),
                 "fit",
@@ -78,11 +144,43 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
                 ),
             ));
         };
-        let mut parts = vec![estimate_text("EI", ei, v, "variances", "kT known")];
+        // Under tension, a checked mode without a bending share (not `n=k`).
+        let Some(ei) = &f.bending_rigidity else {
+            return Err(Error::run_failed(
+                format!("data run {}", f.run),
+                "fit",
+                Error::invalid(
+                    "mode-variance checks",
+                    v.modes.join(", "),
+                    "checked modes n=k of the membrane, each with a bending share",
+                ),
+            ));
+        };
+        let (name, held) = (object.name(), object.held());
+        let bending = f.bending_regression.as_ref().unwrap_or(v);
+        let mut parts = vec![estimate_text(
+            name,
+            ei,
+            bending,
+            "variances",
+            &format!("kT known{held}"),
+        )];
         if let (Some(r), Some(xi)) = (&f.rate, &f.drag) {
-            parts.push(estimate_text("xi", xi, r, "decay rates", "with that EI"));
+            parts.push(estimate_text(
+                "xi",
+                xi,
+                r,
+                "decay rates",
+                &format!("with that {name}"),
+            ));
         }
-        parts.push(estimate_text("kT", kt, v, "variances", "EI known instead"));
+        parts.push(estimate_text(
+            "kT",
+            kt,
+            v,
+            "variances",
+            &format!("{name} known instead"),
+        ));
         summary.scenes[0].notes.push(format!(
             "fit, run {} (95 % intervals): {}",
             f.run,

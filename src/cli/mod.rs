@@ -115,7 +115,8 @@ enum Command {
     /// the trajectory data format (the format `run` writes).
     Check(check::CheckArgs),
     /// The bending rigidity (from the mode variances) and the drag (from the decay rates)
-    /// that a filament's data imply, with 95 % intervals, beside the report of `check`.
+    /// that a filament's or a membrane's data imply, with 95 % intervals, beside the
+    /// report of `check`.
     Fit(fit::FitArgs),
     /// List the scenes: the built-in ones, and with --scene-dir the files there.
     List(list::ListArgs),

@@ -718,25 +718,16 @@ mod tests {
                 variance_correlation: None,
             }
         };
-        let scene = SceneSummary {
-            name: "s".into(),
-            passed: true,
-            wall_seconds: 0.0,
-            figures: vec![],
-            captions: vec![],
-            tables: vec![],
-            notes: vec![],
-            warnings: vec![],
-            skipped: vec![],
-            checks: vec![
+        let scene = SceneSummary::of_checks(
+            "s",
+            vec![
                 check("a/mode-variance/n=1", Some(0.2)),
                 check("a/mode-variance/n=2", Some(0.02)),
                 check("a/decay-rate/n=2", Some(0.1)),
                 check("a/decay-rate/n=3", None),
                 check("b/mode-variance/n=1", Some(0.04)),
             ],
-            detectable: vec![],
-        };
+        );
         let d = detectable_deviations(&scene, 0.01);
         let lam = detectable_shift(0.01 / 5.0, None).unwrap();
         let got: Vec<(&str, &str, &str)> = d

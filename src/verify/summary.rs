@@ -260,6 +260,26 @@ pub struct SceneSummary {
     pub detectable: Vec<crate::verify::diagnosis::Detectable>,
 }
 
+impl SceneSummary {
+    /// The summary of scene `name` holding only `checks` (passed if every check passed;
+    /// no figures, notes or wall time), e.g. for the analyses of a summary's checks.
+    pub fn of_checks(name: &str, checks: Vec<CheckResult>) -> SceneSummary {
+        SceneSummary {
+            name: name.to_string(),
+            passed: checks.iter().all(|c| c.passed),
+            wall_seconds: 0.0,
+            figures: vec![],
+            captions: vec![],
+            tables: vec![],
+            notes: vec![],
+            warnings: vec![],
+            skipped: vec![],
+            checks,
+            detectable: vec![],
+        }
+    }
+}
+
 /// The result of a verification run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {

@@ -343,6 +343,15 @@ impl Membrane {
         self.c_of_q2(self.wavenumber_sq(mode))
     }
 
+    /// The bending share s_q = ∂ln c_q/∂ln κ = κq⁴/(κq⁴ + σq²) of `mode`'s stiffness
+    /// (M1) at fixed σ: 1 at σ = 0, below 1 under tension, above 1 under compression
+    /// (NaN if it is not a mode). The regressor of `fit`'s κ under a tension held known.
+    pub fn bending_share(&self, mode: MembraneMode) -> f64 {
+        let q2 = self.wavenumber_sq(mode);
+        let bending = self.params.bending_rigidity * q2 * q2;
+        bending / (bending + self.params.tension * q2)
+    }
+
     /// Relaxation rate λ_q = c_q/ξ of `mode` (M2) (NaN if it is not a mode).
     pub fn mode_rate(&self, mode: MembraneMode) -> f64 {
         self.stiffness(mode) / self.params.drag
@@ -572,6 +581,40 @@ mod tests {
             boundary,
         })
         .unwrap()
+    }
+
+    // What: the bending share s_q = ∂ln c_q/∂ln κ at fixed σ.
+    // Reference: a central difference of ln c_q in ln κ (step 1e-4; c_q is linear in κ, so
+    // the difference is exact up to rounding and the O(step²) curvature of ln c_q);
+    // exactly 1 at σ = 0; above 1 under compression. Tolerance: 1e-7.
+    #[test]
+    fn bending_share_is_the_log_derivative_in_kappa() {
+        for b in [
+            MembraneBoundary::SimplySupported,
+            MembraneBoundary::Periodic,
+        ] {
+            let mb = membrane(b);
+            assert!(mb.params.tension > 0.0);
+            let at = |kappa: f64, tension: f64| {
+                Membrane::new(MembraneParams {
+                    bending_rigidity: kappa,
+                    tension,
+                    ..mb.params
+                })
+                .unwrap()
+            };
+            let (k, h) = (mb.params.bending_rigidity, 1e-4_f64);
+            for mode in mb.modes(20).unwrap() {
+                let c = |kappa: f64| at(kappa, mb.params.tension).stiffness(mode).ln();
+                let fd = (c(k * h.exp()) - c(k * (-h).exp())) / (2.0 * h);
+                let s = mb.bending_share(mode);
+                assert!((s - fd).abs() < 1e-7, "{mode:?}: {s} vs {fd}");
+                assert!(s > 0.0 && s < 1.0);
+                assert_eq!(at(k, 0.0).bending_share(mode), 1.0);
+                let q2 = mb.params.min_wavenumber_sq();
+                assert!(at(k, -0.5 * k * q2).bending_share(mode) > 1.0);
+            }
+        }
     }
 
     // What: (M2)–(M3): rate c_q/ξ; variance kT/(c_q‖φ‖²) with ‖φ‖² = A/4 or A/2; the
