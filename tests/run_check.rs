@@ -1307,24 +1307,20 @@ fn fit_recovers_the_parameters_with_intervals() {
     assert_eq!(o.status.code(), Some(2), "{}", describe(&args, &o));
 }
 
-/// `fit` of membrane data (a tension σ = 20 held known): membrane-periodic's
-/// Crank–Nicolson run simulated at κ = 1.1 with a sidecar that says κ = 1. The fitted κ
-/// covers the simulated 1.1 and excludes the sidecar's 1, with one factor over the modes
-/// (the regression on the modes' bending shares κq⁴/c_q; scaling every variance alike,
-/// as for a filament, gives κ ≈ 1.09 here, outside this interval); ξ covers 1; the
-/// printed fit names κ and the tension held.
-#[test]
-fn fit_recovers_a_membranes_bending_rigidity_under_tension() {
-    let dir = TempDir::new("run-check-fit-membrane");
-    let scene = dir.join_str("kappa-11.toml");
+/// Membrane-periodic's Crank–Nicolson run simulated with `key = value` (its scene's
+/// `key = 1.0` or `20.0` replaced) into `dir/name`, and its sidecar then set back to the
+/// scene's value; returns the data directory.
+fn membrane_data_off(dir: &TempDir, name: &str, key: &str, value: &str) -> String {
+    let scene = dir.join_str(&format!("{name}.toml"));
     let text = std::fs::read_to_string(fixture("verification/membrane-periodic.toml")).unwrap();
-    assert!(text.contains("\nbending_rigidity = 1.0\n") && text.contains("\ntension = 20.0\n"));
-    std::fs::write(
-        &scene,
-        text.replace("\nbending_rigidity = 1.0\n", "\nbending_rigidity = 1.1\n"),
-    )
-    .unwrap();
-    let data = dir.join_str("data");
+    let old = match key {
+        "bending_rigidity" => "1.0",
+        _ => "20.0",
+    };
+    let line = format!("\n{key} = {old}\n");
+    assert!(text.contains(&line), "{line}");
+    std::fs::write(&scene, text.replace(&line, &format!("\n{key} = {value}\n"))).unwrap();
+    let data = dir.join_str(name);
     let args = [
         "run",
         "-q",
@@ -1339,33 +1335,59 @@ fn fit_recovers_a_membranes_bending_rigidity_under_tension() {
     assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
     let side_path = Path::new(&data).join("data.json");
     let mut side = json(&side_path);
-    side["membrane"]["bending_rigidity"] = 1.0.into();
+    side["membrane"][key] = old.parse::<f64>().unwrap().into();
     std::fs::write(&side_path, serde_json::to_vec_pretty(&side).unwrap()).unwrap();
+    data
+}
 
-    let out = dir.join_str("fit");
-    let args = [
-        "fit",
-        "--scene",
-        "membrane-periodic",
-        "--data",
-        &data,
-        "--out",
-        &out,
-    ];
-    let o = run(&args);
-    let d = describe(&args, &o);
-    let stdout = String::from_utf8_lossy(&o.stdout);
+/// `fit` of membrane-periodic data (σ = 20) against a sidecar that misstates κ or σ:
+/// - simulated at κ = 1.1 with a sidecar of 1: κ with σ held (the regression on the modes'
+///   bending shares κq⁴/c_q) covers 1.1 and excludes 1, with one factor over the modes
+///   (scaling every variance alike, as for a filament, gives κ ≈ 1.09 here, outside this
+///   interval); ξ covers 1; κ and σ fitted together cover 1.1 and 20;
+/// - simulated at σ = 25 with a sidecar of 20: κ and σ together cover 1 and 25, σ's
+///   interval excludes 20, and the fit with σ held says one factor does not explain the
+///   modes (χ² p < 1e-3).
+///
+/// The printed fit names κ, the tension held and the joint fit.
+#[test]
+fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
+    let dir = TempDir::new("run-check-fit-membrane");
+    let fit = |data: &str, out: &str| {
+        let args = [
+            "fit",
+            "--scene",
+            "membrane-periodic",
+            "--data",
+            data,
+            "--out",
+            out,
+        ];
+        let o = run(&args);
+        let d = describe(&args, &o);
+        let f = json(&Path::new(out).join("fit.json"));
+        (
+            f["runs"][0].clone(),
+            String::from_utf8_lossy(&o.stdout).to_string(),
+            d,
+        )
+    };
+    let interval = |v: &serde_json::Value| {
+        let i = &v["interval"];
+        (i[0].as_f64().unwrap(), i[1].as_f64().unwrap())
+    };
+
+    let data = membrane_data_off(&dir, "kappa", "bending_rigidity", "1.1");
+    let (run0, stdout, d) = fit(&data, &dir.join_str("fit-kappa"));
     assert!(
         stdout.contains("    kappa = ") && stdout.contains("kT known, sigma = 20 held"),
         "{d}"
     );
-    let f = json(&Path::new(&out).join("fit.json"));
-    let run0 = &f["runs"][0];
-    let interval = |key: &str| {
-        let i = &run0[key]["interval"];
-        (i[0].as_f64().unwrap(), i[1].as_f64().unwrap())
-    };
-    let (lo, hi) = interval("bending_rigidity");
+    assert!(
+        stdout.contains(" together from the variances of modes "),
+        "{d}"
+    );
+    let (lo, hi) = interval(&run0["bending_rigidity"]);
     assert!(
         lo <= 1.1 && 1.1 <= hi && lo > 1.0 && hi / lo < 1.02,
         "kappa [{lo}, {hi}]: {d}"
@@ -1373,8 +1395,24 @@ fn fit_recovers_a_membranes_bending_rigidity_under_tension() {
     assert!(lo > 1.09, "kappa [{lo}, {hi}]");
     let p = run0["bending_regression"]["p_value"].as_f64().unwrap();
     assert!(p > 1e-3, "one factor over the modes: p = {p}");
-    let (lo, hi) = interval("drag");
+    let (lo, hi) = interval(&run0["drag"]);
     assert!(lo <= 1.0 && 1.0 <= hi, "xi [{lo}, {hi}]");
+    let (lo, hi) = interval(&run0["joint"]["bending_rigidity"]);
+    assert!(lo <= 1.1 && 1.1 <= hi, "joint kappa [{lo}, {hi}]");
+    let (lo, hi) = interval(&run0["joint"]["tension"]);
+    assert!(lo <= 20.0 && 20.0 <= hi, "joint sigma [{lo}, {hi}]");
+
+    let data = membrane_data_off(&dir, "sigma", "tension", "25.0");
+    let (run0, _, d) = fit(&data, &dir.join_str("fit-sigma"));
+    let (lo, hi) = interval(&run0["joint"]["tension"]);
+    assert!(
+        lo <= 25.0 && 25.0 <= hi && lo > 20.0,
+        "joint sigma [{lo}, {hi}]: {d}"
+    );
+    let (lo, hi) = interval(&run0["joint"]["bending_rigidity"]);
+    assert!(lo <= 1.0 && 1.0 <= hi, "joint kappa [{lo}, {hi}]");
+    let p = run0["bending_regression"]["p_value"].as_f64().unwrap();
+    assert!(p < 1e-3, "sigma held at the wrong value: p = {p}");
 }
 
 /// What: `check` shows progress on stderr while it prepares references that take

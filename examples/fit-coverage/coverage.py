@@ -3,7 +3,8 @@
 
 For seeds 1..N: `langevin-fem run` of a scene's run at that seed, then `langevin-fem fit`
 on its output; counts how often each interval covers the true parameter (the sidecar's:
-EI, a membrane's kappa, and xi with kT known, kT with EI known) and compares the count with the binomial law
+EI, a membrane's kappa, and xi with kT known, kT with EI known; for a membrane also kappa
+and sigma fitted together) and compares the count with the binomial law
 of the nominal level: the exact two-sided 99 % range of covered counts. Pure Python
 (standard library only). Exit 0 when every parameter's count is in its range.
 
@@ -11,7 +12,8 @@ Usage: coverage.py BIN WORKDIR [--scene S] [--run R] [--seeds N] [--first-seed S
 
 Seeds S .. S+N-1 (default 1 .. N). Besides the counts it prints, per parameter, the
 variance of the normal scores ln(value/truth)/s.e.(ln) over the seeds (1 for honest
-errors), with its approximate 99 % range 1 +- 2.58 sqrt(2/(N-1)).
+errors; (value - truth)/s.e. for sigma), with its approximate 99 % range
+1 +- 2.58 sqrt(2/(N-1)).
 """
 
 import argparse
@@ -68,12 +70,24 @@ def main():
         truth = {"bending_rigidity": f["bending_rigidity"], "drag": f["drag"],
                  "kt_given_bending_rigidity": f["kt"]}
         fit = json.load(open(os.path.join(out, "fit.json")))["runs"][0]
+        if "joint" in fit:
+            # A membrane's kappa and sigma fitted together (sigma on the linear scale).
+            fit["joint_kappa"] = fit["joint"]["bending_rigidity"]
+            fit["joint_sigma"] = fit["joint"]["tension"]
+            truth["joint_kappa"] = f["bending_rigidity"]
+            truth["joint_sigma"] = f["tension"]
+            for k in ("joint_kappa", "joint_sigma"):
+                covered.setdefault(k, 0)
+                scores.setdefault(k, [])
         row = [seed]
         for k in covered:
             lo, hi = fit[k]["interval"]
             ok = lo <= truth[k] <= hi
             covered[k] += ok
-            scores[k].append(math.log(fit[k]["value"] / truth[k]) / fit[k]["log_std_error"])
+            if "log_std_error" in fit[k]:
+                scores[k].append(math.log(fit[k]["value"] / truth[k]) / fit[k]["log_std_error"])
+            else:
+                scores[k].append((fit[k]["value"] - truth[k]) / fit[k]["std_error"])
             row += [fit[k]["value"], lo, hi, int(ok)]
         rows.append(row)
         shutil.rmtree(data)

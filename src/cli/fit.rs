@@ -9,7 +9,9 @@ use langevin_fem::data::{DataFilament, DataMembrane, DataSidecar};
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::spectral::membrane::Membrane;
-use langevin_fem::verify::fit::{FitBase, RunFit, ShareOf, estimate_text, fit_runs};
+use langevin_fem::verify::fit::{
+    FitBase, JointFit, RunFit, SensitivityOf, ShareOf, estimate_text, fit_runs,
+};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -19,14 +21,15 @@ Examples:
   langevin-fem run -s hinged-linear-2d --run crank-nicolson -o traj
   langevin-fem fit -s hinged-linear-2d -d traj -o traj-fit
   langevin-fem run -s membrane-periodic --run crank-nicolson -o mem
-  langevin-fem fit -s membrane-periodic -d mem -o mem-fit       kappa, sigma held known
+  langevin-fem fit -s membrane-periodic -d mem -o mem-fit       kappa; kappa and sigma
 
 Prints per run EI (a membrane: kappa) from the mode variances with kT known, xi from the
 decay rates with that EI, and kT with EI known instead, each with its 95 % interval;
 writes them to fit.json in the output directory, beside the report of `check` on the same
-data. A membrane's tension sigma is held at the sidecar's value: its modes' variances are
-regressed on their bending shares kappa q^4/(kappa q^4 + sigma q^2). Exit 0 when every
-run gave a fit, 3 when a run's checks hold no mode variance to fit, 2 on bad input.";
+data. For a membrane, kappa is fitted with the tension sigma held at the sidecar's value
+(its modes' variances regressed on their bending shares kappa q^4/(kappa q^4 + sigma q^2)),
+then kappa and sigma together. Exit 0 when every run gave a fit, 3 when a run's checks
+hold no mode variance to fit, 2 on bad input.";
 
 /// Command-line arguments of `langevin-fem fit`: those of `check`.
 #[derive(Debug, Args)]
@@ -81,20 +84,27 @@ impl FitObject {
         }
     }
 
-    /// The bending share of checked mode `mode` (`n=k`, the k-th slowest,
-    /// [`Membrane::modes`]): [`Membrane::bending_share`].
-    fn share(&self, mode: &str) -> Option<f64> {
+    /// The log sensitivities [`Membrane::bending_share`] and
+    /// [`Membrane::tension_sensitivity`] of checked mode `mode` (`n=k`, the k-th slowest,
+    /// [`Membrane::modes`]); `None` for a filament.
+    fn sensitivities(&self, mode: &str) -> Option<[f64; 2]> {
         let FitObject::Membrane(_, Some(m)) = self else {
             return None;
         };
         let k: usize = mode.strip_prefix("n=")?.parse().ok()?;
         let modes = m.modes(k).ok()?;
-        Some(m.bending_share(*modes.get(k.checked_sub(1)?)?))
+        let mode = *modes.get(k.checked_sub(1)?)?;
+        Some([m.bending_share(mode), m.tension_sensitivity(mode)])
+    }
+
+    /// The bending share of checked mode `mode` ([`Self::sensitivities`]).
+    fn share(&self, mode: &str) -> Option<f64> {
+        self.sensitivities(mode).map(|s| s[0])
     }
 
     /// The sidecar's parameters, with `share` (this object's [`Self::share`]) for a
     /// membrane under tension.
-    fn base<'a>(&self, share: ShareOf<'a>) -> FitBase<'a> {
+    fn base<'a>(&self, share: ShareOf<'a>, sensitivities: SensitivityOf<'a>) -> FitBase<'a> {
         let (bending_rigidity, drag, kt, tension) = match self {
             FitObject::Filament(f) => (f.bending_rigidity, f.drag, f.kt, 0.0),
             FitObject::Membrane(m, _) => (m.bending_rigidity, m.drag, m.kt, m.tension),
@@ -104,6 +114,7 @@ impl FitObject {
             drag,
             kt,
             shares: (tension != 0.0).then_some(share),
+            tension: matches!(self, FitObject::Membrane(..)).then_some((tension, sensitivities)),
         }
     }
 }
@@ -130,7 +141,8 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
         ));
     }
     let share = |mode: &str| object.share(mode);
-    let fits = fit_runs(&summary.scenes[0], &object.base(&share));
+    let sensitivities = |mode: &str| object.sensitivities(mode);
+    let fits = fit_runs(&summary.scenes[0], &object.base(&share, &sensitivities));
     let mut lines = Vec::new();
     for f in &fits {
         let (Some(v), Some(kt)) = (&f.variance, &f.kt_given_bending_rigidity) else {
@@ -181,6 +193,9 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             "variances",
             &format!("{name} known instead"),
         ));
+        if let Some(j) = &f.joint {
+            parts.push(joint_text(j));
+        }
         summary.scenes[0].notes.push(format!(
             "fit, run {} (95 % intervals): {}",
             f.run,
@@ -201,4 +216,33 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
     write_report(report, &summary)?;
     print_verdict(&args, &summary, verbosity, start, &lines);
     Ok(0)
+}
+
+/// `kappa = 1.0989 [1.0954, 1.1025] and sigma = 19.93 [19.21, 20.65] together from the
+/// variances of modes 1, …, 24, kT known (correlation -0.93; χ² p = 0.559)`.
+fn joint_text(j: &JointFit) -> String {
+    let f = |v: f64| {
+        if (0.1..1e4).contains(&v.abs()) {
+            format!("{v:.4}")
+        } else {
+            format!("{v:.4e}")
+        }
+    };
+    let (k, s) = (&j.bending_rigidity, &j.tension);
+    format!(
+        "kappa = {} [{}, {}] and sigma = {} [{}, {}] together from the variances of modes {}, kT known (correlation {:.2}; χ² p = {:.3})",
+        f(k.value),
+        f(k.interval[0]),
+        f(k.interval[1]),
+        f(s.value),
+        f(s.interval[0]),
+        f(s.interval[1]),
+        j.modes
+            .iter()
+            .map(|m| m.trim_start_matches("n="))
+            .collect::<Vec<_>>()
+            .join(", "),
+        j.correlation,
+        j.p_value
+    )
 }

@@ -40,7 +40,11 @@
 //! weights; kT with κ known is the plain pool, as above (kT scales every mode alike).
 //! Scaling every variance alike instead would mistake tension-dominated modes, which
 //! hardly feel κ, for noise (a run at κ = 1.1 under σ = 20: κ = 1.09 with an interval
-//! that misses 1.1; tested).
+//! that misses 1.1; tested). When σ is not known either, κ and σ are fitted together
+//! ([`JointFit`]): ln r_var,n = −sₙ ln(κ/κ₀) − uₙ(σ − σ₀) with uₙ = ∂ln kₙ/∂σ = q²/kₙ,
+//! a two-parameter weighted least-squares fit (modes − 2 dof) whose covariance gives both
+//! intervals and their correlation; the tension-dominated modes fix σ, the
+//! bending-dominated ones κ.
 //!
 //! **Exactness.** The scaling is exact for the continuum, the spectral model and the
 //! stationary variances of the exact-modal and Crank–Nicolson integrators (their
@@ -170,6 +174,112 @@ pub struct FitBase<'a> {
     /// parameters: κq⁴/(κq⁴ + σq²) for a membrane under tension σ, held at the sidecar's
     /// value; `None` when every mode's is 1 (the filament, a membrane at σ = 0).
     pub shares: Option<ShareOf<'a>>,
+    /// A membrane's tension σ₀ and, per mode, its log sensitivities
+    /// (∂ln kₙ/∂ln κ, ∂ln kₙ/∂σ) = (κq⁴, q²)/kₙ at these parameters, for the joint fit of
+    /// κ and σ ([`JointFit`]); `None` for a filament.
+    pub tension: Option<(f64, SensitivityOf<'a>)>,
+}
+
+/// A mode's log sensitivities (∂ln kₙ/∂ln κ, ∂ln kₙ/∂σ) by its check's parameter (`n=k`),
+/// if it has them ([`FitBase::tension`]).
+pub type SensitivityOf<'a> = &'a dyn Fn(&str) -> Option<[f64; 2]>;
+
+/// κ and σ fitted together from a membrane's mode variances, kT known: the weighted
+/// least-squares fit of ln r_var,n = −sₙ·ln(κ/κ₀) − uₙ·(σ − σ₀) over the modes (first
+/// order in the parameters' errors, as every fit here; sₙ, uₙ the sensitivities of
+/// [`FitBase::tension`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointFit {
+    /// The modes used.
+    pub modes: Vec<String>,
+    /// κ, its interval exp(±z·s.e.) on the log scale.
+    pub bending_rigidity: Estimate,
+    /// σ, its interval ±z·s.e.
+    pub tension: LinearEstimate,
+    /// The correlation of the estimates of ln κ and σ.
+    pub correlation: f64,
+    /// χ² of the modes about the fit (modes − 2 dof).
+    pub chi2: f64,
+    /// Its p-value.
+    pub p_value: f64,
+}
+
+/// A parameter estimated on the linear scale: the estimate, its interval at [`LEVEL`]
+/// and its standard error.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinearEstimate {
+    /// The estimate.
+    pub value: f64,
+    /// The interval at [`LEVEL`] (lower, upper).
+    pub interval: [f64; 2],
+    /// Its standard error.
+    pub std_error: f64,
+}
+
+impl LinearEstimate {
+    /// Whether `x` lies in the interval.
+    pub fn covers(&self, x: f64) -> bool {
+        (self.interval[0]..=self.interval[1]).contains(&x)
+    }
+}
+
+impl JointFit {
+    /// The joint fit of `ratios` with each mode's sensitivities `x[n] = [sₙ, uₙ]` about
+    /// κ₀ = `kappa`, σ₀ = `sigma`; `None` with fewer than 3 modes, a ratio or error
+    /// [`Pooled::of`] refuses, or sensitivities that do not separate the two (the normal
+    /// matrix singular to 1e-12 of its scale).
+    pub fn of(ratios: &[ModeRatio], x: &[[f64; 2]], kappa: f64, sigma: f64) -> Option<JointFit> {
+        Pooled::of(ratios)?;
+        if ratios.len() < 3 || x.len() != ratios.len() || x.iter().flatten().any(|v| !v.is_finite())
+        {
+            return None;
+        }
+        let yw: Vec<(f64, f64)> = ratios
+            .iter()
+            .map(|m| (m.ratio.ln(), (m.std_error / m.ratio).powi(-2)))
+            .collect();
+        let (mut a, mut b) = ([[0.0; 2]; 2], [0.0; 2]);
+        for ((y, w), xn) in yw.iter().zip(x) {
+            for i in 0..2 {
+                b[i] += w * xn[i] * y;
+                for j in 0..2 {
+                    a[i][j] += w * xn[i] * xn[j];
+                }
+            }
+        }
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        if det.is_nan() || det <= 1e-12 * a[0][0] * a[1][1] {
+            return None;
+        }
+        let inv = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        let beta = [
+            inv[0][0] * b[0] + inv[0][1] * b[1],
+            inv[1][0] * b[0] + inv[1][1] * b[1],
+        ];
+        let chi2: f64 = (yw.iter().zip(x))
+            .map(|((y, w), xn)| w * (y - xn[0] * beta[0] - xn[1] * beta[1]).powi(2))
+            .sum();
+        let dof = ratios.len() as f64 - 2.0;
+        let z = Normal::standard().inverse_cdf(0.5 + LEVEL / 2.0);
+        let se_sigma = inv[1][1].sqrt();
+        let value = sigma - beta[1];
+        Some(JointFit {
+            modes: ratios.iter().map(|m| m.mode.clone()).collect(),
+            bending_rigidity: Estimate::scaled(kappa, -1.0, beta[0], inv[0][0].sqrt()),
+            tension: LinearEstimate {
+                value,
+                interval: [value - z * se_sigma, value + z * se_sigma],
+                std_error: se_sigma,
+            },
+            // ln κ = −β₀, σ = σ₀ − β₁: the sign of the covariance is kept.
+            correlation: inv[0][1] / (inv[0][0] * inv[1][1]).sqrt(),
+            chi2,
+            p_value: ChiSquared::new(dof).map_or(f64::NAN, |d| d.sf(chi2)),
+        })
+    }
 }
 
 /// The fit of one run.
@@ -185,6 +295,9 @@ pub struct RunFit {
     /// every share is 1 (`variance` gives it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending_regression: Option<Pooled>,
+    /// A membrane's κ and σ fitted together from the variances, kT known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<JointFit>,
     /// The pooled decay-rate ratio (its `decay-rate` checks).
     pub rate: Option<Pooled>,
     /// EI with kT known (the sidecar's): from the variances.
@@ -328,10 +441,15 @@ fn fit_run(scene: &SceneSummary, run: &str, base: &FitBase) -> RunFit {
     let variance_rate_correlation = both
         .zip(cov)
         .map(|(((v, r), _), cov)| cov / (v.std_error * r.std_error));
+    let joint = base.tension.and_then(|(sigma, of)| {
+        let x: Option<Vec<[f64; 2]>> = var_ratios.iter().map(|m| of(&m.mode)).collect();
+        JointFit::of(&var_ratios, &x?, base.bending_rigidity, sigma)
+    });
     RunFit {
         run: run.to_string(),
         variance,
         bending_regression: regression.flatten(),
+        joint,
         rate,
         bending_rigidity: ei,
         drag,
@@ -486,6 +604,7 @@ mod tests {
                 drag: 3.0,
                 kt: 0.5,
                 shares,
+                tension: None,
             }
         }
         let fit = &fit_runs(&scene, &base(Some(&share)))[0];
@@ -513,6 +632,39 @@ mod tests {
         assert!((wrong - 1.0).abs() > 0.01, "{wrong}");
         assert!(naive.bending_regression.is_none());
         assert!(naive.variance.as_ref().unwrap().p_value.unwrap() < 1e-6);
+    }
+
+    /// The joint fit recovers ln κ/κ₀ = a and σ − σ₀ = d from exact ratios
+    /// ln rₙ = −sₙa − uₙd with χ² 0, and a covariance that gives the single-parameter
+    /// error when the two regressors are orthogonal in the weights; it refuses fewer than
+    /// 3 modes and regressors that do not separate κ from σ (uₙ ∝ sₙ).
+    #[test]
+    fn joint_fit_recovers_kappa_and_sigma() {
+        let (a, d) = (0.08_f64, -1.5_f64);
+        let x = [[1.0, 0.02], [0.9, 0.01], [0.7, 0.005], [0.5, 0.002]];
+        let r: Vec<ModeRatio> = (x.iter().enumerate())
+            .map(|(k, [s, u])| ModeRatio::new(format!("n={}", k + 1), (-s * a - u * d).exp(), 1e-3))
+            .collect();
+        let j = JointFit::of(&r, &x, 2.0, 20.0).unwrap();
+        assert!(
+            (j.bending_rigidity.value / (2.0 * a.exp()) - 1.0).abs() < 1e-10,
+            "{j:?}"
+        );
+        assert!((j.tension.value - (20.0 + d)).abs() < 1e-8, "{j:?}");
+        assert!(j.chi2 < 1e-12 && j.p_value > 0.999, "{j:?}");
+        assert!(j.tension.covers(20.0 + d) && j.correlation.abs() < 1.0);
+        assert!(JointFit::of(&r[..2], &x[..2], 2.0, 20.0).is_none());
+        let collinear: Vec<[f64; 2]> = x.iter().map(|[s, _]| [*s, 0.01 * s]).collect();
+        assert!(JointFit::of(&r, &collinear, 2.0, 20.0).is_none());
+        // Orthogonal regressors, equal weights (ratio 1): errors 1/√Σwₙxₙ² each.
+        let one: Vec<ModeRatio> = (0..4)
+            .map(|k| ModeRatio::new(format!("n={k}"), 1.0, 0.01))
+            .collect();
+        let x = [[1.0, 1.0], [1.0, -1.0], [1.0, 1.0], [1.0, -1.0]];
+        let j = JointFit::of(&one, &x, 1.0, 0.0).unwrap();
+        let se = (4.0f64 * 1e4).sqrt().recip();
+        assert!((j.bending_rigidity.log_std_error - se).abs() < 1e-15);
+        assert!((j.tension.std_error - se).abs() < 1e-15 && j.correlation.abs() < 1e-15);
     }
 
     /// An error estimated with ν degrees of freedom is scaled by √(ν/(ν − 2)) before

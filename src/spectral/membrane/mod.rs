@@ -352,6 +352,14 @@ impl Membrane {
         bending / (bending + self.params.tension * q2)
     }
 
+    /// The tension sensitivity u_q = ∂ln c_q/∂σ = q²/(κq⁴ + σq²) of `mode`'s stiffness
+    /// (M1) at fixed κ (NaN if it is not a mode). With [`Self::bending_share`], the
+    /// regressors of `fit`'s joint κ and σ.
+    pub fn tension_sensitivity(&self, mode: MembraneMode) -> f64 {
+        let q2 = self.wavenumber_sq(mode);
+        q2 / self.c_of_q2(q2)
+    }
+
     /// Relaxation rate λ_q = c_q/ξ of `mode` (M2) (NaN if it is not a mode).
     pub fn mode_rate(&self, mode: MembraneMode) -> f64 {
         self.stiffness(mode) / self.params.drag
@@ -583,12 +591,13 @@ mod tests {
         .unwrap()
     }
 
-    // What: the bending share s_q = ∂ln c_q/∂ln κ at fixed σ.
-    // Reference: a central difference of ln c_q in ln κ (step 1e-4; c_q is linear in κ, so
+    // What: the bending share s_q = ∂ln c_q/∂ln κ at fixed σ, and the tension
+    // sensitivity u_q = ∂ln c_q/∂σ at fixed κ.
+    // Reference: central differences of ln c_q in ln κ and in σ (step 1e-4; c_q is linear in κ, so
     // the difference is exact up to rounding and the O(step²) curvature of ln c_q);
     // exactly 1 at σ = 0; above 1 under compression. Tolerance: 1e-7.
     #[test]
-    fn bending_share_is_the_log_derivative_in_kappa() {
+    fn bending_share_and_tension_sensitivity_are_log_derivatives() {
         for b in [
             MembraneBoundary::SimplySupported,
             MembraneBoundary::Periodic,
@@ -609,6 +618,11 @@ mod tests {
                 let fd = (c(k * h.exp()) - c(k * (-h).exp())) / (2.0 * h);
                 let s = mb.bending_share(mode);
                 assert!((s - fd).abs() < 1e-7, "{mode:?}: {s} vs {fd}");
+                let sigma = mb.params.tension;
+                let c = |tension: f64| at(k, tension).stiffness(mode).ln();
+                let fd = (c(sigma + h) - c(sigma - h)) / (2.0 * h);
+                let u = mb.tension_sensitivity(mode);
+                assert!((u / fd - 1.0).abs() < 1e-6, "{mode:?}: {u} vs {fd}");
                 assert!(s > 0.0 && s < 1.0);
                 assert_eq!(at(k, 0.0).bending_share(mode), 1.0);
                 let q2 = mb.params.min_wavenumber_sq();
