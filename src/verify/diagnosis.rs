@@ -324,8 +324,9 @@ pub fn diagnose(variance: &[ModeRatio], rate: &[ModeRatio]) -> Option<Hint> {
                     hint(
                         Pattern::Stiffness,
                         format!(
-                            "{both}, about its inverse — stiffness × {c:.3} (K or EI: \
-                             variances × 1/c, rates × c)?"
+                            "{both}, about its inverse — stiffness × {c:.3} (K: EI or a \
+                             membrane's κ, variances × 1/c, rates × c; `fit` gives the \
+                             parameters)?"
                         ),
                     )
                 } else if same_size(v.log(), r.log()) {
