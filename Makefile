@@ -81,12 +81,15 @@ test:
 # and declared unknown fails against the continuum with every label saying so.
 # examples/bead-spring-simulator (11 beads, springs and the full cosine angle potential):
 # passes declared as "bead-spring", `fit` recovers its EI, fails with the noise x1.05.
-# Part of `make test` (CI).
+# examples/membrane-simulator (a periodic membrane by Fourier-space Brownian dynamics):
+# passes membrane-periodic's checks against the continuum, `fit` recovers kappa and sigma,
+# fails with the noise x1.05. Part of `make test` (CI).
 EXAMPLE_OUT ?= target/example-check
 example-check: build numpy-venv
 	examples/numpy-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)
 	examples/fd-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)-fd
 	examples/bead-spring-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)-beads
+	examples/membrane-simulator/ci-check.sh $(PEERS_VENV)/bin/python $(BIN) $(EXAMPLE_OUT)-membrane
 
 # The venv with NumPy (pinned, PEERS_NUMPY) of example-check and docs-check.
 numpy-venv:
