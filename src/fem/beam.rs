@@ -328,6 +328,35 @@ impl BeamModel {
         })
     }
 
+    /// [`BeamModel::elastic_deflection_at`] prepared for repeated use at `x`: the
+    /// element's shape functions at `x` on its DOFs and the rigid modes' deflections
+    /// there, computed once ([`DeflectionProbe::elastic`] then gives the same values,
+    /// bit for bit, for any state).
+    pub fn deflection_probe(&self, x: f64) -> DeflectionProbe {
+        let weights = self.mesh.locate(x).map(|(e, s)| {
+            let n = hermite::shape(self.mesh.element_length(e), s);
+            (self.dofs[e].iter().zip(n))
+                .filter_map(|(d, na)| d.map(|i| (i, na)))
+                .collect()
+        });
+        let rigid = self
+            .rigid
+            .iter()
+            .map(|(psi, _)| self.deflection_at(psi, x))
+            .collect();
+        DeflectionProbe { weights, rigid }
+    }
+
+    /// The rigid amplitudes `r_k = ψ_kᵀCw` of `state` as [`BeamModel::elastic_deflection_at`]
+    /// forms them (one per rigid mode; none where the ends allow no rigid motion).
+    pub fn rigid_projection(&self, state: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(
+            (self.rigid.iter())
+                .map(|(_, c_psi)| c_psi.iter().zip(state).map(|(a, b)| a * b).sum::<f64>()),
+        );
+    }
+
     /// The rigid basis before caching ([`BeamModel::rigid_modes`]).
     fn rigid_basis(&self) -> Vec<Vec<f64>> {
         let nodes = self.mesh.nodes();
@@ -442,9 +471,69 @@ fn element_rate_factor() -> Result<f64> {
     Ok(SymmetricEigen::new(a).eigenvalues.max())
 }
 
+/// The deflection functional of a beam at one point ([`BeamModel::deflection_probe`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeflectionProbe {
+    /// (DOF, shape function value) of the element holding the point; `None` outside
+    /// `[0, L]`.
+    weights: Option<Vec<(usize, f64)>>,
+    /// The rigid modes' deflections ψ_k(x).
+    rigid: Vec<f64>,
+}
+
+impl DeflectionProbe {
+    /// [`BeamModel::elastic_deflection_at`] of `state` at the probe's point, with `rigid`
+    /// its rigid amplitudes ([`BeamModel::rigid_projection`]): the same operations in the
+    /// same order (NaN outside `[0, L]`).
+    pub fn elastic(&self, state: &[f64], rigid: &[f64]) -> f64 {
+        let w: f64 = match &self.weights {
+            Some(weights) => weights.iter().map(|&(i, na)| na * state[i]).sum(),
+            None => f64::NAN,
+        };
+        (rigid.iter().zip(&self.rigid)).fold(w, |w, (r, psi_x)| w - r * psi_x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The prepared probe gives `elastic_deflection_at` bit for bit, for every pair of
+    /// ends (rigid motion projected out where there is some), on a graded mesh, at nodes,
+    /// between them and outside [0, L] (NaN).
+    #[test]
+    fn deflection_probe_equals_elastic_deflection_bit_for_bit() {
+        use rand::RngExt;
+        let params = FilamentParams::default();
+        let mut rng = crate::rng::trajectory_rng(20261206, 0);
+        for ends in Ends::all() {
+            let Ok(beam) = BeamModel::with_ends(params, Mesh::graded(1.0, 7, 0.3).unwrap(), ends)
+            else {
+                continue;
+            };
+            let state: Vec<f64> = (0..beam.n_dofs())
+                .map(|_| rng.random::<f64>() - 0.5)
+                .collect();
+            let mut rigid = Vec::new();
+            beam.rigid_projection(&state, &mut rigid);
+            assert_eq!(rigid.len(), ends.rigid_modes());
+            let xs = beam
+                .mesh()
+                .nodes()
+                .to_vec()
+                .into_iter()
+                .chain([0.123, 0.5, 0.987]);
+            for x in xs {
+                let p = beam.deflection_probe(x);
+                let (a, b) = (
+                    p.elastic(&state, &rigid),
+                    beam.elastic_deflection_at(&state, x),
+                );
+                assert_eq!(a.to_bits(), b.to_bits(), "{ends:?} at {x}: {a} vs {b}");
+            }
+            assert!(beam.deflection_probe(1.5).elastic(&state, &rigid).is_nan());
+        }
+    }
 
     #[test]
     fn free_numbering() {

@@ -37,6 +37,7 @@ mod stream;
 pub(crate) use object::Continuum;
 pub(crate) use object::FemObject;
 pub(crate) use object::MEMO_ENTRIES;
+use object::Probes;
 
 pub use stream::{RowPlan, ShortRows};
 
@@ -327,6 +328,7 @@ struct FemBatch<'a> {
     projector: &'a DMatrix<f64>,
     filament: ComponentBatch,
     lane: RefCell<Vec<f64>>,
+    probes: ProbeCache,
 }
 
 impl BatchTrajectory for FemBatch<'_> {
@@ -357,10 +359,11 @@ impl Observables for LaneOf<'_, FemBatch<'_>> {
         });
     }
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
-        self.batch.each_component(self.lane, |c, s| {
-            for (j, &x) in xs.iter().enumerate() {
-                out[c * xs.len() + j] = self.batch.object.value_at(s, x);
-            }
+        self.batch.probes.with(self.batch.object, xs, |probes| {
+            self.batch.each_component(self.lane, |c, s| {
+                let row = &mut out[c * xs.len()..(c + 1) * xs.len()];
+                self.batch.object.values_with(probes, s, row);
+            });
         });
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
@@ -389,6 +392,26 @@ struct FemSampler<'a> {
     object: &'a FemObject,
     projector: &'a DMatrix<f64>,
     filament: Components<Box<dyn Integrator>>,
+    probes: ProbeCache,
+}
+
+/// The points of the last [`Observables::deflections`] call prepared
+/// ([`FemObject::probes`]), so that a sampler evaluated at the same points every sample
+/// prepares them once.
+#[derive(Default)]
+struct ProbeCache(RefCell<Option<Probes>>);
+
+impl ProbeCache {
+    /// Calls `f` with `object`'s probes at `xs`, prepared anew if the points changed.
+    fn with(&self, object: &FemObject, xs: &[f64], f: impl FnOnce(&Probes)) {
+        let mut cache = self.0.borrow_mut();
+        if cache.as_ref().is_none_or(|p| p.xs != xs) {
+            *cache = Some(object.probes(xs));
+        }
+        if let Some(p) = cache.as_ref() {
+            f(p);
+        }
+    }
 }
 
 impl Trajectory for FemSampler<'_> {
@@ -408,11 +431,12 @@ impl Observables for FemSampler<'_> {
         }
     }
     fn deflections(&self, xs: &[f64], out: &mut [f64]) {
-        for (c, s) in self.filament.states.iter().enumerate() {
-            for (j, &x) in xs.iter().enumerate() {
-                out[c * xs.len() + j] = self.object.value_at(s, x);
+        self.probes.with(self.object, xs, |probes| {
+            for (c, s) in self.filament.states.iter().enumerate() {
+                let row = &mut out[c * xs.len()..(c + 1) * xs.len()];
+                self.object.values_with(probes, s, row);
             }
-        }
+        });
     }
     fn add_slope_squares(&self, acc: &mut [f64]) {
         if let Some(beam) = self.object.beam() {
@@ -1664,6 +1688,7 @@ impl LinearRun {
                     object,
                     projector,
                     filament: Components::at_rest(stepper, self.components, n),
+                    probes: ProbeCache::default(),
                 })
             }
             Model::SpectralMembrane { simulator, checked } => {
@@ -1896,6 +1921,7 @@ impl LinearRun {
             projector,
             filament: ComponentBatch::at_rest(t, self.components),
             lane: RefCell::new(vec![0.0; system.n_dofs()]),
+            probes: ProbeCache::default(),
         }))
     }
 

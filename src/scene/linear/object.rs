@@ -9,7 +9,7 @@
 //! points are positions on that line (fractions of its length in the scene file).
 
 use crate::error::Result;
-use crate::fem::beam::BeamModel;
+use crate::fem::beam::{BeamModel, DeflectionProbe};
 use crate::fem::chain::ChainModel;
 use crate::fem::modal::{GeneralizedModes, generalized_modes};
 use crate::fem::plate::PlateModel;
@@ -18,6 +18,7 @@ use crate::fem::system::LinearSystem;
 use crate::spectral::EndedBeam;
 use crate::spectral::membrane::{Membrane, MembraneMode};
 use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 /// Objects of fewer unknowns decompose faster than [`memoized`] keys them.
@@ -320,6 +321,39 @@ impl FemObject {
         }
     }
 
+    /// The points `xs` of the sampling line prepared for [`Self::values_with`]: a beam's
+    /// deflection functionals ([`BeamModel::deflection_probe`]), the points themselves
+    /// otherwise.
+    pub(crate) fn probes(&self, xs: &[f64]) -> Probes {
+        Probes {
+            xs: xs.to_vec(),
+            beam: self
+                .beam()
+                .map(|b| xs.iter().map(|&x| b.deflection_probe(x)).collect()),
+            rigid: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// [`Self::value_at`] of `state` at every point of `probes` into `out`, bit for bit:
+    /// for a beam with the functionals prepared once and the rigid amplitudes formed
+    /// once per state instead of once per point.
+    pub(crate) fn values_with(&self, probes: &Probes, state: &[f64], out: &mut [f64]) {
+        match (self.beam(), &probes.beam) {
+            (Some(b), Some(points)) => {
+                let mut rigid = probes.rigid.borrow_mut();
+                b.rigid_projection(state, &mut rigid);
+                for (o, p) in out.iter_mut().zip(points) {
+                    *o = p.elastic(state, &rigid);
+                }
+            }
+            _ => {
+                for (o, &x) in out.iter_mut().zip(&probes.xs) {
+                    *o = self.value_at(state, x);
+                }
+            }
+        }
+    }
+
     /// The positions of the mesh nodes on the sampling line (where the trajectory files
     /// record the field).
     pub(crate) fn line_nodes(&self) -> Vec<f64> {
@@ -341,6 +375,18 @@ impl FemObject {
             FemObject::Chain(_) | FemObject::Plate { .. } => None,
         }
     }
+}
+
+/// Points of the sampling line prepared for repeated evaluation
+/// ([`FemObject::probes`]).
+#[derive(Debug)]
+pub(crate) struct Probes {
+    /// The points.
+    pub(crate) xs: Vec<f64>,
+    /// A beam's deflection functionals at them.
+    beam: Option<Vec<DeflectionProbe>>,
+    /// Scratch space of the rigid amplitudes.
+    rigid: RefCell<Vec<f64>>,
 }
 
 #[cfg(test)]
