@@ -10,7 +10,7 @@ use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::spectral::membrane::Membrane;
 use langevin_fem::verify::fit::{
-    FitBase, JointFit, RunFit, SensitivityOf, ShareOf, estimate_text, fit_runs,
+    FitBase, JointFit, RunFit, SensitivityOf, estimate_text, fit_runs,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -97,24 +97,22 @@ impl FitObject {
         Some([m.bending_share(mode), m.tension_sensitivity(mode)])
     }
 
-    /// The bending share of checked mode `mode` ([`Self::sensitivities`]).
-    fn share(&self, mode: &str) -> Option<f64> {
-        self.sensitivities(mode).map(|s| s[0])
-    }
-
-    /// The sidecar's parameters, with `share` (this object's [`Self::share`]) for a
-    /// membrane under tension.
-    fn base<'a>(&self, share: ShareOf<'a>, sensitivities: SensitivityOf<'a>) -> FitBase<'a> {
-        let (bending_rigidity, drag, kt, tension) = match self {
-            FitObject::Filament(f) => (f.bending_rigidity, f.drag, f.kt, 0.0),
-            FitObject::Membrane(m, _) => (m.bending_rigidity, m.drag, m.kt, m.tension),
-        };
-        FitBase {
-            bending_rigidity,
-            drag,
-            kt,
-            shares: (tension != 0.0).then_some(share),
-            tension: matches!(self, FitObject::Membrane(..)).then_some((tension, sensitivities)),
+    /// The sidecar's parameters, with a membrane's tension and `sensitivities` (this
+    /// object's [`Self::sensitivities`]).
+    fn base<'a>(&self, sensitivities: SensitivityOf<'a>) -> FitBase<'a> {
+        match self {
+            FitObject::Filament(f) => FitBase {
+                bending_rigidity: f.bending_rigidity,
+                drag: f.drag,
+                kt: f.kt,
+                tension: None,
+            },
+            FitObject::Membrane(m, _) => FitBase {
+                bending_rigidity: m.bending_rigidity,
+                drag: m.drag,
+                kt: m.kt,
+                tension: Some((m.tension, sensitivities)),
+            },
         }
     }
 }
@@ -140,9 +138,8 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             "a linear scene (mode variances and decay rates): a compression scene's force data do not fit EI this way",
         ));
     }
-    let share = |mode: &str| object.share(mode);
     let sensitivities = |mode: &str| object.sensitivities(mode);
-    let fits = fit_runs(&summary.scenes[0], &object.base(&share, &sensitivities));
+    let fits = fit_runs(&summary.scenes[0], &object.base(&sensitivities));
     let mut lines = Vec::new();
     for f in &fits {
         let (Some(v), Some(kt)) = (&f.variance, &f.kt_given_bending_rigidity) else {

@@ -271,7 +271,7 @@ impl BeamModel {
     /// consistent noise), written to `out` (length [`Ends::rigid_modes`]).
     pub fn rigid_amplitudes(&self, state: &[f64], out: &mut [f64]) {
         for (o, (_, c_psi)) in out.iter_mut().zip(&self.rigid) {
-            *o = c_psi.iter().zip(state).map(|(a, b)| a * b).sum();
+            *o = rigid_amplitude(c_psi, state);
         }
     }
 
@@ -323,8 +323,7 @@ impl BeamModel {
             return w;
         }
         self.rigid.iter().fold(w, |w, (psi, c_psi)| {
-            let r: f64 = c_psi.iter().zip(state).map(|(a, b)| a * b).sum();
-            w - r * self.deflection_at(psi, x)
+            w - rigid_amplitude(c_psi, state) * self.deflection_at(psi, x)
         })
     }
 
@@ -333,28 +332,13 @@ impl BeamModel {
     /// there, computed once ([`DeflectionProbe::elastic`] then gives the same values,
     /// bit for bit, for any state).
     pub fn deflection_probe(&self, x: f64) -> DeflectionProbe {
-        let weights = self.mesh.locate(x).map(|(e, s)| {
-            let n = hermite::shape(self.mesh.element_length(e), s);
-            (self.dofs[e].iter().zip(n))
-                .filter_map(|(d, na)| d.map(|i| (i, na)))
-                .collect()
-        });
+        let weights = self.shape_weights(x).map(Iterator::collect);
         let rigid = self
             .rigid
             .iter()
             .map(|(psi, _)| self.deflection_at(psi, x))
             .collect();
         DeflectionProbe { weights, rigid }
-    }
-
-    /// The rigid amplitudes `r_k = ψ_kᵀCw` of `state` as [`BeamModel::elastic_deflection_at`]
-    /// forms them (one per rigid mode; none where the ends allow no rigid motion).
-    pub fn rigid_projection(&self, state: &[f64], out: &mut Vec<f64>) {
-        out.clear();
-        out.extend(
-            (self.rigid.iter())
-                .map(|(_, c_psi)| c_psi.iter().zip(state).map(|(a, b)| a * b).sum::<f64>()),
-        );
     }
 
     /// The rigid basis before caching ([`BeamModel::rigid_modes`]).
@@ -410,15 +394,16 @@ impl BeamModel {
             self.n_dofs(),
             "deflection_at: wrong state length"
         );
-        let Some((e, s)) = self.mesh.locate(x) else {
-            return f64::NAN;
-        };
+        self.shape_weights(x)
+            .map_or(f64::NAN, |w| w.map(|(i, na)| na * state[i]).sum())
+    }
+
+    /// (free DOF, shape function value) of the element holding `x`, in the element's DOF
+    /// order ([`BeamModel::deflection_at`]'s terms); `None` outside `[0, L]`.
+    fn shape_weights(&self, x: f64) -> Option<impl Iterator<Item = (usize, f64)> + '_> {
+        let (e, s) = self.mesh.locate(x)?;
         let n = hermite::shape(self.mesh.element_length(e), s);
-        self.dofs[e]
-            .iter()
-            .zip(n)
-            .filter_map(|(d, na)| d.map(|i| na * state[i]))
-            .sum()
+        Some((self.dofs[e].iter().zip(n)).filter_map(|(d, na)| d.map(|i| (i, na))))
     }
 
     /// Largest generalized eigenvalue `λ_max` of `K φ = λ C φ` (fastest decay rate of the
@@ -471,6 +456,12 @@ fn element_rate_factor() -> Result<f64> {
     Ok(SymmetricEigen::new(a).eigenvalues.max())
 }
 
+/// The amplitude `r = (Cψ)ᵀw` of a rigid mode in `state`, from the mode's `c_psi = Cψ`
+/// ([`BeamModel::elastic_deflection_at`], [`BeamModel::rigid_amplitudes`]).
+fn rigid_amplitude(c_psi: &[f64], state: &[f64]) -> f64 {
+    c_psi.iter().zip(state).map(|(a, b)| a * b).sum()
+}
+
 /// The deflection functional of a beam at one point ([`BeamModel::deflection_probe`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeflectionProbe {
@@ -483,7 +474,7 @@ pub struct DeflectionProbe {
 
 impl DeflectionProbe {
     /// [`BeamModel::elastic_deflection_at`] of `state` at the probe's point, with `rigid`
-    /// its rigid amplitudes ([`BeamModel::rigid_projection`]): the same operations in the
+    /// its rigid amplitudes ([`BeamModel::rigid_amplitudes`]): the same operations in the
     /// same order (NaN outside `[0, L]`).
     pub fn elastic(&self, state: &[f64], rigid: &[f64]) -> f64 {
         let w: f64 = match &self.weights {
@@ -514,9 +505,8 @@ mod tests {
             let state: Vec<f64> = (0..beam.n_dofs())
                 .map(|_| rng.random::<f64>() - 0.5)
                 .collect();
-            let mut rigid = Vec::new();
-            beam.rigid_projection(&state, &mut rigid);
-            assert_eq!(rigid.len(), ends.rigid_modes());
+            let mut rigid = vec![0.0; ends.rigid_modes()];
+            beam.rigid_amplitudes(&state, &mut rigid);
             let xs = beam
                 .mesh()
                 .nodes()

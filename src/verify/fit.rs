@@ -157,10 +157,6 @@ impl Pooled {
     }
 }
 
-/// The bending share of a mode named by its check's parameter (`n=k`), if it has one
-/// ([`FitBase::shares`]).
-pub type ShareOf<'a> = &'a dyn Fn(&str) -> Option<f64>;
-
 /// The parameters a data set was simulated with (its sidecar's), as [`fit_runs`] scales
 /// them, and how each mode's stiffness kₙ depends on the bending rigidity.
 pub struct FitBase<'a> {
@@ -170,13 +166,10 @@ pub struct FitBase<'a> {
     pub drag: f64,
     /// kT.
     pub kt: f64,
-    /// The bending share sₙ = ∂ln kₙ/∂ln κ of mode `n=k` (its check's parameter) at these
-    /// parameters: κq⁴/(κq⁴ + σq²) for a membrane under tension σ, held at the sidecar's
-    /// value; `None` when every mode's is 1 (the filament, a membrane at σ = 0).
-    pub shares: Option<ShareOf<'a>>,
     /// A membrane's tension σ₀ and, per mode, its log sensitivities
-    /// (∂ln kₙ/∂ln κ, ∂ln kₙ/∂σ) = (κq⁴, q²)/kₙ at these parameters, for the joint fit of
-    /// κ and σ ([`JointFit`]); `None` for a filament.
+    /// (∂ln kₙ/∂ln κ, ∂ln kₙ/∂σ) = (κq⁴, q²)/kₙ at these parameters: for κ with σ held at
+    /// σ₀ ≠ 0 the first is the mode's bending share sₙ (every sₙ = 1 at σ₀ = 0, and for a
+    /// filament, `None`), and both serve the joint fit of κ and σ ([`JointFit`]).
     pub tension: Option<(f64, SensitivityOf<'a>)>,
 }
 
@@ -349,24 +342,29 @@ fn pooled_covariance(
         .sum()
 }
 
-/// The bending shares of `ratios`' modes (`None` if `base` has none, or as the first
-/// mode's, `Some(Err(mode))`, if a mode has none).
+/// The bending shares of `ratios`' modes under a tension σ₀ ≠ 0 held known (`None` if
+/// `base` has none or σ₀ = 0: every share is 1; `Some(Err(mode))` for the first mode
+/// without one).
 fn shares_of(
     base: &FitBase,
     ratios: &[ModeRatio],
 ) -> Option<std::result::Result<Vec<f64>, String>> {
-    let share = base.shares?;
+    let (_, sensitivities) = base.tension.filter(|(sigma, _)| *sigma != 0.0)?;
     Some(
         ratios
             .iter()
-            .map(|m| share(&m.mode).ok_or_else(|| m.mode.clone()))
+            .map(|m| {
+                sensitivities(&m.mode)
+                    .map(|s| s[0])
+                    .ok_or_else(|| m.mode.clone())
+            })
             .collect(),
     )
 }
 
 /// The fits of every run of `scene` (the summary of `check` of the data whose sidecar
 /// gives `base`), in the order of the runs' first checks (see the module docs). A run
-/// under tension held known (`base.shares`) whose variance or rate modes lack a share
+/// under tension held known (`base.tension`) whose variance or rate modes lack a share
 /// gets no bending rigidity or drag.
 pub fn fit_runs(scene: &SceneSummary, base: &FitBase) -> Vec<RunFit> {
     first_seen(scene.checks.iter().map(|c| c.run.as_str()))
@@ -594,20 +592,20 @@ mod tests {
             checks.push(check("decay-rate", k + 1, (s * a - b).exp()));
         }
         let scene = SceneSummary::of_checks("m", checks);
+        // No tension sensitivity: the joint fit has none to separate, only κ is fitted.
         let share = |mode: &str| {
             let k: usize = mode.strip_prefix("n=")?.parse().ok()?;
-            shares.get(k - 1).copied()
+            shares.get(k - 1).map(|&s| [s, 0.0])
         };
-        fn base(shares: Option<ShareOf<'_>>) -> FitBase<'_> {
+        fn base(tension: Option<(f64, SensitivityOf<'_>)>) -> FitBase<'_> {
             FitBase {
                 bending_rigidity: 2.0,
                 drag: 3.0,
                 kt: 0.5,
-                shares,
-                tension: None,
+                tension,
             }
         }
-        let fit = &fit_runs(&scene, &base(Some(&share)))[0];
+        let fit = &fit_runs(&scene, &base(Some((20.0, &share))))[0];
         let kappa = fit.bending_rigidity.as_ref().unwrap();
         assert!(
             (kappa.value / (2.0 * a.exp()) - 1.0).abs() < 1e-12,

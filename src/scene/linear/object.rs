@@ -341,7 +341,8 @@ impl FemObject {
         match (self.beam(), &probes.beam) {
             (Some(b), Some(points)) => {
                 let mut rigid = probes.rigid.borrow_mut();
-                b.rigid_projection(state, &mut rigid);
+                rigid.resize(b.ends().rigid_modes(), 0.0);
+                b.rigid_amplitudes(state, &mut rigid);
                 for (o, p) in out.iter_mut().zip(points) {
                     *o = p.elastic(state, &rigid);
                 }
