@@ -1312,7 +1312,7 @@ mod tests {
     /// failed checks, as a question. Deterministic (fixed seed).
     #[test]
     fn the_hints_name_the_signatures_of_noise_stiffness_and_drag_faults() {
-        use crate::verify::diagnosis::{Pattern, run_hints};
+        use crate::verify::diagnosis::Pattern;
         let mut linear = builtin::find("hinged-linear-3d").unwrap().load().unwrap();
         linear.runs.retain(|r| r.name == "crank-nicolson");
         for (kind, pattern) in [
@@ -1325,9 +1325,9 @@ mod tests {
                 &format!("hint-{kind}"),
             )
             .unwrap();
-            let hints = run_hints(&summary.scenes[0]);
+            let hints = &summary.scenes[0].hints;
             assert!(
-                matches!(&hints[..], [(run, h)] if run == "crank-nicolson" && h.pattern == pattern && h.text.ends_with('?')),
+                matches!(&hints[..], [h] if h.run == "crank-nicolson" && h.pattern == pattern && h.text.ends_with('?')),
                 "{kind}: {hints:?}"
             );
             assert!(

@@ -300,6 +300,7 @@ fn sample_summary() -> Summary {
                     check("energy/equipartition", true, None),
                 ],
                 detectable: vec![],
+                hints: vec![],
             },
             SceneSummary {
                 name: "pinned".to_string(),
@@ -316,6 +317,11 @@ fn sample_summary() -> Summary {
                     check("msd/late-time", false, Some(1.234_567e-9)),
                 ],
                 detectable: vec![],
+                hints: vec![langevin_fem::verify::diagnosis::RunHint {
+                    run: "msd".to_string(),
+                    pattern: langevin_fem::verify::diagnosis::Pattern::Tension,
+                    text: "hint: … — tension σ ≈ 24.09 rather than 20?".to_string(),
+                }],
             },
         ],
         files: vec![
@@ -357,6 +363,8 @@ fn summary_json_follows_its_schema_and_departures_are_found() {
     let v = broken(&|b| b["scenes"][0]["checks"][1]["statistic"] = serde_json::json!("4.2"));
     assert!(v.iter().any(|e| e.contains("statistic")), "{v:?}");
     let v = broken(&|b| b["scenes"][0]["checks"][0]["reference_kind"] = serde_json::json!("x"));
+    assert!(v.iter().any(|e| e.contains("not one of")), "{v:?}");
+    let v = broken(&|b| b["scenes"][1]["hints"][0]["pattern"] = serde_json::json!("kappa"));
     assert!(v.iter().any(|e| e.contains("not one of")), "{v:?}");
 }
 

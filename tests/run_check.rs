@@ -1349,7 +1349,10 @@ fn membrane_data_off(dir: &TempDir, name: &str, key: &str, value: &str) -> Strin
 ///   interval excludes 20, and the fit with σ held says one factor does not explain the
 ///   modes (χ² p < 1e-3).
 ///
-/// The printed fit names κ, the tension held and the joint fit.
+/// The printed fit names κ, the tension held and the joint fit. The hint of the checks
+/// beside it (`summary.json`'s `hints`, in its schema, and stdout) names the parameter
+/// from the modes' shares: κ × 1.1 with σ held (pattern `bending-rigidity`), then the tension (pattern
+/// `tension`, σ within 5 % of 25 by its first-order slope).
 #[test]
 fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     let dir = TempDir::new("run-check-fit-membrane");
@@ -1366,11 +1369,22 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
         let o = run(&args);
         let d = describe(&args, &o);
         let f = json(&Path::new(out).join("fit.json"));
+        let summary = json(&Path::new(out).join("summary.json"));
+        let v = common::schema::violations(&common::schema::summary_schema(), &summary);
+        assert!(v.is_empty(), "{v:#?}");
+        let hints = summary["scenes"][0]["hints"].clone();
         (
             f["runs"][0].clone(),
             String::from_utf8_lossy(&o.stdout).to_string(),
             d,
+            hints,
         )
+    };
+    let hint = |hints: &serde_json::Value, pattern: &str| {
+        let h = &hints[0];
+        assert_eq!(h["run"], "crank-nicolson", "{hints}");
+        assert_eq!(h["pattern"], pattern, "{hints}");
+        h["text"].as_str().unwrap().to_string()
     };
     let interval = |v: &serde_json::Value| {
         let i = &v["interval"];
@@ -1378,7 +1392,13 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     };
 
     let data = membrane_data_off(&dir, "kappa", "bending_rigidity", "1.1");
-    let (run0, stdout, d) = fit(&data, &dir.join_str("fit-kappa"));
+    let (run0, stdout, d, hints) = fit(&data, &dir.join_str("fit-kappa"));
+    let text = hint(&hints, "bending-rigidity");
+    assert!(
+        text.contains("bending rigidity κ × 1.09") || text.contains("bending rigidity κ × 1.10"),
+        "{text}"
+    );
+    assert!(stdout.contains(&format!("crank-nicolson: {text}")), "{d}");
     assert!(
         stdout.contains("    kappa = ") && stdout.contains("kT known, sigma = 20 held"),
         "{d}"
@@ -1403,7 +1423,12 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     assert!(lo <= 20.0 && 20.0 <= hi, "joint sigma [{lo}, {hi}]");
 
     let data = membrane_data_off(&dir, "sigma", "tension", "25.0");
-    let (run0, _, d) = fit(&data, &dir.join_str("fit-sigma"));
+    let (run0, _, d, hints) = fit(&data, &dir.join_str("fit-sigma"));
+    let text = hint(&hints, "tension");
+    let sigma: f64 = text.split("tension σ ≈ ").nth(1).unwrap()[..5]
+        .parse()
+        .unwrap();
+    assert!((sigma / 25.0 - 1.0).abs() < 0.05, "{text}");
     let (lo, hi) = interval(&run0["joint"]["tension"]);
     assert!(
         lo <= 25.0 && 25.0 <= hi && lo > 20.0,

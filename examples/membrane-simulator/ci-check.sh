@@ -7,7 +7,9 @@
 #  1. its data pass: exit 0; `fit` recovers kappa = 1 (sigma held), and kappa = 1 and
 #     sigma = 20 fitted together, within their 95 % intervals;
 #  2. with the noise variance x1.05 they fail: exit 1, naming mode-variance checks, and
-#     the hint names the noise amplitude or kT.
+#     the hint names the noise amplitude or kT;
+#  3. simulated at sigma x1.2 (24 for the stated 20) they fail, and the hint names the
+#     tension (from the modes' tension sensitivities), with sigma within 5 % of 24.
 # Usage: ci-check.sh PYTHON BIN WORKDIR
 set -euo pipefail
 PY=$1 BIN=$2 WORK=$3
@@ -30,13 +32,31 @@ print("fit: kappa", covers(run["bending_rigidity"], 1.0),
       "and sigma", covers(run["joint"]["tension"], 20.0))
 PYEOF
 
-"$PY" "$HERE/simulate.py" --out "$WORK/noise" --noise-variance-factor 1.05
-set +e
-"$BIN" check --scene $SCENE --data "$WORK/noise" --out "$WORK/noise-report" > "$WORK/noise.txt"
-code=$?
-set -e
-cat "$WORK/noise.txt"
-[ "$code" -eq 1 ] || { echo "FAIL: noise variance x1.05 should fail its checks (exit 1), got $code"; exit 1; }
+# fails NAME WHAT SIMULATE-ARGS...: simulates into $WORK/NAME, checks the data, prints the
+# verdict to $WORK/NAME.txt and stdout, and stops CI unless the check exits 1.
+fails() {
+    local name=$1 what=$2
+    shift 2
+    "$PY" "$HERE/simulate.py" --out "$WORK/$name" "$@"
+    set +e
+    "$BIN" check --scene $SCENE --data "$WORK/$name" --out "$WORK/$name-report" > "$WORK/$name.txt"
+    local code=$?
+    set -e
+    cat "$WORK/$name.txt"
+    [ "$code" -eq 1 ] || { echo "FAIL: $what should fail its checks (exit 1), got $code"; exit 1; }
+}
+
+fails noise "noise variance x1.05" --noise-variance-factor 1.05
 grep -q "failed: numpy-fourier/mode-variance/" "$WORK/noise.txt" || { echo "FAIL: no mode-variance check named"; exit 1; }
 grep -q "hint: .*noise amplitude or kT" "$WORK/noise.txt" || { echo "FAIL: the hint does not name the noise"; exit 1; }
+
+fails tension "sigma x1.2" --tension-factor 1.2
+"$PY" - "$WORK/tension.txt" <<'PYEOF'
+import re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r"hint: .*tension σ ≈ ([0-9.]+) rather than 20", text)
+assert m, "FAIL: the hint does not name the tension"
+assert abs(float(m.group(1)) / 24 - 1) < 0.05, m.group(0)
+print("hint names the tension: sigma ~", m.group(1))
+PYEOF
 echo "membrane example check: passed"

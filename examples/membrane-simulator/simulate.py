@@ -19,7 +19,8 @@ slowest modes named `ac_m_n` and `as_m_n` (the trajectory data format of langevi
 No discretization is declared, so `langevin-fem check` judges them against the continuum;
 the cut-off leaves out a part kT/(4 pi kappa Q^2) of the point variance, Q = 2 pi M/a
 (0.3 % at M = 16). `--noise-variance-factor 1.05` injects a 5 % error of the noise
-variance.
+variance; `--tension-factor 1.2` simulates sigma x 1.2 while the sidecar states sigma
+(a tension entered in other units).
 """
 
 import argparse
@@ -47,7 +48,7 @@ def simulate(args):
     order = sorted(range(len(pts)), key=lambda k: (q2[k], pts[k][0], pts[k][1]))
     pts = [pts[k] for k in order]
     q, q2 = q[order], q2[order]
-    c = kappa * q2 ** 2 + sigma * q2
+    c = kappa * q2 ** 2 + args.tension_factor * sigma * q2
     rate = c / xi
     var = args.noise_variance_factor * kT / (c * area / 2.0)
     tau1 = 1.0 / rate[0]
@@ -82,7 +83,9 @@ def simulate(args):
         "format": "langevin-fem-trajectories",
         "version": 1,
         "producer": "examples/membrane-simulator/simulate.py (NumPy %s), Fourier-space Brownian dynamics, %d modes%s"
-        % (np.__version__, 2 * nm, "" if args.noise_variance_factor == 1.0 else f", noise variance x{args.noise_variance_factor}"),
+        % (np.__version__, 2 * nm, "".join(
+            f", {what} x{f}" for what, f in [("noise variance", args.noise_variance_factor),
+                                              ("tension", args.tension_factor)] if f != 1.0)),
         "dims": 3,
         "membrane": {"width": a, "height": b, "bending_rigidity": kappa, "tension": sigma,
                      "drag": xi, "kt": kT, "boundary": "periodic"},
@@ -116,6 +119,7 @@ def main():
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--run", default="numpy-fourier", help="run name")
     p.add_argument("--noise-variance-factor", type=float, default=1.0, help="fault: noise variance times this")
+    p.add_argument("--tension-factor", type=float, default=1.0, help="fault: sigma simulated times this, the sidecar stating sigma")
     simulate(p.parse_args())
 
 

@@ -9,6 +9,7 @@ use langevin_fem::data::{DataFilament, DataMembrane, DataSidecar};
 use langevin_fem::error::{Error, Result};
 use langevin_fem::report::write_report;
 use langevin_fem::spectral::membrane::Membrane;
+use langevin_fem::verify::diagnosis::membrane_sensitivities;
 use langevin_fem::verify::fit::{
     FitBase, JointFit, RunFit, SensitivityOf, estimate_text, fit_runs,
 };
@@ -84,17 +85,13 @@ impl FitObject {
         }
     }
 
-    /// The log sensitivities [`Membrane::bending_share`] and
-    /// [`Membrane::tension_sensitivity`] of checked mode `mode` (`n=k`, the k-th slowest,
-    /// [`Membrane::modes`]); `None` for a filament.
+    /// The log sensitivities of checked mode `mode` ([`membrane_sensitivities`]); `None`
+    /// for a filament.
     fn sensitivities(&self, mode: &str) -> Option<[f64; 2]> {
         let FitObject::Membrane(_, Some(m)) = self else {
             return None;
         };
-        let k: usize = mode.strip_prefix("n=")?.parse().ok()?;
-        let modes = m.modes(k).ok()?;
-        let mode = *modes.get(k.checked_sub(1)?)?;
-        Some([m.bending_share(mode), m.tension_sensitivity(mode)])
+        membrane_sensitivities(m, mode)
     }
 
     /// The sidecar's parameters, with a membrane's tension and `sensitivities` (this

@@ -152,8 +152,8 @@ pub fn print_scenes(summary: &Summary, verbosity: Verbosity, wall: bool, detecta
             }
         }
         if verbosity != Verbosity::Quiet {
-            for (run, hint) in diagnosis::run_hints(s) {
-                println!("    {run}: {}", hint.text);
+            for h in &s.hints {
+                println!("    {}: {}", h.run, h.text);
             }
         }
         if verbosity == Verbosity::Normal
@@ -232,6 +232,7 @@ mod tests {
                 .collect(),
             checks,
             detectable: vec![],
+            hints: vec![],
         }
     }
 

@@ -54,6 +54,7 @@
 //! the interval's coverage does not depend on it (measured in statistics.md).
 
 use crate::verify::diagnosis::{ModeRatio, first_seen, mode_ratios};
+pub use crate::verify::diagnosis::{Pooled, SensitivityOf};
 use crate::verify::summary::SceneSummary;
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
@@ -92,71 +93,6 @@ impl Estimate {
     }
 }
 
-/// The pooled log ratio of one observable over the modes of a run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Pooled {
-    /// The modes used, as their checks name them (`n=3`).
-    pub modes: Vec<String>,
-    /// The inverse-variance weighted mean m of ln(estimate/reference).
-    pub log_ratio: f64,
-    /// Its standard error.
-    pub std_error: f64,
-    /// χ² of the modes' ln r about m (modes − 1 dof).
-    pub chi2: f64,
-    /// Its p-value (`None` with one mode).
-    pub p_value: Option<f64>,
-}
-
-impl Pooled {
-    /// The pooled log ratio of `ratios` (`None` if there is none, or one is not positive
-    /// with a positive finite error).
-    pub fn of(ratios: &[ModeRatio]) -> Option<Pooled> {
-        Self::regressed(ratios, None)
-    }
-
-    /// The weighted least-squares slope m through the origin of ln rₙ on the regressors
-    /// `shares` (sₙ; all 1 when `None`, which makes m the weighted mean of [`Self::of`],
-    /// bit for bit): m = Σ wₙsₙ ln rₙ / Σ wₙsₙ², its standard error (Σ wₙsₙ²)^(−1/2),
-    /// and the χ² of ln rₙ about sₙm (modes − 1 dof), wₙ = 1/s.e.(ln rₙ)². `None` as
-    /// [`Self::of`], or if `shares` does not give every mode a finite regressor.
-    pub fn regressed(ratios: &[ModeRatio], shares: Option<&[f64]>) -> Option<Pooled> {
-        if ratios.is_empty()
-            || ratios.iter().any(|m| {
-                !(m.ratio.is_finite()
-                    && m.ratio > 0.0
-                    && m.std_error.is_finite()
-                    && m.std_error > 0.0)
-            })
-            || shares.is_some_and(|s| s.len() != ratios.len() || s.iter().any(|x| !x.is_finite()))
-        {
-            return None;
-        }
-        let share = |k: usize| shares.map_or(1.0, |s| s[k]);
-        let logs: Vec<(f64, f64)> = ratios
-            .iter()
-            .map(|m| (m.ratio.ln(), m.std_error / m.ratio))
-            .collect();
-        let sw: f64 = (logs.iter().enumerate())
-            .map(|(k, (_, s))| s.powi(-2) * share(k) * share(k))
-            .sum();
-        let mean = (logs.iter().enumerate())
-            .map(|(k, (l, s))| l * s.powi(-2) * share(k))
-            .sum::<f64>()
-            / sw;
-        let chi2: f64 = (logs.iter().enumerate())
-            .map(|(k, (l, s))| ((l - share(k) * mean) / s).powi(2))
-            .sum();
-        let dof = logs.len() as f64 - 1.0;
-        Some(Pooled {
-            modes: ratios.iter().map(|m| m.mode.clone()).collect(),
-            log_ratio: mean,
-            std_error: sw.sqrt().recip(),
-            chi2,
-            p_value: (dof > 0.0).then(|| ChiSquared::new(dof).map_or(f64::NAN, |d| d.sf(chi2))),
-        })
-    }
-}
-
 /// The parameters a data set was simulated with (its sidecar's), as [`fit_runs`] scales
 /// them, and how each mode's stiffness kₙ depends on the bending rigidity.
 pub struct FitBase<'a> {
@@ -172,10 +108,6 @@ pub struct FitBase<'a> {
     /// filament, `None`), and both serve the joint fit of κ and σ ([`JointFit`]).
     pub tension: Option<(f64, SensitivityOf<'a>)>,
 }
-
-/// A mode's log sensitivities (∂ln kₙ/∂ln κ, ∂ln kₙ/∂σ) by its check's parameter (`n=k`),
-/// if it has them ([`FitBase::tension`]).
-pub type SensitivityOf<'a> = &'a dyn Fn(&str) -> Option<[f64; 2]>;
 
 /// κ and σ fitted together from a membrane's mode variances, kT known: the weighted
 /// least-squares fit of ln r_var,n = −sₙ·ln(κ/κ₀) − uₙ·(σ − σ₀) over the modes (first

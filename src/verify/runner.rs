@@ -66,6 +66,7 @@ use crate::shard::{Shard, ShardSet};
 use crate::stats;
 use crate::verify::checks::{LinearEstimates, linear_checks};
 use crate::verify::compression::{compression_checks, halving_check};
+use crate::verify::diagnosis::SensitivityOf;
 use crate::verify::oracle::{Oracle, compression_oracle, linear_oracle};
 use crate::verify::summary::{CheckResult, SceneSummary, SkippedCheck, Summary};
 use crate::work::{WorkLimits, WorkProjection};
@@ -404,6 +405,10 @@ struct SceneOutputs<'r> {
     /// whose discretization this tool does not model): its figures say so
     /// ([`SceneOutputs::words`]).
     continuum_references: bool,
+    /// The membrane whose modes the hints of a failed run read (issue #27,
+    /// [`crate::verify::diagnosis::diagnose_membrane`]): a linear membrane scene's, or for
+    /// `check` the data's; `None` for a filament or a membrane under imposed area.
+    membrane: Option<crate::spectral::MembraneParams>,
 }
 
 impl<'r> SceneOutputs<'r> {
@@ -435,6 +440,7 @@ impl<'r> SceneOutputs<'r> {
             skipped: Vec::new(),
             runs: scene.runs.iter().map(|r| r.name.clone()).collect(),
             continuum_references: false,
+            membrane: scene.membrane.filter(|_| scene.compression.is_none()),
             notes: std::iter::once(scene.description.clone())
                 .chain(
                     scene
@@ -1232,6 +1238,7 @@ fn finish_scene(
         skipped,
         runs,
         continuum_references: _,
+        membrane,
     } = outputs;
     let runs: Vec<&str> = runs.iter().map(String::as_str).collect();
     for c in &mut checks {
@@ -1268,6 +1275,7 @@ fn finish_scene(
         skipped,
         checks,
         detectable: Vec::new(),
+        hints: Vec::new(),
     };
     // Per run and observable, the smallest error the checks would have caught (issue #31).
     summary.detectable = crate::verify::diagnosis::detectable_deviations(&summary, alpha);
@@ -1279,11 +1287,18 @@ fn finish_scene(
         ));
     }
     // Per run with a failed check, the pattern of its per-mode ratios, if any (issue #31).
-    for (run, hint) in crate::verify::diagnosis::run_hints(&summary) {
+    let membrane = membrane.and_then(|p| crate::spectral::membrane::Membrane::new(p).ok());
+    let of = |mode: &str| {
+        let m = membrane.as_ref()?;
+        crate::verify::diagnosis::membrane_sensitivities(m, mode)
+    };
+    let tension = membrane.map(|m| (m.params.tension, &of as SensitivityOf));
+    summary.hints = crate::verify::diagnosis::run_hints(&summary, tension);
+    for h in &summary.hints {
         summary.notes.push(format!(
-            "run {run}: {} (a pattern among the run's per-mode ratios estimate/reference, \
+            "run {}: {} (a pattern among the run's per-mode ratios estimate/reference, \
              not a verdict: the checks are)",
-            hint.text
+            h.run, h.text
         ));
     }
     Ok(summary)
@@ -1398,6 +1413,7 @@ pub fn check_data(
     let start = Instant::now();
     let dir = out.join(&scene.name);
     let mut outputs = SceneOutputs::new(scene, &report);
+    outputs.membrane = sidecar.membrane.map(|m| m.params());
     lead_with_data(&mut outputs, scene, data_note(sidecar, data_dir));
     for (data, dc) in sidecar.runs.iter().zip(&prepared) {
         outputs.runs.push(data.name.clone());

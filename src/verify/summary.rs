@@ -258,6 +258,11 @@ pub struct SceneSummary {
     /// states a ratio with a standard error.
     #[serde(default)]
     pub detectable: Vec<crate::verify::diagnosis::Detectable>,
+    /// Per run with a failed check, the pattern its per-mode ratios show, stated as a
+    /// hint with its evidence (issue #31, [`crate::verify::diagnosis::run_hints`]); not
+    /// written when there is none (every check passed, or no pattern).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hints: Vec<crate::verify::diagnosis::RunHint>,
 }
 
 impl SceneSummary {
@@ -276,6 +281,7 @@ impl SceneSummary {
             skipped: vec![],
             checks,
             detectable: vec![],
+            hints: vec![],
         }
     }
 }
