@@ -30,27 +30,33 @@
 //!
 //! **A membrane** (issue #27's object) has kₙ = κq⁴ + σq² (M1–M2). At σ = 0 it scales as
 //! the filament (κ for EI). Under a tension held at the sidecar's σ₀, a mode's stiffness
-//! depends on κ with the log slope sₙ = ∂ln kₙ/∂ln κ = κq⁴/kₙ, its bending share
+//! depends on κ through its bending share sₙ = ∂ln kₙ/∂ln κ = κ₀q⁴/kₙ⁰
 //! ([`crate::spectral::membrane::Membrane::bending_share`], from the continuum mode the
-//! check names), so to first order ln r_var,n = ln(kT/kT₀) − sₙ ln(κ/κ₀) and
-//! ln r_rate,n = sₙ ln(κ/κ₀) − ln(ξ/ξ₀). With kT known, κ = κ₀·e^(−m) with m the weighted
-//! least-squares slope of ln r_var on sₙ through the origin ([`Pooled::regressed`], the
-//! weighted mean when every sₙ = 1); ξ = ξ₀·e^(−s̄m − m_rate) with s̄ the rates' weighted
-//! mean share, its error var = s̄²s_m² + s_rate² + 2s̄·cov(m, m_rate) with m's regression
-//! weights; kT with κ known is the plain pool, as above (kT scales every mode alike).
-//! Scaling every variance alike instead would mistake tension-dominated modes, which
-//! hardly feel κ, for noise (a run at κ = 1.1 under σ = 20: κ = 1.09 with an interval
-//! that misses 1.1; tested). When σ is not known either, κ and σ are fitted together
-//! ([`JointFit`]): ln r_var,n = −sₙ ln(κ/κ₀) − uₙ(σ − σ₀) with uₙ = ∂ln kₙ/∂σ = q²/kₙ,
-//! a two-parameter weighted least-squares fit (modes − 2 dof) whose covariance gives both
-//! intervals and their correlation; the tension-dominated modes fix σ, the
-//! bending-dominated ones κ.
+//! check names): kₙ(κ, σ₀)/kₙ⁰ = gₙ = (κ/κ₀)·sₙ + 1 − sₙ, so ln r_var,n =
+//! ln(kT/kT₀) − ln gₙ and ln r_rate,n = ln gₙ − ln(ξ/ξ₀). With kT known, κ is the
+//! weighted least-squares solution of that law ([`held_tension`], Gauss–Newton: the first
+//! step is the regression of ln r_var on sₙ through the origin, [`Pooled::regressed`],
+//! each further step the regression on the local shares (κ/κ₀)sₙ/gₙ at the current κ);
+//! ξ = ξ₀·e^(Ḡ − m_rate) with Ḡ the rates' weighted mean of ln gₙ at κ̂, its error var =
+//! s̄²s_m² + s_rate² + 2s̄·cov(m, m_rate) with s̄ the rates' weighted mean local share and
+//! m's regression weights (to first order Ḡ = s̄·ln(κ/κ₀)); kT with κ known is the plain
+//! pool, as above (kT scales every mode alike). Scaling every variance alike instead
+//! would mistake tension-dominated modes, which hardly feel κ, for noise (a run at κ =
+//! 1.1 under σ = 20: κ = 1.09 with an interval that misses 1.1; tested). When σ is not
+//! known either, κ and σ are fitted together ([`JointFit::solved`]): ln r_var,n = −ln gₙ
+//! with gₙ = (κ/κ₀)sₙ + σuₙ, uₙ = ∂ln kₙ/∂σ = q²/kₙ⁰, a two-parameter weighted least-squares
+//! fit (modes − 2 dof, Gauss–Newton from the first-order fit [`JointFit::of`]) whose
+//! covariance at the solution gives both intervals and their correlation; the
+//! tension-dominated modes fix σ, the bending-dominated ones κ. Solved in the law, a
+//! large misstatement is not biased by the linearization (σ = 40 for a stated 20: the
+//! first-order fit gives 34; tested).
 //!
 //! **Exactness.** The scaling is exact for the continuum, the spectral model and the
 //! stationary variances of the exact-modal and Crank–Nicolson integrators (their
 //! stationary law is kT K⁻¹); for an Euler variance, and for every discrete rate, the
 //! reference depends on λΔt too, so the scaling holds to first order in the parameter's
-//! error with a slope 1 − O(λΔt). At the true parameters every ratio is 1 either way, so
+//! error with a slope 1 − O(λΔt). A finite-element membrane's mode stiffness follows the
+//! continuum's shares to the mesh's relative error. At the true parameters every ratio is 1 either way, so
 //! the interval's coverage does not depend on it (measured in statistics.md).
 
 use crate::verify::diagnosis::{ModeRatio, first_seen, mode_ratios};
@@ -110,9 +116,10 @@ pub struct FitBase<'a> {
 }
 
 /// κ and σ fitted together from a membrane's mode variances, kT known: the weighted
-/// least-squares fit of ln r_var,n = −sₙ·ln(κ/κ₀) − uₙ·(σ − σ₀) over the modes (first
-/// order in the parameters' errors, as every fit here; sₙ, uₙ the sensitivities of
-/// [`FitBase::tension`]).
+/// least-squares fit of ln r_var,n = −sₙ·ln(κ/κ₀) − uₙ·(σ − σ₀) over the modes
+/// ([`Self::of`], first order in the parameters' errors), or of ln r_var,n = −ln gₙ in
+/// the stiffness law itself ([`Self::solved`], what `fit` reports); sₙ, uₙ the
+/// sensitivities of [`FitBase::tension`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JointFit {
     /// The modes used.
@@ -205,6 +212,112 @@ impl JointFit {
             p_value: ChiSquared::new(dof).map_or(f64::NAN, |d| d.sf(chi2)),
         })
     }
+
+    /// The joint fit of [`Self::of`] solved in the stiffness law itself: the weighted
+    /// least-squares (ln κ, σ) of ln r_var,n = −ln gₙ, gₙ = kₙ(κ, σ)/kₙ(κ₀, σ₀) =
+    /// (κ/κ₀)·sₙ + σ·uₙ (exact for kₙ = κq⁴ + σq² with `x[n] = [sₙ, uₙ]` at κ₀, σ₀), by
+    /// Gauss–Newton from (κ₀, σ₀): each step is [`Self::of`] of the ratios the law at
+    /// (κ, σ) leaves to explain ([`relative_to`]) on the local sensitivities
+    /// ((κ/κ₀)sₙ/gₙ, uₙ/gₙ), halved while a gₙ would not be positive. The first step is
+    /// the first-order fit; the estimate, its intervals, the correlation and χ² are those
+    /// of the step taken at the solution (|Δln κ| and |Δσ|/(1 + |σ|) below 1e-12). `None`
+    /// as [`Self::of`], or without convergence in [`MAX_ITERATIONS`] steps.
+    pub fn solved(
+        ratios: &[ModeRatio],
+        x: &[[f64; 2]],
+        kappa: f64,
+        sigma: f64,
+    ) -> Option<JointFit> {
+        let law = |c: f64, s: f64| -> Option<Vec<f64>> {
+            let g: Vec<f64> = x.iter().map(|x| c * x[0] + s * x[1]).collect();
+            g.iter().all(|g| *g > 0.0).then_some(g)
+        };
+        let (mut c, mut s) = (1.0, sigma);
+        let mut g = law(c, s)?;
+        for _ in 0..MAX_ITERATIONS {
+            let local: Vec<[f64; 2]> = (x.iter().zip(&g))
+                .map(|(x, g)| [c * x[0] / g, x[1] / g])
+                .collect();
+            let step = Self::of(&relative_to(ratios, &g), &local, kappa * c, s)?;
+            let (dl, ds) = (
+                (step.bending_rigidity.value / (kappa * c)).ln(),
+                step.tension.value - s,
+            );
+            if dl.abs() < 1e-12 && ds.abs() < 1e-12 * (1.0 + s.abs()) {
+                return Some(step);
+            }
+            let mut h = 1.0;
+            loop {
+                if let Some(next) = law(c * (h * dl).exp(), s + h * ds) {
+                    (c, s, g) = (c * (h * dl).exp(), s + h * ds, next);
+                    break;
+                }
+                h *= 0.5;
+                if h < 1e-9 {
+                    return None;
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Steps of the Gauss–Newton fits ([`held_tension`], [`JointFit::solved`]) before they
+/// give up.
+pub const MAX_ITERATIONS: usize = 50;
+
+/// The ratios `ratios` over the law's at the current parameters, rₙ·gₙ (gₙ the stiffness
+/// ratio kₙ/kₙ⁰, so ln(rₙgₙ) = ln rₙ + ln gₙ is the part of ln rₙ = −ln gₙ + … the law
+/// leaves unexplained), with the same relative errors: their linearized fit about the
+/// current parameters is one Gauss–Newton step.
+fn relative_to(ratios: &[ModeRatio], g: &[f64]) -> Vec<ModeRatio> {
+    (ratios.iter().zip(g))
+        .map(|(m, g)| ModeRatio::new(m.mode.clone(), m.ratio * g, m.std_error * g))
+        .collect()
+}
+
+/// κ with the tension held at σ₀ ≠ 0, solved in the stiffness law: the weighted
+/// least-squares ℓ = ln(κ/κ₀) of ln r_var,n = −ln gₙ, gₙ = e^ℓ·sₙ + 1 − sₙ
+/// (kₙ(κ, σ₀)/kₙ(κ₀, σ₀), exact for kₙ = κq⁴ + σq² with the bending shares `shares` at
+/// κ₀), by Gauss–Newton from ℓ = 0: each step is the regression ([`Pooled::regressed`])
+/// of the ratios the law at ℓ leaves ([`relative_to`]) on the local shares e^ℓsₙ/gₙ,
+/// halved while a gₙ would not be positive. The first step is the first-order
+/// regression on sₙ. Returns the pool with m = −ℓ (κ = κ₀e^(−m)) and the standard error
+/// and χ² of the step at the solution (|Δℓ| below 1e-12), and the local shares there;
+/// `None` as [`Pooled::regressed`] or without convergence in [`MAX_ITERATIONS`] steps.
+fn held_tension(ratios: &[ModeRatio], shares: &[f64]) -> Option<(Pooled, Vec<f64>)> {
+    let law = |l: f64| -> Option<Vec<f64>> {
+        let c = l.exp();
+        let g: Vec<f64> = shares.iter().map(|s| c * s + 1.0 - s).collect();
+        g.iter().all(|g| *g > 0.0).then_some(g)
+    };
+    let (mut l, mut g): (f64, _) = (0.0, law(0.0)?);
+    for _ in 0..MAX_ITERATIONS {
+        let c = l.exp();
+        let local: Vec<f64> = shares.iter().zip(&g).map(|(s, g)| c * s / g).collect();
+        let step = Pooled::regressed(&relative_to(ratios, &g), Some(&local))?;
+        if step.log_ratio.abs() < 1e-12 {
+            return Some((
+                Pooled {
+                    log_ratio: -l,
+                    ..step
+                },
+                local,
+            ));
+        }
+        let mut h = 1.0;
+        loop {
+            if let Some(next) = law(l - h * step.log_ratio) {
+                (l, g) = (l - h * step.log_ratio, next);
+                break;
+            }
+            h *= 0.5;
+            if h < 1e-9 {
+                return None;
+            }
+        }
+    }
+    None
 }
 
 /// The fit of one run.
@@ -215,9 +328,10 @@ pub struct RunFit {
     /// The pooled variance ratio (its `mode-variance` checks): kT's, and the bending
     /// rigidity's when every mode's bending share is 1.
     pub variance: Option<Pooled>,
-    /// The regression of the variance ratios on the modes' bending shares that gives the
-    /// bending rigidity under tension held known ([`Pooled::regressed`]); absent when
-    /// every share is 1 (`variance` gives it).
+    /// The fit of the variance ratios in the stiffness law that gives the bending
+    /// rigidity under tension held known ([`held_tension`]: `log_ratio` = −ln(κ/κ₀), its
+    /// standard error and the modes' χ² about the law at the solution); absent when every
+    /// share is 1 (`variance` gives it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending_regression: Option<Pooled>,
     /// A membrane's κ and σ fitted together from the variances, kT known.
@@ -324,31 +438,38 @@ fn fit_run(scene: &SceneSummary, run: &str, base: &FitBase) -> RunFit {
         .collect();
     let variance = Pooled::of(&var_ratios);
     let rate = Pooled::of(&rate_ratios);
-    // Under tension: the variances regressed on the modes' bending shares, and the rates'
-    // weighted mean share s̄ (ln ξ/ξ₀ = s̄·ln κ/κ₀ − m_rate); 1 and the plain pool without.
+    // Under tension: κ from the variances in the stiffness law (held_tension), and the
+    // rates' part of ξ, ln ξ/ξ₀ = Ḡ − m_rate with Ḡ their weighted mean of ln gₙ at κ̂
+    // (−s̄·m to first order) and s̄ their mean local share (module docs); without, the
+    // plain pool, −Ḡ = m (exactly 1·m) and s̄ = 1.
     let var_shares = shares_of(base, &var_ratios);
-    let (regression, sbar) = match (&var_shares, shares_of(base, &rate_ratios)) {
-        (None, _) => (None, Some(1.0)),
-        (Some(v), r) => {
-            let regression = v
-                .as_ref()
-                .ok()
-                .and_then(|v| Pooled::regressed(&var_ratios, Some(v)));
-            let sbar = r.and_then(|r| r.ok()).map(|r| {
-                let w = |m: &ModeRatio| (m.std_error / m.ratio).powi(-2);
-                let sw: f64 = rate_ratios.iter().map(w).sum();
-                rate_ratios
-                    .iter()
-                    .zip(&r)
-                    .map(|(m, s)| w(m) * s)
-                    .sum::<f64>()
-                    / sw
-            });
-            (Some(regression), sbar)
+    let held = var_shares
+        .as_ref()
+        .map(|v| v.as_ref().ok().and_then(|v| held_tension(&var_ratios, v)));
+    let (regression, shares) = match held {
+        Some(h) => {
+            let (pool, local) = h.unzip();
+            (Some(pool), local)
         }
+        None => (None, None),
     };
     let bending = regression.clone().unwrap_or_else(|| variance.clone());
-    let shares = var_shares.and_then(|v| v.ok());
+    let rate_part = match (&var_shares, shares_of(base, &rate_ratios)) {
+        (None, _) => bending.as_ref().map(|v| (v.log_ratio, 1.0)),
+        (Some(_), r) => bending.as_ref().zip(r.and_then(|r| r.ok())).map(|(v, r)| {
+            let c = (-v.log_ratio).exp();
+            let w = |m: &ModeRatio| (m.std_error / m.ratio).powi(-2);
+            let sw: f64 = rate_ratios.iter().map(w).sum();
+            let mean = |f: &dyn Fn(f64) -> f64| {
+                (rate_ratios.iter().zip(&r))
+                    .map(|(m, &s)| w(m) * f(s))
+                    .sum::<f64>()
+                    / sw
+            };
+            let g = |s: f64| c * s + 1.0 - s;
+            (-mean(&|s| g(s).ln()), mean(&|s| c * s / g(s)))
+        }),
+    };
     let correlation = |mode: &str| rate_check(mode).and_then(|c| c.variance_correlation);
     let ei = bending
         .as_ref()
@@ -356,24 +477,19 @@ fn fit_run(scene: &SceneSummary, run: &str, base: &FitBase) -> RunFit {
     let kt = variance
         .as_ref()
         .map(|v| Estimate::scaled(base.kt, 1.0, v.log_ratio, v.std_error));
-    let both = bending.as_ref().zip(rate.as_ref()).zip(sbar);
+    let both = bending.as_ref().zip(rate.as_ref()).zip(rate_part);
     let cov =
         both.map(|_| pooled_covariance(&var_ratios, &rate_ratios, shares.as_deref(), correlation));
-    let drag = both.zip(cov).map(|(((v, r), sbar), cov)| {
+    let drag = both.zip(cov).map(|(((v, r), (g, sbar)), cov)| {
         let var = sbar * sbar * v.std_error.powi(2) + r.std_error.powi(2) + 2.0 * sbar * cov;
-        Estimate::scaled(
-            base.drag,
-            -1.0,
-            sbar * v.log_ratio + r.log_ratio,
-            var.max(0.0).sqrt(),
-        )
+        Estimate::scaled(base.drag, -1.0, g + r.log_ratio, var.max(0.0).sqrt())
     });
     let variance_rate_correlation = both
         .zip(cov)
         .map(|(((v, r), _), cov)| cov / (v.std_error * r.std_error));
     let joint = base.tension.and_then(|(sigma, of)| {
         let x: Option<Vec<[f64; 2]>> = var_ratios.iter().map(|m| of(&m.mode)).collect();
-        JointFit::of(&var_ratios, &x?, base.bending_rigidity, sigma)
+        JointFit::solved(&var_ratios, &x?, base.bending_rigidity, sigma)
     });
     RunFit {
         run: run.to_string(),
@@ -489,10 +605,11 @@ mod tests {
     }
 
     /// A run whose stiffness kₙ = κq⁴ + σq² is off by κ/κ₀ = e^a at a tension held known,
-    /// with drag ξ/ξ₀ = e^b: exact ratios r_var,n = e^(−sₙa) and r_rate,n = e^(sₙa − b)
-    /// (first order in the shares sₙ, exact here by construction) give κ₀e^a and ξ₀e^b
-    /// with χ² 0, and kT from the plain mean; without the shares (σ = 0 assumed) κ is
-    /// off by more than 1 % and the modes disagree (χ² p < 1e-6).
+    /// with drag ξ/ξ₀ = e^b: the exact ratios r_var,n = 1/gₙ and r_rate,n = gₙe^(−b),
+    /// gₙ = e^a·sₙ + 1 − sₙ, give κ₀e^a and ξ₀e^b with χ² 0, and kT from the plain mean;
+    /// the first-order regression on sₙ alone (the Gauss–Newton fit's first step) misses
+    /// κ by more than 0.1 %; without the shares (σ = 0 assumed) κ is off by more than 1 %
+    /// and the modes disagree (χ² p < 1e-6).
     #[test]
     fn shares_recover_the_bending_rigidity_under_tension() {
         let (a, b) = (0.1_f64, -0.05_f64);
@@ -518,10 +635,11 @@ mod tests {
             largest_deviation: None,
             variance_correlation: None,
         };
+        let g = |s: f64| a.exp() * s + 1.0 - s;
         let mut checks = Vec::new();
-        for (k, s) in shares.iter().enumerate() {
-            checks.push(check("mode-variance", k + 1, (-s * a).exp()));
-            checks.push(check("decay-rate", k + 1, (s * a - b).exp()));
+        for (k, &s) in shares.iter().enumerate() {
+            checks.push(check("mode-variance", k + 1, 1.0 / g(s)));
+            checks.push(check("decay-rate", k + 1, g(s) * (-b).exp()));
         }
         let scene = SceneSummary::of_checks("m", checks);
         // No tension sensitivity: the joint fit has none to separate, only κ is fitted.
@@ -547,9 +665,13 @@ mod tests {
         assert!((xi.value / (3.0 * b.exp()) - 1.0).abs() < 1e-12, "{xi:?}");
         let regression = fit.bending_regression.as_ref().unwrap();
         assert!(regression.chi2 < 1e-12, "{regression:?}");
+        let ratios = mode_ratios(&scene.checks, "cn", "mode-variance");
+        let first = Pooled::regressed(&ratios, Some(&shares)).unwrap();
+        let missed = (-first.log_ratio - a).exp() - 1.0;
+        assert!(missed.abs() > 1e-3, "{missed}");
         // ln r weighted by 1/s.e.(ln r)² = (r/1e-3)².
-        let w = |s: f64| (-2.0 * s * a).exp();
-        let mean: f64 = shares.iter().map(|&s| -s * a * w(s)).sum::<f64>()
+        let w = |s: f64| g(s).powi(-2);
+        let mean: f64 = shares.iter().map(|&s| -g(s).ln() * w(s)).sum::<f64>()
             / shares.iter().map(|&s| w(s)).sum::<f64>();
         let kt = fit.kt_given_bending_rigidity.as_ref().unwrap();
         assert!(
@@ -595,6 +717,39 @@ mod tests {
         let se = (4.0f64 * 1e4).sqrt().recip();
         assert!((j.bending_rigidity.log_std_error - se).abs() < 1e-15);
         assert!((j.tension.std_error - se).abs() < 1e-15 && j.correlation.abs() < 1e-15);
+    }
+
+    /// Solved in the law, the joint fit recovers a large misstatement exactly: ratios
+    /// 1/gₙ of κ/κ₀ = 1.5 and σ = 40 for a stated σ₀ = 20 (gₙ = 1.5sₙ + 40uₙ, with
+    /// sₙ + 20uₙ = 1 as for kₙ = κq⁴ + σq²) give κ = 1.5κ₀ and σ = 40 to 1e-9 with χ² 0,
+    /// while the first-order fit ([`JointFit::of`], its first step) misses σ by more than
+    /// 5 %; a law that a step would take through gₙ ≤ 0 is approached by halved steps.
+    #[test]
+    fn the_joint_fit_solved_in_the_law_has_no_linearization_bias() {
+        let shares = [0.9, 0.75, 0.6, 0.45, 0.3, 0.2];
+        let x: Vec<[f64; 2]> = shares.iter().map(|s| [*s, (1.0 - s) / 20.0]).collect();
+        let r: Vec<ModeRatio> = (x.iter().enumerate())
+            .map(|(k, [s, u])| {
+                let g = 1.5 * s + 40.0 * u;
+                ModeRatio::new(format!("n={}", k + 1), 1.0 / g, 1e-3 / g)
+            })
+            .collect();
+        let j = JointFit::solved(&r, &x, 2.0, 20.0).unwrap();
+        assert!((j.bending_rigidity.value / 3.0 - 1.0).abs() < 1e-9, "{j:?}");
+        assert!((j.tension.value - 40.0).abs() < 1e-8, "{j:?}");
+        assert!(j.chi2 < 1e-12, "{j:?}");
+        let first = JointFit::of(&r, &x, 2.0, 20.0).unwrap();
+        assert!((first.tension.value / 40.0 - 1.0).abs() > 0.05, "{first:?}");
+        // σ far below: the first step would leave gₙ ≤ 0 for the tension-dominated modes.
+        let soft: Vec<ModeRatio> = (x.iter().enumerate())
+            .map(|(k, [s, u])| {
+                let g = 0.9 * s + 2.0 * u;
+                ModeRatio::new(format!("n={}", k + 1), 1.0 / g, 1e-3 / g)
+            })
+            .collect();
+        let j = JointFit::solved(&soft, &x, 2.0, 20.0).unwrap();
+        assert!((j.tension.value - 2.0).abs() < 1e-8, "{j:?}");
+        assert!((j.bending_rigidity.value / 1.8 - 1.0).abs() < 1e-9, "{j:?}");
     }
 
     /// An error estimated with ν degrees of freedom is scaled by √(ν/(ν − 2)) before
