@@ -23,7 +23,7 @@
 #   make calibrate         the verifier's false-alarm rate and p-value uniformity over
 #                          SEEDS seeds (default 100), reports/calibration/
 #   make power             fault injection: detection rate of each catalogued fault over seeds
-#   make fit-coverage      coverage of `fit`'s 95 % intervals over SEEDS seeds
+#   make fit-coverage      coverage of `fit`'s 95 % intervals over SEEDS seeds (FIT_SCENE=…)
 
 CARGO  ?= cargo
 BUDGET ?= quick
@@ -59,11 +59,14 @@ calibrate: build
 	$(BIN) calibrate $(foreach s,$(CALIBRATION_SCENES),--scene $(s)) --seeds $(SEEDS) --budget $(BUDGET) --out $(OUT)/calibration
 
 # Coverage of `fit`'s 95 % intervals (issue #31): for seeds 1..SEEDS, `run` of
-# hinged-linear-2d's Crank-Nicolson run and `fit` of its output; how often each interval
-# (EI, xi, kT) covers the truth, against the binomial range of 95 %, in
-# $(OUT)/fit-coverage/coverage.csv. About 2 min for 100 seeds on 2 cores.
+# FIT_SCENE's Crank-Nicolson run (default hinged-linear-2d) and `fit` of its output; how
+# often each interval (EI or a membrane's kappa, xi, kT; for a membrane also kappa and
+# sigma together) covers the truth, against the binomial range of 95 %, in
+# $(OUT)/fit-coverage/coverage.csv. About 2 min for 100 seeds on 2 cores
+# (FIT_SCENE=membrane-periodic: 3.4 min for 200).
+FIT_SCENE ?= hinged-linear-2d
 fit-coverage: build
-	python3 examples/fit-coverage/coverage.py $(BIN) $(OUT)/fit-coverage --seeds $(SEEDS)
+	python3 examples/fit-coverage/coverage.py $(BIN) $(OUT)/fit-coverage --scene $(FIT_SCENE) --seeds $(SEEDS)
 
 # Tests run in the release profile, so that `make test` and `make verify` share every
 # compiled dependency (one build, not two: the time to first result on a fresh clone).
