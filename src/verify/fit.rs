@@ -32,32 +32,31 @@
 //! the filament (κ for EI). Under a tension held at the sidecar's σ₀, a mode's stiffness
 //! depends on κ through its bending share sₙ = ∂ln kₙ/∂ln κ = κ₀q⁴/kₙ⁰
 //! ([`crate::spectral::membrane::Membrane::bending_share`], from the continuum mode the
-//! check names): kₙ(κ, σ₀)/kₙ⁰ = gₙ = (κ/κ₀)·sₙ + 1 − sₙ, so ln r_var,n =
-//! ln(kT/kT₀) − ln gₙ and ln r_rate,n = ln gₙ − ln(ξ/ξ₀). With kT known, κ is the
-//! weighted least-squares solution of that law ([`held_tension`], Gauss–Newton: the first
-//! step is the regression of ln r_var on sₙ through the origin, [`Pooled::regressed`],
-//! each further step the regression on the local shares (κ/κ₀)sₙ/gₙ at the current κ);
-//! ξ = ξ₀·e^(Ḡ − m_rate) with Ḡ the rates' weighted mean of ln gₙ at κ̂, its error var =
-//! s̄²s_m² + s_rate² + 2s̄·cov(m, m_rate) with s̄ the rates' weighted mean local share and
-//! m's regression weights (to first order Ḡ = s̄·ln(κ/κ₀)); kT with κ known is the plain
-//! pool, as above (kT scales every mode alike). Scaling every variance alike instead
-//! would mistake tension-dominated modes, which hardly feel κ, for noise (a run at κ =
-//! 1.1 under σ = 20: κ = 1.09 with an interval that misses 1.1; tested). When σ is not
-//! known either, κ and σ are fitted together ([`JointFit::solved`]): ln r_var,n = −ln gₙ
-//! with gₙ = (κ/κ₀)sₙ + σuₙ, uₙ = ∂ln kₙ/∂σ = q²/kₙ⁰, a two-parameter weighted least-squares
-//! fit (modes − 2 dof, Gauss–Newton from the first-order fit [`JointFit::of`]) whose
-//! covariance at the solution gives both intervals and their correlation; the
-//! tension-dominated modes fix σ, the bending-dominated ones κ. Solved in the law, a
-//! large misstatement is not biased by the linearization (σ = 40 for a stated 20: the
-//! first-order fit gives 34; tested).
+//! check names): kₙ(κ, σ₀)/kₙ⁰ = gₙ = (κ/κ₀)·sₙ + 1 − sₙ, so ln r_var,n = ln(kT/kT₀) − ln
+//! gₙ and ln r_rate,n = ln gₙ − ln(ξ/ξ₀). With kT known, κ is the weighted least-squares
+//! solution of that law ([`held_tension`], Gauss–Newton: the first step is the regression
+//! of ln r_var on sₙ through the origin, [`Pooled::regressed`], each further step the
+//! regression on the local shares (κ/κ₀)sₙ/gₙ at the current κ); ξ = ξ₀·e^(Ḡ − m_rate) with
+//! Ḡ the rates' weighted mean of ln gₙ at κ̂, its error var = s̄²s_m² + s_rate² +
+//! 2s̄·cov(m, m_rate) with s̄ the rates' weighted mean local share and m's regression
+//! weights (to first order Ḡ = s̄·ln(κ/κ₀)); kT with κ known is the plain pool, as above
+//! (kT scales every mode alike). Scaling every variance alike instead would mistake
+//! tension-dominated modes, which hardly feel κ, for noise (a run at κ = 1.1 under σ = 20:
+//! κ = 1.09 with an interval that misses 1.1; tested). When σ is not known either, κ and σ
+//! are fitted together ([`JointFit::solved`]): ln r_var,n = −ln gₙ with gₙ = (κ/κ₀)sₙ +
+//! σuₙ, uₙ = ∂ln kₙ/∂σ = q²/kₙ⁰, a two-parameter weighted least-squares fit (modes − 2 dof,
+//! Gauss–Newton from the first-order fit [`JointFit::of`]) whose covariance at the solution
+//! gives both intervals and their correlation; the tension-dominated modes fix σ, the
+//! bending-dominated ones κ. Solved in the law, a large misstatement is not biased by the
+//! linearization (σ = 40 for a stated 20: the first-order fit gives 34; tested).
 //!
 //! **Exactness.** The scaling is exact for the continuum, the spectral model and the
-//! stationary variances of the exact-modal and Crank–Nicolson integrators (their
-//! stationary law is kT K⁻¹); for an Euler variance, and for every discrete rate, the
-//! reference depends on λΔt too, so the scaling holds to first order in the parameter's
-//! error with a slope 1 − O(λΔt). A finite-element membrane's mode stiffness follows the
-//! continuum's shares to the mesh's relative error. At the true parameters every ratio is 1 either way, so
-//! the interval's coverage does not depend on it (measured in statistics.md).
+//! stationary variances of the exact-modal and Crank–Nicolson integrators (their stationary
+//! law is kT K⁻¹); for an Euler variance, and for every discrete rate, the reference
+//! depends on λΔt too, so the scaling holds to first order in the parameter's error with a
+//! slope 1 − O(λΔt). A finite-element membrane's mode stiffness follows the continuum's
+//! shares to the mesh's relative error. At the true parameters every ratio is 1 either way,
+//! so the interval's coverage does not depend on it (measured in statistics.md).
 
 use crate::verify::diagnosis::{ModeRatio, first_seen, mode_ratios};
 pub use crate::verify::diagnosis::{Pooled, SensitivityOf};
@@ -214,14 +213,14 @@ impl JointFit {
     }
 
     /// The joint fit of [`Self::of`] solved in the stiffness law itself: the weighted
-    /// least-squares (ln κ, σ) of ln r_var,n = −ln gₙ, gₙ = kₙ(κ, σ)/kₙ(κ₀, σ₀) =
-    /// (κ/κ₀)·sₙ + σ·uₙ (exact for kₙ = κq⁴ + σq² with `x[n] = [sₙ, uₙ]` at κ₀, σ₀), by
-    /// Gauss–Newton from (κ₀, σ₀): each step is [`Self::of`] of the ratios the law at
-    /// (κ, σ) leaves to explain ([`relative_to`]) on the local sensitivities
-    /// ((κ/κ₀)sₙ/gₙ, uₙ/gₙ), halved while a gₙ would not be positive. The first step is
-    /// the first-order fit; the estimate, its intervals, the correlation and χ² are those
-    /// of the step taken at the solution (|Δln κ| and |Δσ|/(1 + |σ|) below 1e-12). `None`
-    /// as [`Self::of`], or without convergence in [`MAX_ITERATIONS`] steps.
+    /// least-squares (ln κ, σ) of ln r_var,n = −ln gₙ, gₙ = kₙ(κ, σ)/kₙ(κ₀, σ₀) = (κ/κ₀)·sₙ
+    /// + σ·uₙ (exact for kₙ = κq⁴ + σq² with `x[n] = [sₙ, uₙ]` at κ₀, σ₀), by Gauss–Newton
+    /// from (κ₀, σ₀): each step is [`Self::of`] of the ratios the law at (κ, σ) leaves to
+    /// explain ([`relative_to`]) on the local sensitivities ((κ/κ₀)sₙ/gₙ, uₙ/gₙ), halved
+    /// while a gₙ would not be positive. The first step is the first-order fit; the
+    /// estimate, its intervals, the correlation and χ² are those of the step taken at the
+    /// solution (|Δln κ| and |Δσ|/(1 + |σ|) below 1e-12). `None` as [`Self::of`], or
+    /// without convergence in [`MAX_ITERATIONS`] steps.
     pub fn solved(
         ratios: &[ModeRatio],
         x: &[[f64; 2]],
