@@ -1344,8 +1344,9 @@ fn membrane_data_off(dir: &TempDir, name: &str, key: &str, value: &str) -> Strin
 /// - simulated at κ = 1.1 with a sidecar of 1: κ with σ held (the regression on the modes'
 ///   bending shares κq⁴/c_q) covers 1.1 and excludes 1, with one factor over the modes
 ///   (scaling every variance alike, as for a filament, gives κ ≈ 1.09 here, outside this
-///   interval); ξ covers 1; κ and σ fitted together cover 1.1 and 20;
-/// - simulated at σ = 25 with a sidecar of 20: κ and σ together cover 1 and 25, σ's
+///   interval); ξ covers 1; κ and σ fitted together cover 1.1 and 20, and ξ with them 1;
+/// - simulated at σ = 25 with a sidecar of 20: κ and σ together cover 1 and 25 (ξ with
+///   them 1), σ's
 ///   interval excludes 20, and the fit with σ held says one factor does not explain the
 ///   modes (χ² p < 1e-3).
 ///
@@ -1421,6 +1422,8 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     assert!(lo <= 1.1 && 1.1 <= hi, "joint kappa [{lo}, {hi}]");
     let (lo, hi) = interval(&run0["joint"]["tension"]);
     assert!(lo <= 20.0 && 20.0 <= hi, "joint sigma [{lo}, {hi}]");
+    let (lo, hi) = interval(&run0["joint"]["drag"]);
+    assert!(lo <= 1.0 && 1.0 <= hi, "joint xi [{lo}, {hi}]");
 
     let data = membrane_data_off(&dir, "sigma", "tension", "25.0");
     let (run0, _, d, hints) = fit(&data, &dir.join_str("fit-sigma"));
@@ -1436,6 +1439,8 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     );
     let (lo, hi) = interval(&run0["joint"]["bending_rigidity"]);
     assert!(lo <= 1.0 && 1.0 <= hi, "joint kappa [{lo}, {hi}]");
+    let (lo, hi) = interval(&run0["joint"]["drag"]);
+    assert!(lo <= 1.0 && 1.0 <= hi, "joint xi [{lo}, {hi}]");
     let p = run0["bending_regression"]["p_value"].as_f64().unwrap();
     assert!(p < 1e-3, "sigma held at the wrong value: p = {p}");
 }

@@ -4,7 +4,7 @@
 For seeds 1..N: `langevin-fem run` of a scene's run at that seed, then `langevin-fem fit`
 on its output; counts how often each interval covers the true parameter (the sidecar's:
 EI, a membrane's kappa, and xi with kT known, kT with EI known; for a membrane also kappa
-and sigma fitted together) and compares the count with the binomial law
+and sigma fitted together, and xi with them) and compares the count with the binomial law
 of the nominal level: the exact two-sided 99 % range of covered counts. Pure Python
 (standard library only). Exit 0 when every parameter's count is in its range.
 
@@ -74,9 +74,11 @@ def main():
             # A membrane's kappa and sigma fitted together (sigma on the linear scale).
             fit["joint_kappa"] = fit["joint"]["bending_rigidity"]
             fit["joint_sigma"] = fit["joint"]["tension"]
+            fit["joint_drag"] = fit["joint"]["drag"]
             truth["joint_kappa"] = f["bending_rigidity"]
             truth["joint_sigma"] = f["tension"]
-            for k in ("joint_kappa", "joint_sigma"):
+            truth["joint_drag"] = f["drag"]
+            for k in ("joint_kappa", "joint_sigma", "joint_drag"):
                 covered.setdefault(k, 0)
                 scores.setdefault(k, [])
         row = [seed]

@@ -5,7 +5,7 @@
 # against membrane-periodic's checks with the continuum's references (no discretization
 # declared).
 #  1. its data pass: exit 0; `fit` recovers kappa = 1 (sigma held), and kappa = 1 and
-#     sigma = 20 fitted together, within their 95 % intervals;
+#     sigma = 20 fitted together, and xi = 1 with them, within their 95 % intervals;
 #  2. with the noise variance x1.05 they fail: exit 1, naming mode-variance checks, and
 #     the hint names the noise amplitude or kT;
 #  3. simulated at sigma x1.2 (24 for the stated 20) they fail, and the hint names the
@@ -29,7 +29,8 @@ def covers(e, x):
     return f"{e['value']:.4f} [{lo:.4f}, {hi:.4f}]"
 print("fit: kappa", covers(run["bending_rigidity"], 1.0),
       "; together kappa", covers(run["joint"]["bending_rigidity"], 1.0),
-      "and sigma", covers(run["joint"]["tension"], 20.0))
+      "and sigma", covers(run["joint"]["tension"], 20.0),
+      "with xi", covers(run["joint"]["drag"], 1.0))
 PYEOF
 
 # fails NAME WHAT SIMULATE-ARGS...: simulates into $WORK/NAME, checks the data, prints the

@@ -213,7 +213,8 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
 }
 
 /// `kappa = 1.0989 [1.0954, 1.1025] and sigma = 19.93 [19.21, 20.65] together from the
-/// variances of modes 1, …, 24, kT known (correlation -0.93; χ² p = 0.559)`.
+/// variances of modes 1, …, 24, kT known (correlation -0.93; χ² p = 0.559); with them xi =
+/// 1.0027 [0.9990, 1.0064] from the decay rates`.
 fn joint_text(j: &JointFit) -> String {
     let f = |v: f64| {
         if (0.1..1e4).contains(&v.abs()) {
@@ -223,8 +224,16 @@ fn joint_text(j: &JointFit) -> String {
         }
     };
     let (k, s) = (&j.bending_rigidity, &j.tension);
+    let xi = j.drag.as_ref().map_or(String::new(), |x| {
+        format!(
+            "; with them xi = {} [{}, {}] from the decay rates",
+            f(x.value),
+            f(x.interval[0]),
+            f(x.interval[1])
+        )
+    });
     format!(
-        "kappa = {} [{}, {}] and sigma = {} [{}, {}] together from the variances of modes {}, kT known (correlation {:.2}; χ² p = {:.3})",
+        "kappa = {} [{}, {}] and sigma = {} [{}, {}] together from the variances of modes {}, kT known (correlation {:.2}; χ² p = {:.3}){xi}",
         f(k.value),
         f(k.interval[0]),
         f(k.interval[1]),

@@ -133,6 +133,10 @@ pub struct JointFit {
     pub chi2: f64,
     /// Its p-value.
     pub p_value: f64,
+    /// ξ from the decay rates with these κ and σ ([`joint_drag`]); absent without rates
+    /// (or from [`Self::of`] alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag: Option<Estimate>,
 }
 
 /// A parameter estimated on the linear scale: the estimate, its interval at [`LEVEL`]
@@ -209,12 +213,13 @@ impl JointFit {
             correlation: inv[0][1] / (inv[0][0] * inv[1][1]).sqrt(),
             chi2,
             p_value: ChiSquared::new(dof).map_or(f64::NAN, |d| d.sf(chi2)),
+            drag: None,
         })
     }
 
     /// The joint fit of [`Self::of`] solved in the stiffness law itself: the weighted
-    /// least-squares (ln κ, σ) of ln r_var,n = −ln gₙ, gₙ = kₙ(κ, σ)/kₙ(κ₀, σ₀) = (κ/κ₀)·sₙ
-    /// + σ·uₙ (exact for kₙ = κq⁴ + σq² with `x[n] = [sₙ, uₙ]` at κ₀, σ₀), by Gauss–Newton
+    /// least-squares (ln κ, σ) of ln r_var,n = −ln gₙ, gₙ = kₙ(κ, σ)/kₙ(κ₀, σ₀) =
+    /// (κ/κ₀)·sₙ + σ·uₙ (exact for kₙ = κq⁴ + σq² with `x[n] = [sₙ, uₙ]` at κ₀, σ₀), by Gauss–Newton
     /// from (κ₀, σ₀): each step is [`Self::of`] of the ratios the law at (κ, σ) leaves to
     /// explain ([`relative_to`]) on the local sensitivities ((κ/κ₀)sₙ/gₙ, uₙ/gₙ), halved
     /// while a gₙ would not be positive. The first step is the first-order fit; the
@@ -407,6 +412,78 @@ fn shares_of(
     )
 }
 
+/// ξ (about ξ₀ = `drag`) with κ and σ from the joint fit `j` (about κ₀ = `kappa`, of
+/// the variances `var` with sensitivities `xv`): the decay rates `rate` (sensitivities `xr`)
+/// satisfy ln r_rate,n = ln gₙ − ln(ξ/ξ₀) with gₙ = (κ/κ₀)sₙ + σuₙ, so
+/// ln(ξ/ξ₀) = Ḡ − m_rate, Ḡ the rates' inverse-variance weighted mean of ln gₙ at the
+/// fit's (κ̂, σ̂) and m_rate their pooled log ratio. Its error, to first order:
+/// var = s_rate² + aᵀΣa − 2aᵀc, with a = ∂Ḡ/∂(ln κ, σ) (the rates' weighted mean local
+/// sensitivities), Σ the joint fit's covariance and c = cov((ln κ̂, σ̂), m_rate) =
+/// −Σ·Σₙ Xₙ wₙ bₙ ρₙ s_var,n s_rate,n over the modes in both, with Xₙ = ((κ/κ₀)sₙ/gₙ,
+/// uₙ/gₙ) the variance's local sensitivities, wₙ = s_var,n⁻² its weight, bₙ the mode's
+/// normalized weight in m_rate and ρₙ its `correlation` (the jackknife's, 0 without).
+/// `None` without rates, with a rate mode lacking sensitivities, or a gₙ not positive.
+pub fn joint_drag(
+    j: &JointFit,
+    (kappa, drag): (f64, f64),
+    (var, xv): (&[ModeRatio], &[[f64; 2]]),
+    (rate, xr): (&[ModeRatio], &[[f64; 2]]),
+    correlation: impl Fn(&str) -> Option<f64>,
+) -> Option<Estimate> {
+    let pool = Pooled::of(rate)?;
+    if xr.len() != rate.len() || xv.len() != var.len() {
+        return None;
+    }
+    let (c, s) = (j.bending_rigidity.value / kappa, j.tension.value);
+    let local = |x: &[f64; 2]| {
+        let g = c * x[0] + s * x[1];
+        (g > 0.0).then(|| (g, [c * x[0] / g, x[1] / g]))
+    };
+    let log_se = |m: &ModeRatio| m.std_error / m.ratio;
+    let wr: Vec<f64> = rate.iter().map(|m| log_se(m).powi(-2)).collect();
+    let sw: f64 = wr.iter().sum();
+    let (mut gbar, mut a) = (0.0, [0.0; 2]);
+    for (x, w) in xr.iter().zip(&wr) {
+        let (g, l) = local(x)?;
+        gbar += w * g.ln() / sw;
+        a[0] += w * l[0] / sw;
+        a[1] += w * l[1] / sw;
+    }
+    let (sl, ss, rho) = (
+        j.bending_rigidity.log_std_error,
+        j.tension.std_error,
+        j.correlation,
+    );
+    let cov = [[sl * sl, rho * sl * ss], [rho * sl * ss, ss * ss]];
+    // Σₙ Xₙ wₙ bₙ ρₙ s_var,n s_rate,n over the modes in both.
+    let mut t = [0.0; 2];
+    for (m, x) in var.iter().zip(xv) {
+        let Some(k) = rate.iter().position(|r| r.mode == m.mode) else {
+            continue;
+        };
+        let Some(r) = correlation(&m.mode) else {
+            continue;
+        };
+        let (_, l) = local(x)?;
+        let term = log_se(m).powi(-2) * (wr[k] / sw) * r * log_se(m) * log_se(&rate[k]);
+        t[0] += l[0] * term;
+        t[1] += l[1] * term;
+    }
+    let quad = |u: [f64; 2], v: [f64; 2]| {
+        (0..2)
+            .map(|i| (0..2).map(|k| u[i] * cov[i][k] * v[k]).sum::<f64>())
+            .sum::<f64>()
+    };
+    // c = −Σt, so −2aᵀc = 2aᵀΣt.
+    let var_m = pool.std_error.powi(2) + quad(a, a) + 2.0 * quad(a, t);
+    Some(Estimate::scaled(
+        drag,
+        -1.0,
+        pool.log_ratio - gbar,
+        var_m.max(0.0).sqrt(),
+    ))
+}
+
 /// The fits of every run of `scene` (the summary of `check` of the data whose sidecar
 /// gives `base`), in the order of the runs' first checks (see the module docs). A run
 /// under tension held known (`base.tension`) whose variance or rate modes lack a share
@@ -487,8 +564,22 @@ fn fit_run(scene: &SceneSummary, run: &str, base: &FitBase) -> RunFit {
         .zip(cov)
         .map(|(((v, r), _), cov)| cov / (v.std_error * r.std_error));
     let joint = base.tension.and_then(|(sigma, of)| {
-        let x: Option<Vec<[f64; 2]>> = var_ratios.iter().map(|m| of(&m.mode)).collect();
-        JointFit::solved(&var_ratios, &x?, base.bending_rigidity, sigma)
+        let xv: Vec<[f64; 2]> = var_ratios
+            .iter()
+            .map(|m| of(&m.mode))
+            .collect::<Option<_>>()?;
+        let mut j = JointFit::solved(&var_ratios, &xv, base.bending_rigidity, sigma)?;
+        let xr: Option<Vec<[f64; 2]>> = rate_ratios.iter().map(|m| of(&m.mode)).collect();
+        j.drag = xr.and_then(|xr| {
+            joint_drag(
+                &j,
+                (base.bending_rigidity, base.drag),
+                (&var_ratios, &xv),
+                (&rate_ratios, &xr),
+                correlation,
+            )
+        });
+        Some(j)
     });
     RunFit {
         run: run.to_string(),
@@ -749,6 +840,64 @@ mod tests {
         let j = JointFit::solved(&soft, &x, 2.0, 20.0).unwrap();
         assert!((j.tension.value - 2.0).abs() < 1e-8, "{j:?}");
         assert!((j.bending_rigidity.value / 1.8 - 1.0).abs() < 1e-9, "{j:?}");
+    }
+
+    /// ξ with the joint κ and σ: exact law ratios of κ × 1.5, σ = 40 (stated 20) and
+    /// ξ × 0.8 give ξ₀·0.8 to 1e-9; and its standard error is the delta method's — the
+    /// numerical gradient of ln ξ̂ in the variance and rate log ratios (a central
+    /// difference through [`JointFit::solved`] and [`joint_drag`]) against their
+    /// covariance (log errors s_var, s_rate, and ρₙ between a mode's two) gives the same
+    /// variance to 1e-4; with the correlations left out it does not (the covariance term
+    /// is tested, not idle).
+    #[test]
+    fn the_joint_drag_is_exact_in_the_law_with_the_delta_methods_error() {
+        let shares = [0.9, 0.75, 0.6, 0.45, 0.3, 0.2];
+        let x: Vec<[f64; 2]> = shares.iter().map(|s| [*s, (1.0 - s) / 20.0]).collect();
+        let (sv, sr) = ([0.01, 0.012, 0.015, 0.02, 0.025, 0.03], 0.04);
+        let rho = |m: &str| Some(if m == "n=2" { -0.6 } else { -0.3 });
+        let ratios = |y: &[f64], z: &[f64]| {
+            let v: Vec<ModeRatio> = (y.iter().zip(&sv).enumerate())
+                .map(|(k, (y, s))| ModeRatio::new(format!("n={}", k + 1), y.exp(), s * y.exp()))
+                .collect();
+            let r: Vec<ModeRatio> = (z.iter().enumerate())
+                .map(|(k, z)| ModeRatio::new(format!("n={}", k + 1), z.exp(), sr * z.exp()))
+                .collect();
+            (v, r)
+        };
+        let drag = |y: &[f64], z: &[f64], rho: &dyn Fn(&str) -> Option<f64>| {
+            let (v, r) = ratios(y, z);
+            let j = JointFit::solved(&v, &x, 2.0, 20.0).unwrap();
+            joint_drag(&j, (2.0, 3.0), (&v, &x), (&r, &x), rho).unwrap()
+        };
+        let g: Vec<f64> = x.iter().map(|[s, u]| 1.5 * s + 40.0 * u).collect();
+        let y: Vec<f64> = g.iter().map(|g| -g.ln()).collect();
+        let z: Vec<f64> = g.iter().map(|g| g.ln() - 0.8f64.ln()).collect();
+        let xi = drag(&y, &z, &rho);
+        assert!((xi.value / 2.4 - 1.0).abs() < 1e-9, "{xi:?}");
+        // The delta method, by central differences in each log ratio.
+        let h = 1e-6;
+        let grad = |k: usize| {
+            let (mut yp, mut ym, mut zp, mut zm) = (y.clone(), y.clone(), z.clone(), z.clone());
+            if k < 6 {
+                yp[k] += h;
+                ym[k] -= h;
+            } else {
+                zp[k - 6] += h;
+                zm[k - 6] -= h;
+            }
+            (drag(&yp, &zp, &rho).value.ln() - drag(&ym, &zm, &rho).value.ln()) / (2.0 * h)
+        };
+        let d: Vec<f64> = (0..12).map(grad).collect();
+        let mut var = 0.0;
+        for n in 0..6 {
+            let r = rho(&format!("n={}", n + 1)).unwrap();
+            var += d[n] * d[n] * sv[n] * sv[n] + d[6 + n] * d[6 + n] * sr * sr;
+            var += 2.0 * d[n] * d[6 + n] * r * sv[n] * sr;
+        }
+        let stated = xi.log_std_error.powi(2);
+        assert!((stated / var - 1.0).abs() < 1e-4, "{stated} vs {var}");
+        let without = drag(&y, &z, &|_| None).log_std_error.powi(2);
+        assert!((without / var - 1.0).abs() > 1e-2, "{without} vs {var}");
     }
 
     /// An error estimated with ν degrees of freedom is scaled by √(ν/(ν − 2)) before
