@@ -11,7 +11,7 @@ use langevin_fem::report::write_report;
 use langevin_fem::spectral::membrane::Membrane;
 use langevin_fem::verify::diagnosis::membrane_sensitivities;
 use langevin_fem::verify::fit::{
-    FitBase, JointFit, RunFit, SensitivityOf, estimate_text, fit_runs,
+    FitBase, JointFit, RunFit, SensitivityOf, estimate_text, fit_runs, number_text,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -216,13 +216,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
 /// variances of modes 1, …, 24, kT known (correlation -0.93; χ² p = 0.559); with them xi =
 /// 1.0027 [0.9990, 1.0064] from the decay rates`.
 fn joint_text(j: &JointFit) -> String {
-    let f = |v: f64| {
-        if (0.1..1e4).contains(&v.abs()) {
-            format!("{v:.4}")
-        } else {
-            format!("{v:.4e}")
-        }
-    };
+    let f = number_text;
     let (k, s) = (&j.bending_rigidity, &j.tension);
     let xi = j.drag.as_ref().map_or(String::new(), |x| {
         format!(

@@ -232,37 +232,24 @@ impl JointFit {
         kappa: f64,
         sigma: f64,
     ) -> Option<JointFit> {
-        let law = |c: f64, s: f64| -> Option<Vec<f64>> {
-            let g: Vec<f64> = x.iter().map(|x| c * x[0] + s * x[1]).collect();
-            g.iter().all(|g| *g > 0.0).then_some(g)
-        };
-        let (mut c, mut s) = (1.0, sigma);
-        let mut g = law(c, s)?;
-        for _ in 0..MAX_ITERATIONS {
-            let local: Vec<[f64; 2]> = (x.iter().zip(&g))
-                .map(|(x, g)| [c * x[0] / g, x[1] / g])
-                .collect();
-            let step = Self::of(&relative_to(ratios, &g), &local, kappa * c, s)?;
-            let (dl, ds) = (
-                (step.bending_rigidity.value / (kappa * c)).ln(),
-                step.tension.value - s,
-            );
-            if dl.abs() < 1e-12 && ds.abs() < 1e-12 * (1.0 + s.abs()) {
-                return Some(step);
-            }
-            let mut h = 1.0;
-            loop {
-                if let Some(next) = law(c * (h * dl).exp(), s + h * ds) {
-                    (c, s, g) = (c * (h * dl).exp(), s + h * ds, next);
-                    break;
-                }
-                h *= 0.5;
-                if h < 1e-9 {
-                    return None;
-                }
-            }
-        }
-        None
+        let law = |(c, s): (f64, f64)| x.iter().map(|x| c * x[0] + s * x[1]).collect();
+        solve_in_law(
+            (1.0, sigma),
+            law,
+            |(c, s), g| {
+                let local: Vec<[f64; 2]> = (x.iter().zip(g))
+                    .map(|(x, g)| [c * x[0] / g, x[1] / g])
+                    .collect();
+                let step = Self::of(&relative_to(ratios, g), &local, kappa * c, s)?;
+                let d = (
+                    (step.bending_rigidity.value / (kappa * c)).ln(),
+                    step.tension.value - s,
+                );
+                Some((step, d))
+            },
+            |(_, s), (dl, ds)| dl.abs() < 1e-12 && ds.abs() < 1e-12 * (1.0 + s.abs()),
+            |(c, s), (dl, ds), h| (c * (h * dl).exp(), s + h * ds),
+        )
     }
 }
 
@@ -290,29 +277,62 @@ fn relative_to(ratios: &[ModeRatio], g: &[f64]) -> Vec<ModeRatio> {
 /// and χ² of the step at the solution (|Δℓ| below 1e-12), and the local shares there;
 /// `None` as [`Pooled::regressed`] or without convergence in [`MAX_ITERATIONS`] steps.
 fn held_tension(ratios: &[ModeRatio], shares: &[f64]) -> Option<(Pooled, Vec<f64>)> {
-    let law = |l: f64| -> Option<Vec<f64>> {
+    let law = |l: f64| {
         let c = l.exp();
-        let g: Vec<f64> = shares.iter().map(|s| c * s + 1.0 - s).collect();
+        shares.iter().map(|s| c * s + 1.0 - s).collect()
+    };
+    solve_in_law(
+        0.0,
+        law,
+        |l, g| {
+            let c = l.exp();
+            let local: Vec<f64> = shares.iter().zip(g).map(|(s, g)| c * s / g).collect();
+            let step = Pooled::regressed(&relative_to(ratios, g), Some(&local))?;
+            let d = step.log_ratio;
+            Some((
+                (
+                    Pooled {
+                        log_ratio: -l,
+                        ..step
+                    },
+                    local,
+                ),
+                d,
+            ))
+        },
+        |_, d| d.abs() < 1e-12,
+        |l, d, h| l - h * d,
+    )
+}
+
+/// Damped Gauss–Newton in a stiffness law ([`held_tension`], [`JointFit::solved`]): from
+/// the parameters `theta`, each step fits the ratios linearized at the law's stiffness
+/// ratios g = `law(θ)` (`step(θ, g)`: the fit at θ and the step Δθ it implies); the fit
+/// is returned once `converged(θ, Δθ)`, else θ moves to `moved(θ, Δθ, h)` with h
+/// halved from 1 while a gₙ there would not be positive. `None` if the law at `theta`
+/// has a gₙ ≤ 0, a fit fails, the step shrinks below 1e-9 or [`MAX_ITERATIONS`] pass.
+fn solve_in_law<P: Copy, R>(
+    mut theta: P,
+    law: impl Fn(P) -> Vec<f64>,
+    step: impl Fn(P, &[f64]) -> Option<(R, P)>,
+    converged: impl Fn(P, P) -> bool,
+    moved: impl Fn(P, P, f64) -> P,
+) -> Option<R> {
+    let positive = |theta: P| {
+        let g = law(theta);
         g.iter().all(|g| *g > 0.0).then_some(g)
     };
-    let (mut l, mut g): (f64, _) = (0.0, law(0.0)?);
+    let mut g = positive(theta)?;
     for _ in 0..MAX_ITERATIONS {
-        let c = l.exp();
-        let local: Vec<f64> = shares.iter().zip(&g).map(|(s, g)| c * s / g).collect();
-        let step = Pooled::regressed(&relative_to(ratios, &g), Some(&local))?;
-        if step.log_ratio.abs() < 1e-12 {
-            return Some((
-                Pooled {
-                    log_ratio: -l,
-                    ..step
-                },
-                local,
-            ));
+        let (fit, d) = step(theta, &g)?;
+        if converged(theta, d) {
+            return Some(fit);
         }
         let mut h = 1.0;
         loop {
-            if let Some(next) = law(l - h * step.log_ratio) {
-                (l, g) = (l - h * step.log_ratio, next);
+            let next = moved(theta, d, h);
+            if let Some(gn) = positive(next) {
+                (theta, g) = (next, gn);
                 break;
             }
             h *= 0.5;
@@ -594,18 +614,21 @@ fn fit_run(scene: &SceneSummary, run: &str, base: &FitBase) -> RunFit {
     }
 }
 
+/// A fitted number as `fit` prints it: four decimals between 0.1 and 10⁴, else four in
+/// exponent form.
+pub fn number_text(v: f64) -> String {
+    if (0.1..1e4).contains(&v.abs()) {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
 /// `EI = 1.0002 [0.9976, 1.0027] from the variances of modes 1, 2, 3, kT known (one
 /// factor over them: χ² p = 0.519)` for an estimate of parameter `name` pooled as
 /// `pooled` from `what` (the interval at [`LEVEL`]; `given`: what is held known).
 pub fn estimate_text(name: &str, e: &Estimate, pooled: &Pooled, what: &str, given: &str) -> String {
-    // Four significant digits: fixed between 0.1 and 10⁴, else in exponent form.
-    let f = |v: f64| {
-        if (0.1..1e4).contains(&v.abs()) {
-            format!("{v:.4}")
-        } else {
-            format!("{v:.4e}")
-        }
-    };
+    let f = number_text;
     format!(
         "{name} = {} [{}, {}] from the {what} of modes {}, {given}{}",
         f(e.value),
