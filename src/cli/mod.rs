@@ -259,8 +259,11 @@ fn check_out_dir(out: &Path, kind: Option<OutputKind<'_>>) -> Result<Option<Outp
     };
     let mut existing = out;
     while !existing.as_os_str().is_empty() && !existing.exists() {
-        // A path that is there but leads nowhere: a dangling symbolic link, or a loop.
-        if std::fs::symlink_metadata(existing).is_ok() {
+        // A path that is there but leads nowhere: a dangling symbolic link, or a loop. A
+        // directory another process (a concurrent shard) created since `exists` is not
+        // one: it is passed over as a missing ancestor would be.
+        let symlink = std::fs::symlink_metadata(existing).is_ok_and(|m| m.file_type().is_symlink());
+        if symlink && !existing.exists() {
             return Err(fail(format!(
                 "{} is a symbolic link that leads to no file or directory (dangling, or a loop): remove it, point it at a directory, or give another --out",
                 existing.display()
