@@ -1342,13 +1342,13 @@ fn membrane_data_off(dir: &TempDir, name: &str, key: &str, value: &str) -> Strin
 
 /// `fit` of membrane-periodic data (σ = 20) against a sidecar that misstates κ or σ:
 /// - simulated at κ = 1.1 with a sidecar of 1: κ with σ held (the regression on the modes'
-///   bending shares κq⁴/c_q) covers 1.1 and excludes 1, with one factor over the modes
-///   (scaling every variance alike, as for a filament, gives κ ≈ 1.09 here, outside this
+///   bending shares κq⁴/c_q) covers 1.1 and excludes 1, the law fitting the modes with that
+///   one parameter (its χ² so labelled, not "one factor"; scaling every variance alike, as for a filament, gives κ ≈ 1.09 here, outside this
 ///   interval); ξ covers 1; κ and σ fitted together cover 1.1 and 20, and ξ with them 1;
 /// - simulated at σ = 25 with a sidecar of 20: κ and σ together cover 1 and 25 (ξ with
 ///   them 1), σ's
-///   interval excludes 20, and the fit with σ held says one factor does not explain the
-///   modes (χ² p < 1e-3).
+///   interval excludes 20, and the fit with σ held says the law with κ alone does not
+///   explain the modes (χ² p < 1e-3).
 ///
 /// The printed fit names κ, the tension held and the joint fit. The hint of the checks
 /// beside it (`summary.json`'s `hints`, in its schema, and stdout) names the parameter
@@ -1401,7 +1401,14 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     );
     assert!(stdout.contains(&format!("crank-nicolson: {text}")), "{d}");
     assert!(
-        stdout.contains("    kappa = ") && stdout.contains("kT known, sigma = 20 held"),
+        stdout.contains("    kappa = ")
+            && stdout.contains(
+                "kT known, sigma = 20 held (the law with that one parameter over them: χ² p = "
+            ),
+        "{d}"
+    );
+    assert!(
+        stdout.contains("kappa known instead (one factor over them: χ² p = "),
         "{d}"
     );
     assert!(
@@ -1415,7 +1422,7 @@ fn fit_recovers_a_membranes_bending_rigidity_and_tension() {
     );
     assert!(lo > 1.09, "kappa [{lo}, {hi}]");
     let p = run0["bending_regression"]["p_value"].as_f64().unwrap();
-    assert!(p > 1e-3, "one factor over the modes: p = {p}");
+    assert!(p > 1e-3, "the law with κ alone over the modes: p = {p}");
     let (lo, hi) = interval(&run0["drag"]);
     assert!(lo <= 1.0 && 1.0 <= hi, "xi [{lo}, {hi}]");
     let (lo, hi) = interval(&run0["joint"]["bending_rigidity"]);

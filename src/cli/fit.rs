@@ -170,6 +170,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             bending,
             "variances",
             &format!("kT known{held}"),
+            f.bending_regression.is_some(),
         )];
         if let (Some(r), Some(xi)) = (&f.rate, &f.drag) {
             parts.push(estimate_text(
@@ -178,6 +179,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
                 r,
                 "decay rates",
                 &format!("with that {name}"),
+                false,
             ));
         }
         parts.push(estimate_text(
@@ -186,6 +188,7 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
             v,
             "variances",
             &format!("{name} known instead"),
+            false,
         ));
         if let Some(j) = &f.joint {
             parts.push(joint_text(j));

@@ -627,8 +627,24 @@ pub fn number_text(v: f64) -> String {
 /// `EI = 1.0002 [0.9976, 1.0027] from the variances of modes 1, 2, 3, kT known (one
 /// factor over them: χ² p = 0.519)` for an estimate of parameter `name` pooled as
 /// `pooled` from `what` (the interval at [`LEVEL`]; `given`: what is held known).
-pub fn estimate_text(name: &str, e: &Estimate, pooled: &Pooled, what: &str, given: &str) -> String {
+///
+/// The χ² is of one factor over the modes, or, for a membrane's κ with σ held
+/// (`in_law`), of the stiffness law gₙ = (κ/κ₀)sₙ + σuₙ with its one parameter κ, which
+/// is not one factor over the modes.
+pub fn estimate_text(
+    name: &str,
+    e: &Estimate,
+    pooled: &Pooled,
+    what: &str,
+    given: &str,
+    in_law: bool,
+) -> String {
     let f = number_text;
+    let over = if in_law {
+        "the law with that one parameter over them"
+    } else {
+        "one factor over them"
+    };
     format!(
         "{name} = {} [{}, {}] from the {what} of modes {}, {given}{}",
         f(e.value),
@@ -640,9 +656,9 @@ pub fn estimate_text(name: &str, e: &Estimate, pooled: &Pooled, what: &str, give
             .map(|m| m.trim_start_matches("n="))
             .collect::<Vec<_>>()
             .join(", "),
-        pooled.p_value.map_or(String::new(), |p| format!(
-            " (one factor over them: χ² p = {p:.3})"
-        ))
+        pooled
+            .p_value
+            .map_or(String::new(), |p| format!(" ({over}: χ² p = {p:.3})"))
     )
 }
 
