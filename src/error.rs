@@ -105,6 +105,33 @@ pub enum Error {
     },
 }
 
+/// The most characters of a value a message repeats ([`shown_value`]).
+pub const MAX_SHOWN_CHARS: usize = 120;
+
+/// A value as a message shows it: a number written with more than 20 characters (as
+/// Rust prints 1e300 in full) in exponent form, and any text longer than
+/// [`MAX_SHOWN_CHARS`] cut there, saying how long it was — so that a refusal of a huge
+/// input does not repeat it.
+pub fn shown_value(text: &str) -> String {
+    if text.len() > 20
+        && let Ok(x) = text.parse::<f64>()
+        && x.is_finite()
+    {
+        return format!("{x:e}");
+    }
+    shown_text(text, MAX_SHOWN_CHARS)
+}
+
+/// `text` cut to its first `max` characters, with "… (N characters in all)" if cut.
+pub fn shown_text(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        return text.to_string();
+    }
+    let head: String = text.chars().take(max).collect();
+    format!("{head}… ({n} characters in all)")
+}
+
 impl Error {
     /// Shorthand for [`Error::InvalidParameter`].
     pub fn invalid(
@@ -114,7 +141,7 @@ impl Error {
     ) -> Self {
         Error::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value: shown_value(&value.to_string()),
             allowed: allowed.into(),
         }
     }
@@ -213,5 +240,29 @@ pub fn require_in_range(name: &str, value: f64, lo: f64, hi: f64) -> Result<()> 
         Ok(())
     } else {
         Err(Error::invalid(name, value, format!("in [{lo}, {hi}]")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refusal does not repeat a huge input: 1e300 as Rust prints it in full comes out
+    /// in exponent form, a long text is cut with its length; short values are untouched.
+    #[test]
+    fn refusals_show_huge_values_briefly() {
+        let e = Error::invalid("width", 1e300, "in [1e-30, 1e30]");
+        assert!(e.to_string().ends_with("got 1e300"), "{e}");
+        let e = Error::invalid("width", 0.25, "in [1e-30, 1e30]");
+        assert!(e.to_string().ends_with("got 0.25"), "{e}");
+        let long = "x".repeat(1000);
+        let e = Error::invalid("name", &long, "short");
+        let m = e.to_string();
+        assert!(
+            m.len() < 300 && m.contains("(1000 characters in all)"),
+            "{m}"
+        );
+        assert_eq!(shown_text("abc", 3), "abc");
+        assert_eq!(shown_text("abcd", 3), "abc… (4 characters in all)");
     }
 }

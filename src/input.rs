@@ -176,7 +176,8 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
         let inner = e.inner();
         let (line, column) = (inner.line(), inner.column());
         let said = inner.to_string();
-        // A missing or unknown field is named with its parent's path: name the field.
+        // A missing field is named with its parent's path: name the field. An unknown
+        // field's path already ends with it (serde_path_to_error has entered the key).
         let field = ["missing field `", "unknown field `"]
             .iter()
             .find_map(|p| said.strip_prefix(p))
@@ -184,6 +185,7 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
         let key = match (at.as_str(), field) {
             ("", None) => "-".to_string(),
             ("", Some(f)) => f.to_string(),
+            (p, Some(f)) if p == f || p.ends_with(&format!(".{f}")) => p.to_string(),
             (p, Some(f)) => format!("{p}.{f}"),
             (p, None) => p.to_string(),
         };
@@ -249,7 +251,7 @@ fn number_before(text: &str, line: usize, column: usize) -> Option<String> {
         .rfind(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c)))
         .map_or(0, |i| i + 1);
     let number = &head[start..];
-    (!number.is_empty()).then(|| number.to_string())
+    (!number.is_empty()).then(|| crate::error::shown_value(number))
 }
 
 /// The literals some writers put in JSON for non-finite floats, longest first (matched
@@ -437,11 +439,13 @@ mod tests {
     #[test]
     fn json_errors_name_the_key_and_non_json_literals() {
         #[derive(serde::Deserialize, Debug)]
+        #[serde(deny_unknown_fields)]
         #[allow(dead_code)]
         struct Run {
             dt: f64,
         }
         #[derive(serde::Deserialize, Debug)]
+        #[serde(deny_unknown_fields)]
         #[allow(dead_code)]
         struct Top {
             runs: Vec<Run>,
@@ -475,6 +479,13 @@ mod tests {
             ),
             ("{\"runs\": []} x", "-", "trailing"),
             ("{\"runs\": [{}]}", "runs[0].dt", "missing field"),
+            // An unknown key is named once (its path already ends with it).
+            (
+                "{\"runs\": [{\"dt\": 1, \"dtt\": 2}]}",
+                "runs[0].dtt",
+                "unknown field",
+            ),
+            ("{\"runs\": [], \"run\": 2}", "run", "unknown field"),
             (
                 "{\"runs\": [{\"dt\": [1, 2]}]}",
                 "runs[0].dt",

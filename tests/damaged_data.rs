@@ -1561,6 +1561,15 @@ fn npy_cases() -> Vec<Case> {
             &["trajectory-0001.npy", "aw_1", "NaN", "row"],
             |_, r| npy_set(r, LIN_NPY, 1500, 6, f64::NAN),
         ),
+        // Finite but beyond 1e60 (at 1e99 the fourth powers of a pooled variance's
+        // error overflowed, and the estimator failed as if the data were too few).
+        refused(
+            N,
+            LinNpy,
+            "npy-1e99-in-aw-1",
+            &["trajectory-0001.npy", "aw_1", "1e99", "row", "at most"],
+            |_, r| npy_set(r, LIN_NPY, 1500, 6, 1e99),
+        ),
         refused(
             N,
             LinNpy,

@@ -13,6 +13,7 @@ use langevin_fem::verify::diagnosis::membrane_sensitivities;
 use langevin_fem::verify::fit::{
     FitBase, JointFit, RunFit, SensitivityOf, estimate_text, fit_runs, number_text,
 };
+use langevin_fem::verify::summary::SceneSummary;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -140,27 +141,11 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
     let mut lines = Vec::new();
     for f in &fits {
         let (Some(v), Some(kt)) = (&f.variance, &f.kt_given_bending_rigidity) else {
-            return Err(Error::run_failed(
-                format!("data run {}", f.run),
-                "fit",
-                Error::invalid(
-                    "mode-variance checks",
-                    0,
-                    "at least one (the scene's checks must include mode-variance)",
-                ),
-            ));
+            return Err(no_variances(&summary.scenes[0], &f.run));
         };
-        // Under tension, a checked mode without a bending share (not `n=k`).
+        // Under tension, κ with σ held comes from the modes' bending shares.
         let Some(ei) = &f.bending_rigidity else {
-            return Err(Error::run_failed(
-                format!("data run {}", f.run),
-                "fit",
-                Error::invalid(
-                    "mode-variance checks",
-                    v.modes.join(", "),
-                    "checked modes n=k of the membrane, each with a bending share",
-                ),
-            ));
+            return Err(no_bending_fit(&object, &f.run, &v.modes));
         };
         let (name, held) = (object.name(), object.held());
         let bending = f.bending_regression.as_ref().unwrap_or(v);
@@ -213,6 +198,80 @@ pub fn run(args: FitArgs, verbosity: Verbosity) -> Result<i32> {
     write_report(report, &summary)?;
     print_verdict(&args, &summary, verbosity, start, &lines);
     Ok(0)
+}
+
+/// Why run `run` has no pooled variance: its checks' estimates are not positive (data
+/// of all but zero variance), its scene has no `mode-variance` checks, or every one was
+/// skipped (named with the first reason).
+fn no_variances(scene: &SceneSummary, run: &str) -> Error {
+    let prefix = format!("{run}/mode-variance/");
+    let skipped = scene
+        .skipped
+        .iter()
+        .filter(|c| c.name.starts_with(&prefix))
+        .collect::<Vec<_>>();
+    let checked: Vec<_> = scene
+        .checks
+        .iter()
+        .filter(|c| c.name.starts_with(&prefix))
+        .collect();
+    let (value, allowed) = match (checked.first(), skipped.first()) {
+        (Some(c), _) => (
+            format!("{} without a positive estimate", checked.len()),
+            format!(
+                "checks whose estimated variance is positive and finite, for a ratio to the reference (the first: {} estimates {:e} against {:e}: are the data's heights or amplitudes all but zero?)",
+                c.name,
+                c.estimate.unwrap_or(f64::NAN),
+                c.reference.unwrap_or(f64::NAN)
+            ),
+        ),
+        (None, None) => (
+            "none".to_string(),
+            "at least one (the scene's checks must include mode-variance)".to_string(),
+        ),
+        (None, Some(first)) => (
+            format!("{} skipped", skipped.len()),
+            format!(
+                "at least one that the data allow (the first skipped: {}: {})",
+                first.name, first.reason
+            ),
+        ),
+    };
+    Error::run_failed(
+        format!("data run {run}"),
+        "fit",
+        Error::invalid("mode-variance checks", value, allowed),
+    )
+}
+
+/// Why a membrane's κ with σ held could not be fitted in run `run` from `modes`: a mode
+/// without a bending share (not `n=k`), or shares that cannot carry κ (all near 0: the
+/// tension sets the variances; or the fit in the law did not converge).
+fn no_bending_fit(object: &FitObject, run: &str, modes: &[String]) -> Error {
+    let shares: Option<Vec<f64>> = modes
+        .iter()
+        .map(|m| object.sensitivities(m).map(|s| s[0]))
+        .collect();
+    let inner = match shares {
+        None => Error::invalid(
+            "mode-variance checks",
+            modes.join(", "),
+            "checked modes n=k of the membrane, each with a bending share",
+        ),
+        Some(shares) => {
+            let (lo, hi) = shares.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| {
+                (lo.min(s), hi.max(s))
+            });
+            Error::invalid(
+                "membrane.bending_rigidity",
+                format!(
+                    "the sidecar's, with bending shares κq⁴/(κq⁴ + σq²) in [{lo:.3e}, {hi:.3e}]"
+                ),
+                "shares that carry κ: the fit of κ with σ held in the law did not converge (with shares near 0 the tension sets the variances and κ cannot be seen); check that κ and σ in data.json are the simulated ones",
+            )
+        }
+    };
+    Error::run_failed(format!("data run {run}"), "fit", inner)
 }
 
 /// `kappa = 1.0989 [1.0954, 1.1025] and sigma = 19.93 [19.21, 20.65] together from the

@@ -304,6 +304,9 @@ pub struct MembraneArgs {
     noise: String,
 }
 
+/// The smallest rate·Δt of the mode `theory membrane --dt` gives the discrete law of.
+const MIN_RATE_DT: f64 = 1e-9;
+
 /// The most plate elements per side `theory membrane --elements` takes.
 const MAX_THEORY_PLATE_ELEMENTS: usize = 64;
 
@@ -327,7 +330,15 @@ fn membrane_fem(
             ));
         }
     }
-    let plate = PlateModel::new(mb.params, nx, ny).map_err(as_flag)?;
+    // The library names the mesh sizes nx and ny; here they are the two flags.
+    let plate = PlateModel::new(mb.params, nx, ny).map_err(|e| {
+        let flag = match &e {
+            Error::InvalidParameter { name, .. } if name == "nx" => "--elements",
+            Error::InvalidParameter { name, .. } if name == "ny" => "--elements-y",
+            _ => return as_flag(e),
+        };
+        as_flag_named(flag)(e)
+    })?;
     let modes = PlateModes::new(&plate)?;
     let Some(fe) = modes.acoustic(mode) else {
         return Err(Error::invalid(
@@ -425,6 +436,18 @@ fn membrane_discrete(
             format!("{dt:e}"),
             format!(
                 "< {limit:e}: past it this mode's {integrator} multiplier rounds to -1 in f64 (rate x dt about 2^55) and its stationary variance is 0/0; give a smaller --dt, or --integrator backward-euler or exact-modal"
+            ),
+        ));
+    }
+    // At rate·Δt below about 1e-9 the multiplier 1 − O(rate·Δt) keeps fewer than seven
+    // digits of its distance from 1 in f64 (and rounds to 1 below ε): the law is lost.
+    let floor = MIN_RATE_DT / rate;
+    if dt < floor {
+        return Err(Error::invalid(
+            "--dt",
+            format!("{dt:e}"),
+            format!(
+                ">= {floor:e}: below it this mode's rate x dt is under {MIN_RATE_DT:e} and its multiplier 1 - O(rate x dt) loses its digits in f64 (it rounds to 1 below about 1e-16)"
             ),
         ));
     }
@@ -717,6 +740,21 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
         return Err(Error::invalid("--tolerance", args.tolerance, "in (0, 1)"));
     }
     let pv = mb.point_variance(x, y, args.tolerance).map_err(as_flag)?;
+    // At the term caps (a tension far above κq_min², where the slowest mode's variance,
+    // the tolerance's scale, is small) the bound reached may exceed the one asked for:
+    // said, not hidden.
+    let target = args.tolerance * mb.variance_scale();
+    let tolerance_met = pv.truncation_error <= target;
+    if !tolerance_met {
+        eprintln!(
+            "warning: point_variance: --tolerance {:e} ({target:e} absolute) is not met within {} terms; the bound reached is {:e} ({:.1e} of the value): raise --tolerance to {:.0e} or more to have it met",
+            args.tolerance,
+            pv.n_modes,
+            pv.truncation_error,
+            pv.truncation_error / pv.value.abs(),
+            args.tolerance * pv.truncation_error / target * 1.5
+        );
+    }
     let [qx, qy] = mb.wavevector(mode);
     let mut out = json!({
         "boundary": params.boundary.name(),
@@ -733,6 +771,7 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
             "x": x, "y": y,
             "value": pv.value,
             "truncation_error": pv.truncation_error,
+            "tolerance_met": tolerance_met,
             "terms": pv.n_modes,
         },
     });
@@ -896,6 +935,9 @@ enum AreaMesh {
     Convergence(Vec<usize>),
 }
 
+/// The range of `theory area --width`.
+const AREA_SIDE_RANGE: (f64, f64) = (1e-100, 1e100);
+
 /// The validated geometry, moduli and mesh (or cutoff) of an area query.
 fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
     let boundary = match args.boundary {
@@ -904,6 +946,18 @@ fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
     };
     require_positive("--width", args.width)?;
     require_positive("--height", args.height)?;
+    // The result depends on the sides only through b/a; their scale must keep A₀, K_A =
+    // S·kT/A₀ and q²_min inside f64.
+    let (w_lo, w_hi) = AREA_SIDE_RANGE;
+    if !(w_lo..=w_hi).contains(&args.width) {
+        return Err(Error::invalid(
+            "--width",
+            format!("{:e}", args.width),
+            format!(
+                "in [{w_lo:e}, {w_hi:e}] (the tension ratio depends on the sides only through b/a; this keeps A₀ and q²_min inside f64)"
+            ),
+        ));
+    }
     let (lo, hi) = (
         args.width / MAX_AREA_ASPECT_RATIO,
         args.width * MAX_AREA_ASPECT_RATIO,

@@ -68,8 +68,8 @@
 //! - A file with no data rows; a CSV file naming a column of the format twice; a value
 //!   of a column of the format (`t`, `w_j`, `v_j`, `aw_n`, `av_n`; `t`, `force`,
 //!   `stored_length`) that is not a finite number (other CSV columns are not read), or
-//!   that the checks use and is larger than 1e100 in magnitude in their units (its
-//!   squares would overflow: no physical value is near it); a column `t` off the
+//!   that the checks use and is larger than 1e60 in magnitude in their units (its
+//!   fourth powers would overflow: no physical value is near it); a column `t` off the
 //!   cadence `t₀ + r·dt_sample`, or (`start = "rest"`) not starting at 0; a `.npy`
 //!   header whose shape does not match the file's size, or that gives a key twice.
 
@@ -80,7 +80,7 @@ pub use npy::{NpyWriter, read_npy};
 pub use table::{Table, TrajectoryFile, read_table};
 
 use crate::dynamics::IntegratorKind;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, shown_value};
 use crate::fem::noise::NoiseModel;
 use crate::input::{MAX_METADATA_BYTES, read_text};
 use crate::params::FilamentParams;
@@ -514,7 +514,10 @@ impl Discretization {
         {
             return Err((
                 key("dt"),
-                format!("must be a positive finite time, got {dt}"),
+                format!(
+                    "must be a positive finite time, got {}",
+                    shown_value(&dt.to_string())
+                ),
             ));
         }
         if !self.is_modelled() {
@@ -734,7 +737,10 @@ impl DataSidecar {
             if !(v.is_finite() && v > 0.0 && (1e-30..=1e30).contains(&v)) {
                 return Err(bad(
                     format!("{table}.{key}"),
-                    format!("must be a finite number in [1e-30, 1e30], got {v}"),
+                    format!(
+                        "must be a finite number in [1e-30, 1e30], got {}",
+                        shown_value(&v.to_string())
+                    ),
                 ));
             }
         }
@@ -744,7 +750,7 @@ impl DataSidecar {
                     "membrane.tension".into(),
                     format!(
                         "must be a finite number in [-1e30, 1e30], got {}",
-                        m.tension
+                        shown_value(&m.tension.to_string())
                     ),
                 ));
             }
@@ -845,7 +851,10 @@ impl DataRun {
         {
             return Err((
                 key("strain_ratio"),
-                format!("must be a finite ratio in [-1e6, 1e6], got {r}"),
+                format!(
+                    "must be a finite ratio in [-1e6, 1e6], got {}",
+                    shown_value(&r.to_string())
+                ),
             ));
         }
         let tau1 = object.tau1();
@@ -866,7 +875,10 @@ impl DataRun {
         if !(self.burn_in.is_finite() && self.burn_in >= 0.0) {
             return Err((
                 key("burn_in"),
-                format!("must be a finite time >= 0, got {}", self.burn_in),
+                format!(
+                    "must be a finite time >= 0, got {}",
+                    shown_value(&self.burn_in.to_string())
+                ),
             ));
         }
         self.validate_layout(k, object.line_length())?;
@@ -895,7 +907,8 @@ impl DataRun {
                 return Err((
                     format!("runs[{k}].positions[{j}]"),
                     format!(
-                        "must be in [0, {length}] (the filament's [0, L], or a membrane's midline x in [0, a]), got {x}"
+                        "must be in [0, {length}] (the filament's [0, L], or a membrane's midline x in [0, a]), got {}",
+                        shown_value(&x.to_string())
                     ),
                 ));
             }

@@ -166,47 +166,132 @@ pub(super) fn parse_npy(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<
     Ok((rows, cols, values))
 }
 
-/// The dtype's byte order (big-endian?) and the shape (rows, columns) of a `.npy`
-/// header; on failure, why.
-fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), String> {
-    let field = |name: &str| -> std::result::Result<&str, String> {
-        let key = format!("'{name}'");
-        let at = header
-            .find(&key)
-            .ok_or(format!("no '{name}' in the header"))?;
-        // NumPy's parser keeps the last of a repeated key, this one would read the first:
-        // the file's meaning would depend on the reader.
-        if header[at + key.len()..].contains(&key) {
+/// The keys of a `.npy` header dictionary, each once, nothing else (as NumPy requires).
+const HEADER_KEYS: [&str; 3] = ["descr", "fortran_order", "shape"];
+
+/// The entries (key, value text) of a `.npy` header: one Python dictionary literal,
+/// padded with whitespace, whose keys are quoted strings and whose values hold no
+/// top-level comma. NumPy evaluates the header with `ast.literal_eval` and refuses a
+/// header that is not such a literal (unterminated, a NUL byte) or whose keys are not
+/// exactly [`HEADER_KEYS`]; so does this reader, rather than guess at what the file holds.
+fn header_entries(header: &str) -> std::result::Result<Vec<(&str, &str)>, String> {
+    if let Some((i, c)) = header
+        .char_indices()
+        .find(|&(_, c)| c.is_control() && !c.is_ascii_whitespace())
+    {
+        return Err(format!(
+            "the header holds a control character (U+{:04X} at byte {i}): not a Python dictionary literal",
+            c as u32
+        ));
+    }
+    let literal = header.trim();
+    let inner = literal
+        .strip_prefix('{')
+        .and_then(|s| s.strip_suffix('}'))
+        .ok_or_else(|| {
+            let shown: String = literal.chars().take(80).collect();
+            format!("the header {shown:?} is not a complete Python dictionary literal {{...}}")
+        })?;
+    let mut entries = Vec::new();
+    let (mut depth, mut quote, mut from) = (0i32, None::<char>, 0usize);
+    let mut push = |part| -> std::result::Result<(), String> {
+        entries.extend(header_entry(part)?);
+        Ok(())
+    };
+    for (i, c) in inner.char_indices() {
+        match (quote, c) {
+            (Some(q), c) if c == q => quote = None,
+            (Some(_), _) => {}
+            (None, '\'' | '"') => quote = Some(c),
+            (None, '(' | '[' | '{') => depth += 1,
+            (None, ')' | ']' | '}') => depth -= 1,
+            (None, ',') if depth == 0 => {
+                push(&inner[from..i])?;
+                from = i + 1;
+            }
+            _ => {}
+        }
+        if depth < 0 {
+            return Err("the header's brackets do not balance".into());
+        }
+    }
+    if quote.is_some() || depth != 0 {
+        return Err("the header's quotes or brackets do not balance".into());
+    }
+    push(&inner[from..])?;
+    for (k, (key, _)) in entries.iter().enumerate() {
+        if !HEADER_KEYS.contains(key) {
             return Err(format!(
-                "the header gives '{name}' twice (NumPy would read the last, so what the file holds is ambiguous): write each key once"
+                "the header has the key '{key}' besides 'descr', 'fortran_order' and 'shape' (NumPy refuses it too): write those three only"
             ));
         }
-        let rest = &header[at + name.len() + 2..];
-        let colon = rest.find(':').ok_or("malformed header")?;
-        Ok(rest[colon + 1..].trim_start())
+        // NumPy's parser keeps the last of a repeated key, a first-match reader the
+        // first: the file's meaning would depend on the reader.
+        if entries[..k].iter().any(|(other, _)| other == key) {
+            return Err(format!(
+                "the header gives '{key}' twice (NumPy would read the last, so what the file holds is ambiguous): write each key once"
+            ));
+        }
+    }
+    Ok(entries)
+}
+
+/// One entry `'key': value` of a header dictionary (None if blank, after a trailing comma).
+fn header_entry(part: &str) -> std::result::Result<Option<(&str, &str)>, String> {
+    let part = part.trim();
+    if part.is_empty() {
+        return Ok(None);
+    }
+    let q = part
+        .chars()
+        .next()
+        .filter(|&c| c == '\'' || c == '"')
+        .ok_or_else(|| format!("header entry {part:?} has no quoted key"))?;
+    let close = part[1..]
+        .find(q)
+        .ok_or_else(|| format!("header entry {part:?} has an unterminated key"))?;
+    let value = part[2 + close..]
+        .trim_start()
+        .strip_prefix(':')
+        .ok_or_else(|| format!("header entry {part:?} has no ':' after its key"))?;
+    Ok(Some((&part[1..1 + close], value.trim())))
+}
+
+/// The dtype's byte order (big-endian?) and the shape (rows, columns) of a `.npy`
+/// header ([`header_entries`]); on failure, why.
+fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), String> {
+    let entries = header_entries(header)?;
+    let field = |name: &str| -> std::result::Result<&str, String> {
+        entries
+            .iter()
+            .find(|(key, _)| *key == name)
+            .map(|&(_, value)| value)
+            .ok_or(format!("no '{name}' in the header"))
     };
     let descr = field("descr")?;
-    let big = if descr.starts_with("'<f8'") {
+    let big = if matches!(descr, "'<f8'" | "\"<f8\"") {
         false
-    } else if descr.starts_with("'>f8'") {
+    } else if matches!(descr, "'>f8'" | "\">f8\"") {
         true
     } else {
         // A structured dtype is a list: shown whole, up to its closing bracket.
         let shown = match descr.strip_prefix('[') {
             Some(rest) => format!("[{}]", rest.split(']').next().unwrap_or("")),
-            None => descr.split(',').next().unwrap_or("").to_string(),
+            None => descr.chars().take(40).collect(),
         };
         return Err(format!(
             "descr (dtype) {shown}: float64 ('<f8' or '>f8') needed"
         ));
     };
-    if !field("fortran_order")?.starts_with("False") {
-        return Err("Fortran order".into());
+    match field("fortran_order")? {
+        "False" => {}
+        "True" => return Err("Fortran order".into()),
+        other => return Err(format!("fortran_order {other}: False or True expected")),
     }
     let shape = field("shape")?;
     let inner = shape
         .strip_prefix('(')
-        .and_then(|s| s.split(')').next())
+        .and_then(|s| s.strip_suffix(')'))
         .ok_or("malformed shape")?;
     let dims: Vec<usize> = inner
         .split(',')
@@ -214,11 +299,17 @@ fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), Strin
         .filter(|s| !s.is_empty())
         .map(|s| s.trim_end_matches('L').parse::<usize>())
         .collect::<std::result::Result<_, _>>()
-        .map_err(|_| format!("shape ({inner})"))?;
+        .map_err(|_| {
+            let shown: String = inner.chars().take(40).collect();
+            format!("shape ({shown})")
+        })?;
     match dims.as_slice() {
         [r] => Ok((big, *r, 1)),
         [r, c] => Ok((big, *r, *c)),
-        _ => Err(format!("shape ({inner}) has {} dimensions", dims.len())),
+        _ => Err(format!(
+            "shape has {} dimensions (1 or 2 expected)",
+            dims.len()
+        )),
     }
 }
 
@@ -396,5 +487,61 @@ mod tests {
         assert!(err.contains("'descr' twice"), "{err}");
         let once = "{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }";
         assert_eq!(parse_npy(&file(once)).unwrap(), (1, 1, vec![1.5]));
+    }
+
+    /// Headers that NumPy's `ast.literal_eval` refuses are refused, and why is said: cut
+    /// off, a NUL byte, a key besides the three, an unquoted key, unbalanced brackets.
+    /// NumPy's own spellings (double quotes, no trailing comma, spaces) are read.
+    #[test]
+    fn malformed_headers_are_refused() {
+        let file = |dict: &str| npy_file(dict, &1.5f64.to_le_bytes());
+        for (dict, says) in [
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (1,",
+                "complete",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (1,), }}",
+                "balance",
+            ),
+            (
+                "{'descr': '<f8',\0 'fortran_order': False, 'shape': (1,), }",
+                "control",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (1,), 'x': 1}",
+                "'x' besides",
+            ),
+            (
+                "{descr: '<f8', 'fortran_order': False, 'shape': (1,)}",
+                "no quoted key",
+            ),
+            (
+                "{'descr' '<f8', 'fortran_order': False, 'shape': (1,)}",
+                "no ':'",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': Fals, 'shape': (1,)}",
+                "fortran_order Fals",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (1,) 2}",
+                "malformed shape",
+            ),
+            ("{'descr': '<f8', 'fortran_order': False}", "no 'shape'"),
+            (
+                "{'descr': '<f4', 'fortran_order': False, 'shape': (1,)}",
+                "'<f4'",
+            ),
+        ] {
+            let err = parse_npy(&file(dict)).unwrap_err();
+            assert!(err.contains(says), "{dict}: {err}");
+        }
+        for dict in [
+            "{\"descr\": \"<f8\", \"fortran_order\": False, \"shape\": (1, 1)}",
+            "{ 'shape' : (1,) , 'fortran_order' : False , 'descr' : '<f8' }",
+        ] {
+            assert_eq!(parse_npy(&file(dict)).unwrap(), (1, 1, vec![1.5]), "{dict}");
+        }
     }
 }

@@ -106,6 +106,20 @@ impl Table {
     }
 }
 
+/// The column names for a message: all of them up to 16, else the first 12, "…" and
+/// the last 3 (with the count), so that a wide sidecar does not fill the terminal.
+fn column_list(columns: &[String]) -> String {
+    if columns.len() <= 16 {
+        return columns.join(", ");
+    }
+    format!(
+        "{}, … {} more …, {}",
+        columns[..12].join(", "),
+        columns.len() - 15,
+        columns[columns.len() - 3..].join(", ")
+    )
+}
+
 /// Reads trajectory file `path` (listed at sidecar key `key`, e.g. `runs[0].files[3]`)
 /// and returns its `columns`, in that order. The file is read as a regular file of at
 /// most `max_bytes` ([`crate::input::read_bytes`]). A CSV file maps its header names to
@@ -131,7 +145,7 @@ pub fn read_table(path: &Path, key: &str, columns: &[String], max_bytes: u64) ->
             return Err(bad(format!(
                 "must have {} columns ({}), as the sidecar implies; the file has {cols}",
                 columns.len(),
-                columns.join(", ")
+                column_list(columns)
             )));
         }
         Table {

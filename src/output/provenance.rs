@@ -86,10 +86,13 @@ pub struct ParameterRecord {
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub given: BTreeMap<String, Quantity>,
     /// The parameters the simulation uses (`length`, `bending_rigidity`,
-    /// `stretch_rigidity`, `drag`, `kt`).
+    /// `stretch_rigidity`, `drag`, `kt`; a membrane's `width`, `height`,
+    /// `bending_rigidity`, `tension`, `drag`, `kt`).
     pub parameters: BTreeMap<String, Quantity>,
     /// Dimensionless groups and scales: `persistence_ratio` ℓp/L = EI/(kT·L),
-    /// `stretch_ratio` EA·L/kT, `tau1` τ₁ = ξL⁴/(π⁴EI), `euler_load` F_c0 = π²EI/L².
+    /// `stretch_ratio` EA·L/kT, `tau1` τ₁ = ξL⁴/(π⁴EI), `euler_load` F_c0 = π²EI/L²;
+    /// a membrane's `tau1` (its slowest relaxation time), `buckling_tension` −κq_min²
+    /// and `tension_ratio` σ/(κq_min²).
     pub groups: BTreeMap<String, Quantity>,
 }
 

@@ -131,11 +131,12 @@ use crate::dynamics::IntegratorKind;
 use crate::error::{Error, Result};
 use crate::fem::mesh::Mesh;
 use crate::fem::noise::NoiseModel;
-use crate::output::provenance::{DescribeScene, SceneProvenance};
+use crate::output::provenance::{DescribeScene, ParameterRecord, Quantity, SceneProvenance};
 use crate::params::physical::{self, FilamentInput, PhysicalFilament};
 use crate::params::{Ends, FilamentParams};
 use crate::spectral::membrane::MembraneParams;
 use serde::{Deserialize, Deserializer, Serialize};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The largest scene file read (1 MiB; the shipped scenes are a few KiB).
@@ -861,8 +862,40 @@ impl DescribeScene for Scene {
             dims: self.dims,
             elements: self.mesh.elements,
             units: physical::base_units(self.physical.is_some()),
-            parameters: physical::parameter_record(&self.filament, self.physical.as_ref()),
+            parameters: match &self.membrane {
+                Some(m) => membrane_record(m),
+                None => physical::parameter_record(&self.filament, self.physical.as_ref()),
+            },
         }
+    }
+}
+
+/// The provenance record of a membrane's parameters (always in the scene's consistent
+/// units): its sides, κ, σ, ξ (per area), kT, and the groups τ₁ (its slowest relaxation
+/// time, (M2)), the buckling tension −κq_min² and σ/(κq_min²).
+fn membrane_record(m: &MembraneParams) -> ParameterRecord {
+    let q = |k: &str, v: f64, unit: &str| (k.to_string(), Quantity::new(v, unit));
+    let q2 = m.min_wavenumber_sq();
+    ParameterRecord {
+        unit_system: "consistent".to_string(),
+        given: BTreeMap::new(),
+        parameters: [
+            q("width", m.width, "[L]"),
+            q("height", m.height, "[L]"),
+            q("bending_rigidity", m.bending_rigidity, "[E]"),
+            q("tension", m.tension, "[E]/[L]^2"),
+            q("drag", m.drag, "[E]*[T]/[L]^4"),
+            q("kt", m.kt, "[E]"),
+        ]
+        .into_iter()
+        .collect(),
+        groups: [
+            q("tau1", m.tau1(), "[T]"),
+            q("buckling_tension", m.buckling_tension(), "[E]/[L]^2"),
+            q("tension_ratio", m.tension / (m.bending_rigidity * q2), "1"),
+        ]
+        .into_iter()
+        .collect(),
     }
 }
 
@@ -1102,12 +1135,39 @@ fn value_key(text: &str, offset: usize) -> Option<String> {
 
 #[cfg(test)]
 mod tests {
+
     //! The accessors of a scene that are not its filament's: τ1 and the displacement
     //! components of a membrane against closed forms written out here (independent of
     //! `crate::spectral::membrane`), and the same arithmetic as before for a filament.
 
     use super::*;
     use std::f64::consts::PI;
+
+    /// A membrane scene's provenance records the membrane (sides, κ, σ, ξ, kT; τ₁, the
+    /// buckling tension and σ/(κq_min²)), not the filament defaults it never reads.
+    #[test]
+    fn a_membrane_scene_records_its_membrane() {
+        let scene = crate::scene::builtin::load_scene("membrane-periodic", None).unwrap();
+        let m = scene.membrane.unwrap();
+        let r = scene.describe().parameters;
+        let names: Vec<&str> = r.parameters.keys().map(String::as_str).collect();
+        assert_eq!(
+            names,
+            [
+                "bending_rigidity",
+                "drag",
+                "height",
+                "kt",
+                "tension",
+                "width"
+            ]
+        );
+        assert_eq!(r.parameters["tension"].value, m.tension);
+        assert_eq!(r.groups["tau1"].value, m.tau1());
+        assert!(!r.groups.contains_key("euler_load"));
+        let ratio = r.groups["tension_ratio"].value;
+        assert!((ratio - m.tension / (4.0 * std::f64::consts::PI.powi(2))).abs() < 1e-12);
+    }
 
     /// A membrane scene with `[membrane]` keys `table` (a valid sampling plan for any
     /// simply supported or periodic 8 × 4 mesh).

@@ -796,10 +796,11 @@ fn read_trajectory(
 
 /// The largest magnitude of a value the checks use, in their units (deflections in the
 /// filament's length unit, modal amplitudes in the reference's, forces in F_c0): the
-/// squares, products and squared sums of a billion of them stay far from overflow.
-/// Larger finite values are no physical data (a filament is at most 1e30 long), and
-/// would make an estimator fail as if the data were too few.
-const MAX_MAGNITUDE: f64 = 1e100;
+/// fourth powers (the variance of a variance estimate sums them) and their sums over a
+/// billion samples stay far from overflow (10²⁴⁰·10⁹). Larger finite values are no
+/// physical data (a filament is at most 1e30 long), and would make an estimator fail as
+/// if the data were too few (at 1e99 a pooled variance's standard error was infinite).
+const MAX_MAGNITUDE: f64 = 1e60;
 
 /// Refuses column `col` of `table` (file `path`, key `key`) if a value of it times
 /// `factor` (the change to the checks' units) exceeds [`MAX_MAGNITUDE`], naming the
@@ -817,7 +818,7 @@ fn require_magnitude(
             path,
             key,
             format!(
-                "column {:?}, data row {}: must be at most {limit:e} in magnitude (the checks sum its squares and products, which must stay finite), got {:?}",
+                "column {:?}, data row {}: must be at most {limit:e} in magnitude (the checks sum its squares and fourth powers, which must stay finite), got {:?}",
                 table.columns[col],
                 r + 1,
                 table.get(r, col)

@@ -201,6 +201,7 @@ impl MembraneParams {
                 ),
             ));
         }
+        self.validate_scales()?;
         let buckling = self.buckling_tension();
         if !(self.tension.is_finite() && self.tension > buckling && buckling.is_finite()) {
             return Err(Error::invalid(
@@ -214,6 +215,40 @@ impl MembraneParams {
                     self.width,
                     self.height,
                     self.min_wavenumber_sq()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The scales every reference multiplies: the area ab and q_min² (named by `width`,
+    /// the sides' scale) and the slowest mode's bending stiffness κq_min⁴ (named by
+    /// `bending_rigidity`) must be normal, finite numbers in f64, or the buckling tension,
+    /// τ₁ and the mode sums overflow or vanish.
+    fn validate_scales(&self) -> Result<()> {
+        let q2 = self.min_wavenumber_sq();
+        if !(self.area().is_normal() && q2.is_normal()) {
+            return Err(Error::invalid(
+                "width",
+                self.width,
+                format!(
+                    "such that the area ab and q_min² are finite and nonzero in f64 (here {:e} and {q2:e} with height {:e}): sides in about [1e-100, 1e100]",
+                    self.area(),
+                    self.height
+                ),
+            ));
+        }
+        let stiffness = self.bending_rigidity * q2 * q2;
+        if !(stiffness.is_normal() && (self.bending_rigidity * q2).is_normal()) {
+            let (lo, hi) = (
+                f64::MIN_POSITIVE / (q2 * q2).min(1.0),
+                f64::MAX / (q2 * q2).max(1.0),
+            );
+            return Err(Error::invalid(
+                "bending_rigidity",
+                self.bending_rigidity,
+                format!(
+                    "such that the slowest mode's bending stiffness κ·q_min⁴ is finite and nonzero in f64 (here {stiffness:e}, q_min² = {q2:e}): about [{lo:e}, {hi:e}]"
                 ),
             ));
         }
