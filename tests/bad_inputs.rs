@@ -673,7 +673,7 @@ fn corpus() -> Vec<Case> {
                 "checks = [\"profile\",",
                 "checks = [\"force-strain\", \"profile\",",
             )],
-            &["key `checks[0]`", "ForceStrain", "a linear check"],
+            &["key `checks[0]`", "got force-strain", "a linear check"],
         ),
         scene(
             "compression-table-in-linear",
@@ -1969,7 +1969,7 @@ fn compression_cases() -> Vec<Case> {
             )],
             &[
                 "key `checks[0]`",
-                "got Profile",
+                "got profile",
                 "force-strain, force-distribution or dt-halving",
             ],
         ),

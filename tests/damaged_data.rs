@@ -948,7 +948,9 @@ const SIDECAR_MISSING: &[(&str, &str, &str)] = &[
     ("sidecar-missing-run-name", "/runs/0/name", "runs[0].name"),
     ("sidecar-missing-dt-sample", "/runs/0/dt_sample", "runs[0].dt_sample"),
     ("sidecar-missing-start", "/runs/0/start", "runs[0].start"),
+    ("sidecar-missing-burn-in", "/runs/0/burn_in", "runs[0].burn_in"),
     ("sidecar-missing-positions", "/runs/0/positions", "runs[0].positions"),
+    ("sidecar-missing-modes", "/runs/0/modes", "runs[0].modes"),
     ("sidecar-missing-files", "/runs/0/files", "runs[0].files"),
     ("sidecar-missing-model", "/runs/0/discretization/model", "runs[0].discretization.model"),
 ];

@@ -492,8 +492,10 @@ fn prepare_linear(job: &Job) -> Result<(Vec<LinearRun>, Vec<RowPlan>)> {
         .chosen
         .iter()
         .map(|&k| {
-            LinearRun::prepare_for_writing(scene, &scene.runs[k])
-                .map_err(|e| scene.run_error(k, "integrator", e))
+            let run = LinearRun::prepare_for_writing(scene, &scene.runs[k])
+                .map_err(|e| scene.run_error(k, "integrator", e))?;
+            run.require_forgetting(scene, k)?;
+            Ok(run)
         })
         .collect::<Result<Vec<_>>>()?;
     let plans = job

@@ -370,12 +370,12 @@ pub struct DataRun {
     /// How the trajectories start.
     pub start: Start,
     /// Time before which rows are not stationary (left out of stationary statistics).
-    #[serde(default)]
+    /// Required, as the documentation lists it: a default of 0 would take a run from rest
+    /// as stationary from its first row.
     pub burn_in: f64,
     /// Positions x of the deflection columns (length units).
     pub positions: Vec<f64>,
-    /// Number of modal amplitude columns per component.
-    #[serde(default)]
+    /// Number of modal amplitude columns per component (required; 0 for none).
     pub modes: usize,
     /// The producer's discretization, if known.
     #[serde(default, skip_serializing_if = "Option::is_none")]

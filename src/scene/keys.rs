@@ -480,7 +480,7 @@ pub const KEYS: &[KeyDoc] = &[
     key(
         "runs[].dt_tau1",
         "τ₁",
-        "in (0, 100] (fem, spectral) or (0, compression.sample_every_tau1] (compression), at most 1e10 steps per trajectory, below the stability limit of an explicit integrator",
+        "in (0, 100] (fem, spectral) or (0, compression.sample_every_tau1] (compression), at most 1e10 steps per trajectory, below the stability limit of an explicit integrator; linear runs: small enough that every checked mode forgets its start within the burn-in as the slowest one does (Crank–Nicolson's multiplier nears −1 at λΔt ≫ 2, e.g. a membrane near buckling; the refusal states the bound)",
         "required",
         None,
         "Time step.",

@@ -66,6 +66,24 @@ pub struct ModeReference {
     pub label: Option<MembraneMode>,
 }
 
+/// A checked mode the burn-in leaves remembering its start ([`LinearRun::unforgetting_mode`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnforgettingMode {
+    /// The mode number.
+    pub n: usize,
+    /// Its one-step multiplier (negative, near −1).
+    pub multiplier: f64,
+    /// |m|^N after the burn-in's N steps.
+    pub memory: f64,
+    /// What the slowest positive-multiplier mode keeps (at least 10⁻³).
+    pub slowest: f64,
+    /// The burn-in's steps N.
+    pub burn_in_steps: u64,
+    /// About the largest Δt at which the mode forgets as fast as the slowest one,
+    /// 0.9·√(4t_b/(λₙ ln(1/F))) with t_b the burn-in time and F `slowest` (time units).
+    pub dt_bound: f64,
+}
+
 /// Exact references for the two-time correlation at one point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TwoTimeReference {
@@ -1391,6 +1409,74 @@ impl LinearRun {
     /// As [`Self::prepare`].
     pub fn prepare_for_writing(scene: &Scene, spec: &RunSpec) -> Result<LinearRun> {
         Self::prepare_with(scene, spec, false)
+    }
+
+    /// Refuses run `k` of `scene` (this run) if a checked mode does not forget its start
+    /// within the burn-in ([`Self::unforgetting_mode`]): [`Error::Scene`] naming
+    /// `runs[k].dt_tau1`, the mode, its multiplier and memory, and about the largest
+    /// dt_tau1 that would serve.
+    ///
+    /// # Errors
+    /// As described.
+    pub fn require_forgetting(&self, scene: &Scene, k: usize) -> Result<()> {
+        let Some(u) = self.unforgetting_mode() else {
+            return Ok(());
+        };
+        let tau1 = scene.tau1();
+        Err(Error::Scene {
+            file: scene.path.clone(),
+            key: format!("runs[{k}].dt_tau1"),
+            message: format!(
+                "must be below about {:.3e} for this run: at {} ({}) checked mode {} has the one-step multiplier {:.6} and keeps {:.3e} of its start after the burn-in's {} steps, more than the slowest mode's {:.3e}, so its stationary references would not hold in the sampled rows; lower dt_tau1, or use the exact-modal or backward-euler integrator",
+                u.dt_bound / tau1,
+                self.spec.dt_tau1,
+                self.spec.integrator,
+                u.n,
+                u.multiplier,
+                u.memory,
+                u.burn_in_steps,
+                u.slowest
+            ),
+        })
+    }
+
+    /// A checked mode that the burn-in leaves remembering its start (rest) more than the
+    /// slowest checked mode does, because its one-step multiplier m is near −1
+    /// (Crank–Nicolson far past λΔt = 2, as a membrane near buckling, whose τ₁ is long,
+    /// gets at a fixed dt_tau1): after the burn-in's N steps it keeps |m|^N of its
+    /// start, and the stationary references of the checks do not yet hold. Only a mode
+    /// that keeps more than 10⁻³ and more than the slowest positive-multiplier mode (whose
+    /// memory `sampling.burn_in_tau1` sets) counts. `None` when every mode forgets.
+    pub fn unforgetting_mode(&self) -> Option<UnforgettingMode> {
+        let n = self.burn_in_steps as f64;
+        let memory = |m: f64| m.abs().powf(n);
+        let slowest = self
+            .reference
+            .modes
+            .iter()
+            .filter(|m| m.multiplier > 0.0)
+            .map(|m| memory(m.multiplier))
+            .fold(0.0, f64::max);
+        let floor = slowest.max(1e-3);
+        let worst = self
+            .reference
+            .modes
+            .iter()
+            .filter(|m| m.multiplier < 0.0 && memory(m.multiplier) > floor)
+            .max_by(|a, b| memory(a.multiplier).total_cmp(&memory(b.multiplier)))?;
+        // With m ≈ −(1 − 4/(λΔt)) the memory is e^{−4 t_b/(λΔt²)} (t_b the burn-in
+        // time, fixed in τ₁): it is the allowed F at Δt = √(4 t_b/(λ ln(1/F))); 0.9 of
+        // that, for the approximation.
+        let t_b = n * self.reference.dt;
+        let dt_bound = 0.9 * (4.0 * t_b / (worst.rate_continuum * (1.0 / floor).ln())).sqrt();
+        Some(UnforgettingMode {
+            n: worst.n,
+            multiplier: worst.multiplier,
+            memory: memory(worst.multiplier),
+            slowest: floor,
+            burn_in_steps: self.burn_in_steps,
+            dt_bound,
+        })
     }
 
     /// [`Self::prepare`], with the discrete reference values if `values`.

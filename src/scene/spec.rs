@@ -326,6 +326,14 @@ pub enum CheckKind {
 }
 
 impl CheckKind {
+    /// The name as scene files write it (`xy-symmetry`).
+    pub fn name(self) -> String {
+        serde_json::to_value(self)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_else(|| format!("{self:?}"))
+    }
+
     /// Whether the check applies to the compression model (otherwise to linear ones).
     pub fn is_compression(self) -> bool {
         matches!(
@@ -706,7 +714,7 @@ impl Scene {
     ///
     /// # Errors
     /// [`Error::Scene`] (exit 2) naming the scene file, the key `membrane` and the scene,
-    /// saying that `what` is not yet supported for membranes.
+    /// saying that `what` is not written yet and which commands take the scene.
     pub fn refuse_membrane(&self, what: &str) -> Result<()> {
         if !self.is_membrane() {
             return Ok(());
@@ -715,9 +723,10 @@ impl Scene {
             file: self.path.clone(),
             key: "membrane".to_string(),
             message: format!(
-                "{what} is not yet supported for membranes: scene \"{}\" is a membrane scene \
-                 (membranes run through every command of the linear filament); use a filament scene \
-                 here",
+                "{what} is not written yet: scene \"{}\" is a membrane under imposed \
+                 projected area, which `verify` checks; `run`, `check` and `converge` take the \
+                 linear membrane scenes (model \"fem\" or \"spectral\": membrane-hinged, \
+                 membrane-periodic, ...) and the filament's",
                 self.name
             ),
         })
@@ -1302,14 +1311,16 @@ full = {{ trajectories = 4, duration_tau1 = 40.0 }}
     /// `membrane`, the scene and what was refused; a filament scene passes.
     #[test]
     fn membranes_are_refused_where_only_filaments_go() {
-        assert!(filament(2, "kt = 1.0").refuse_membrane("verify").is_ok());
-        let e = membrane("kt = 1.0").refuse_membrane("verify").unwrap_err();
+        let what = "run of a membrane under imposed projected area";
+        assert!(filament(2, "kt = 1.0").refuse_membrane(what).is_ok());
+        let e = membrane("kt = 1.0").refuse_membrane(what).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         let m = e.to_string();
         for needle in [
             "m.toml: key `membrane`",
-            "verify is not yet supported for membranes",
+            "run of a membrane under imposed projected area is not written yet",
             "scene \"m\"",
+            "`verify` checks",
         ] {
             assert!(m.contains(needle), "{needle}: {m}");
         }

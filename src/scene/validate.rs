@@ -621,12 +621,7 @@ impl Scene {
             allowed
         };
         match kinds.iter().position(misplaced) {
-            Some(i) => Err(bad(
-                self,
-                &format!("{key}[{i}]"),
-                &format!("{:?}", kinds[i]),
-                allowed,
-            )),
+            Some(i) => Err(bad(self, &format!("{key}[{i}]"), &kinds[i].name(), allowed)),
             None => Ok(()),
         }
     }
@@ -1582,7 +1577,7 @@ full = { trajectories = 4, duration_tau1 = 10.0 }
         );
         let m = message(&text, "c.toml");
         assert!(m.contains("key `runs[0].checks[1]`"), "{m}");
-        assert!(m.contains("got Profile"), "{m}");
+        assert!(m.contains("got profile"), "{m}");
     }
 
     /// A membrane scene: `MEMBRANE`, `MESH` and `POINTS` stand for the `[membrane]`

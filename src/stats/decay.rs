@@ -251,6 +251,7 @@ pub fn decay_rate_with_lag(
         LagRule::Expected(rate) => {
             crate::error::require_positive("expected rate", rate)?;
             let k = expected_lag(series, n_total, rate * dt)?;
+            require_resolvable(series, k, rate * dt)?;
             let blocks = jackknife_blocks(series, n_total, k, shift)?;
             if all_rho_positive(&blocks, known) {
                 jackknife_estimate(&blocks, k, dt, known, confidence)
@@ -259,6 +260,32 @@ pub fn decay_rate_with_lag(
             }
         }
     }
+}
+
+/// The fewest standard errors 1/√(pairs) by which the expected ρ(k) must exceed 0 for
+/// [`LagRule::Expected`] to estimate a rate: at 5, ρ̂(k) ≤ 0 has probability below 10⁻⁶
+/// and ln ρ̂(k) is near normal (relative error at most 20 %).
+pub const MIN_RESOLVED_RHO_SE: f64 = 5.0;
+
+/// Refuses (as [`Error::Numerical`], before the data are looked at) a lag `k` at which
+/// the expected autocorrelation e^{−k·rate_dt} is below [`MIN_RESOLVED_RHO_SE`] standard
+/// errors 1/√(lag pairs): the sampling does not resolve that decay (e.g. a stiff mode
+/// sampled at rate·Δt ≫ 1), and an estimate made when the sample's ρ̂ happens to be
+/// positive would be biased towards slow decay while one made otherwise would not exist —
+/// whether the check runs, and what it finds, would depend on chance.
+fn require_resolvable(series: &[&[f64]], k: usize, rate_dt: f64) -> Result<()> {
+    let n_pairs: usize = series.iter().map(|s| s.len().saturating_sub(k)).sum();
+    let rho = (-rate_dt * k as f64).exp();
+    let floor = MIN_RESOLVED_RHO_SE / (n_pairs as f64).sqrt();
+    if rho >= floor {
+        return Ok(());
+    }
+    Err(numerical(format!(
+        "the expected autocorrelation at lag {k}, exp(-rate x {k} dt) = {rho:.3e} (rate x dt = \
+         {rate_dt:.3}), is below {MIN_RESOLVED_RHO_SE} standard errors 1/sqrt({n_pairs} lag \
+         pairs) = {floor:.3e}: this sampling does not resolve the decay; rows taken more \
+         often (a smaller dt or --every) would"
+    )))
 }
 
 /// Whether ρ̂(k) of the pooled `blocks` and of every delete-one-block replicate is
@@ -505,6 +532,31 @@ mod tests {
         let est = decay_rate(&refs, 1.0, Some(0.0), 0.9).unwrap();
         assert_eq!(est.n_blocks, TARGET_BLOCKS);
         assert_eq!(est.lag, 1);
+    }
+
+    /// A decay the sampling cannot resolve is refused before the data are looked at:
+    /// at rate·Δt = 8 the expected ρ(1) = 3.4e-4 is below 5/√(10⁵ pairs) = 0.016, whatever
+    /// the sample (here white noise, whose ρ̂(1) is positive about half the time). At
+    /// rate·Δt = 2 (ρ(1) = 0.135, 43 standard errors) the rate is estimated and covers
+    /// the truth.
+    #[test]
+    fn an_unresolved_decay_is_refused_from_the_plan() {
+        for index in 0..4 {
+            let white = ar1(0.0, 100_000, index);
+            let e = decay_rate_with_lag(&[&white], 1.0, Some(0.0), 0.95, LagRule::Expected(8.0))
+                .unwrap_err();
+            assert!(e.to_string().contains("does not resolve the decay"), "{e}");
+        }
+        let rho = (-2.0f64).exp();
+        let x = ar1(rho, 100_000, 9);
+        let e = decay_rate_with_lag(&[&x], 1.0, Some(0.0), 0.95, LagRule::Expected(2.0)).unwrap();
+        assert!(!e.lag_from_data && e.lag == 1);
+        assert!(
+            (e.rate - 2.0).abs() < 4.0 * e.std_error,
+            "{} ± {}",
+            e.rate,
+            e.std_error
+        );
     }
 
     #[test]

@@ -200,6 +200,7 @@ pub(super) fn prepare_all(scenes: &[Scene], budget: Budget) -> Result<Vec<Prepar
             for (k, run) in runs.iter().enumerate() {
                 if oracles[k].passed() {
                     check_sample_counts(scene, k, run, budget)?;
+                    run.require_forgetting(scene, k)?;
                 }
             }
         }

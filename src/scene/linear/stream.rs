@@ -259,3 +259,44 @@ impl<S: Observables + ?Sized> Observer<S> for RowWriter<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::LinearRun;
+    use crate::scene::builtin::load_scene;
+
+    /// A periodic membrane at 99.99 % of its buckling tension, its τ₁ long, so that at
+    /// dt_tau1 = 0.02 Crank–Nicolson's fastest checked mode has m ≈ −0.9996 and keeps
+    /// most of its start after the burn-in: refused, naming runs[0].dt_tau1 and the bound;
+    /// at the bound it forgets as the slowest mode does; the scene as built in (σ = 20)
+    /// forgets at once.
+    #[test]
+    fn a_mode_that_does_not_forget_its_start_is_refused() {
+        let mut scene = load_scene("membrane-periodic", None).unwrap();
+        let k = scene
+            .runs
+            .iter()
+            .position(|r| r.name == "crank-nicolson")
+            .unwrap();
+        let prepared =
+            |s: &crate::scene::Scene| LinearRun::prepare_for_writing(s, &s.runs[k]).unwrap();
+        assert!(prepared(&scene).require_forgetting(&scene, k).is_ok());
+        let m = scene.membrane.as_mut().unwrap();
+        m.tension = 0.9999 * m.buckling_tension();
+        let run = prepared(&scene);
+        let u = run.unforgetting_mode().expect("remembers");
+        assert!(u.multiplier < -0.999 && u.memory > 0.5, "{u:?}");
+        let e = run.require_forgetting(&scene, k).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("key `runs[{k}].dt_tau1`")) && e.contains("below about"),
+            "{e}"
+        );
+        scene.runs[k].dt_tau1 = u.dt_bound / scene.tau1();
+        let run = prepared(&scene);
+        assert!(
+            run.unforgetting_mode().is_none(),
+            "{:?}",
+            run.unforgetting_mode()
+        );
+    }
+}
