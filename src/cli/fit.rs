@@ -265,9 +265,9 @@ fn no_bending_fit(object: &FitObject, run: &str, modes: &[String]) -> Error {
             Error::invalid(
                 "membrane.bending_rigidity",
                 format!(
-                    "the sidecar's, with bending shares κq⁴/(κq⁴ + σq²) in [{lo:.3e}, {hi:.3e}]"
+                    "one whose modes' bending shares κq⁴/(κq⁴ + σq²) lie in [{lo:.3e}, {hi:.3e}]"
                 ),
-                "shares that carry κ: the fit of κ with σ held in the law did not converge (with shares near 0 the tension sets the variances and κ cannot be seen); check that κ and σ in data.json are the simulated ones",
+                "fittable with sigma held, but the fit in the stiffness law did not converge (with shares near 0 the tension sets the variances and κ cannot be seen: check that κ and σ in data.json are the simulated ones)",
             )
         }
     };

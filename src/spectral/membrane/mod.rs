@@ -491,7 +491,7 @@ impl Membrane {
     }
 
     /// The Q at which [`Membrane::mode_count_bound`] equals `count`.
-    fn cutoff_for_count(&self, count: f64) -> f64 {
+    pub(crate) fn cutoff_for_count(&self, count: f64) -> f64 {
         let p = &self.params;
         let c2 = p.area() / (4.0 * PI);
         match p.boundary {
@@ -607,6 +607,20 @@ pub(crate) fn cos_pi(s: f64) -> f64 {
 /// s − ⌊s⌋ (exact in floating point).
 pub(crate) fn frac(s: f64) -> f64 {
     s - s.floor()
+}
+
+/// A 1 × 0.7 membrane of the default κ, ξ, kT with `boundary` and `tension`, for the
+/// module's tests.
+#[cfg(test)]
+pub(crate) fn test_membrane(boundary: MembraneBoundary, tension: f64) -> Membrane {
+    Membrane::new(MembraneParams {
+        boundary,
+        tension,
+        width: 1.0,
+        height: 0.7,
+        ..MembraneParams::default()
+    })
+    .unwrap()
 }
 
 #[cfg(test)]

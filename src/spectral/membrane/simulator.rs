@@ -261,19 +261,11 @@ impl MembraneSimulator {
 mod tests {
     use super::*;
     use crate::rng::trajectory_rng;
-    use crate::spectral::membrane::MembraneParams;
 
     const SEED: u64 = 0x3E3B_0001;
 
     fn membrane(boundary: MembraneBoundary, tension: f64) -> Membrane {
-        Membrane::new(MembraneParams {
-            boundary,
-            tension,
-            width: 1.0,
-            height: 0.7,
-            ..MembraneParams::default()
-        })
-        .unwrap()
+        super::super::test_membrane(boundary, tension)
     }
 
     // What: the update is a ← a e^{−λΔt} + σ√(1 − e^{−2λΔt}) Z in mode order, and the

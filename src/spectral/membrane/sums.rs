@@ -254,7 +254,12 @@ impl Membrane {
     /// [`Membrane::max_cutoff`] if that is not enough. `bound` must be non-increasing and
     /// +∞ at q_min/2.
     pub(crate) fn cutoff_for(&self, target: f64, bound: impl Fn(f64) -> f64) -> f64 {
-        let max = self.max_cutoff();
+        self.cutoff_below(target, bound, self.max_cutoff())
+    }
+
+    /// [`Self::cutoff_for`] with the largest cutoff `max` instead of
+    /// [`Membrane::max_cutoff`].
+    pub(crate) fn cutoff_below(&self, target: f64, bound: impl Fn(f64) -> f64, max: f64) -> f64 {
         if bound(max) > target {
             return max;
         }
