@@ -114,7 +114,7 @@ pub fn read_bytes(path: &Path, key: &str, max_bytes: u64) -> Result<Vec<u8>> {
     }
     let mut bytes = Vec::with_capacity(len as usize);
     // `take`: a file that grows while it is read still stops at the cap.
-    file.take(max_bytes + 1)
+    file.take(max_bytes.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(|e| refused(path, key, format!("cannot be read: {e}")))?;
     if bytes.len() as u64 > max_bytes {
@@ -376,6 +376,8 @@ mod tests {
         std::fs::write(&f, "\u{feff}{}").unwrap();
         assert_eq!(read_text(&f, "k", 100).unwrap(), "{}");
         assert_eq!(read_bytes(&f, "k", 5).unwrap().len(), 5);
+        // No cap at all: the whole file (the cap + 1 of `take` must not wrap to 0).
+        assert_eq!(read_bytes(&f, "k", u64::MAX).unwrap().len(), 5);
         let e = read_bytes(&f, "runs[0]", 4).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         let text = e.to_string();

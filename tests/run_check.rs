@@ -1613,3 +1613,78 @@ fn run_warns_of_trajectories_too_short_for_check() {
     let o = check(&long);
     assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
 }
+
+/// `fit` says why it cannot fit a membrane, naming the cause (issue #27; found by
+/// fuzzing, where it said the scene lacked mode-variance checks it had):
+/// - data whose heights and amplitudes are all but zero (membrane-periodic's own, × 1e-300
+///   after the time column): its mode-variance checks estimate no positive variance, and
+///   the first one is named with its estimate;
+/// - a membrane far above κq_min² (σ = 1e30 in scene and sidecar alike): the bending
+///   shares κq⁴/(κq⁴ + σq²), about 1e-29, cannot carry κ with σ held, and the refusal
+///   gives their range.
+#[test]
+fn fit_says_why_it_cannot_fit_a_membrane() {
+    use langevin_fem::data::{NpyWriter, read_npy};
+    let dir = TempDir::new("run-check-fit-cannot");
+    let simulate = |scene: &str, out: &str| {
+        let args = [
+            "run",
+            "-q",
+            "--scene",
+            scene,
+            "--run",
+            "crank-nicolson",
+            "--out",
+            out,
+        ];
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", describe(&args, &o));
+    };
+    let fit = |scene: &str, data: &str, out: &str| {
+        let args = ["fit", "-q", "--scene", scene, "--data", data, "--out", out];
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(3), "{}", describe(&args, &o));
+        stderr_of(&o)
+    };
+
+    let data = dir.join_str("tiny");
+    simulate("membrane-periodic", &data);
+    let runs = Path::new(&data).join("crank-nicolson");
+    for entry in std::fs::read_dir(&runs).unwrap() {
+        let path = entry.unwrap().path();
+        let (rows, cols, values) = read_npy(&path, "file", 1 << 30).unwrap();
+        let file = std::fs::File::create(&path).unwrap();
+        let mut w = NpyWriter::new(std::io::BufWriter::new(file), rows as u64, cols).unwrap();
+        for row in values.chunks(cols) {
+            let scaled: Vec<f64> = (row.iter().enumerate())
+                .map(|(c, &v)| if c == 0 { v } else { v * 1e-300 })
+                .collect();
+            w.push_row(&scaled).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let e = fit("membrane-periodic", &data, &dir.join_str("fit-tiny"));
+    assert!(
+        e.contains("without a positive estimate")
+            && e.contains("crank-nicolson/mode-variance/n=1 estimates")
+            && e.contains("all but zero"),
+        "{e}"
+    );
+
+    let text = std::fs::read_to_string(fixture("verification/membrane-periodic.toml")).unwrap();
+    let scene = dir.join_str("taut.toml");
+    std::fs::write(
+        &scene,
+        text.replace("\ntension = 20.0\n", "\ntension = 1e30\n"),
+    )
+    .unwrap();
+    let data = dir.join_str("taut");
+    simulate(&scene, &data);
+    let e = fit(&scene, &data, &dir.join_str("fit-taut"));
+    assert!(
+        e.contains("membrane.bending_rigidity must be fittable with sigma held")
+            && e.contains("bending shares")
+            && e.contains("e-29"),
+        "{e}"
+    );
+}
