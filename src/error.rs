@@ -122,6 +122,11 @@ pub fn shown_value(text: &str) -> String {
     shown_text(text, MAX_SHOWN_CHARS)
 }
 
+/// A number as a message shows it ([`shown_value`] of its shortest round-trip text).
+pub fn shown_number(x: f64) -> String {
+    shown_value(&x.to_string())
+}
+
 /// `text` cut to its first `max` characters, with "… (N characters in all)" if cut.
 pub fn shown_text(text: &str, max: usize) -> String {
     let n = text.chars().count();
@@ -262,6 +267,7 @@ mod tests {
             m.len() < 300 && m.contains("(1000 characters in all)"),
             "{m}"
         );
+        assert_eq!(shown_number(1e308), "1e308");
         assert_eq!(shown_text("abc", 3), "abc");
         assert_eq!(shown_text("abcd", 3), "abc… (4 characters in all)");
     }

@@ -944,6 +944,23 @@ fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
         BoundaryArg::SimplySupported => MembraneBoundary::SimplySupported,
         BoundaryArg::Periodic => MembraneBoundary::Periodic,
     };
+    area_sides(args)?;
+    let (kappa, stretch) = area_moduli(args)?;
+    let mesh = area_mesh(args, boundary)?;
+    let params = AreaParams {
+        bending_rigidity: kappa,
+        area_modulus: stretch / (args.width * args.height),
+        kt: 1.0,
+        width: args.width,
+        height: args.height,
+        boundary,
+    };
+    Ok((params, mesh))
+}
+
+/// Checks `--width` ([`AREA_SIDE_RANGE`]) and `--height` (b/a at most
+/// [`MAX_AREA_ASPECT_RATIO`] either way).
+fn area_sides(args: &AreaArgs) -> Result<()> {
     require_positive("--width", args.width)?;
     require_positive("--height", args.height)?;
     // The result depends on the sides only through b/a; their scale must keep A₀, K_A =
@@ -972,6 +989,12 @@ fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// `--bending-rigidity` (in [`AREA_BENDING_RANGE`]) and `--stretch-ratio` (S/κ² in
+/// [`STRETCH_BEND_RATIO_RANGE`]), checked.
+fn area_moduli(args: &AreaArgs) -> Result<(f64, f64)> {
     let kappa = args.bending_rigidity;
     let (k_lo, k_hi) = AREA_BENDING_RANGE;
     if !(kappa.is_finite() && kappa >= k_lo && kappa <= k_hi) {
@@ -995,6 +1018,12 @@ fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
             ),
         ));
     }
+    Ok((kappa, stretch))
+}
+
+/// The mesh, cutoff or convergence sizes of an area query: exactly one of `--elements`,
+/// `--cutoff` and `--mesh-convergence`, within their ranges for `boundary`.
+fn area_mesh(args: &AreaArgs, boundary: MembraneBoundary) -> Result<AreaMesh> {
     let min = match boundary {
         MembraneBoundary::SimplySupported => 1,
         MembraneBoundary::Periodic => 2,
@@ -1038,15 +1067,7 @@ fn area_params(args: &AreaArgs) -> Result<(AreaParams, AreaMesh)> {
             ));
         }
     };
-    let params = AreaParams {
-        bending_rigidity: kappa,
-        area_modulus: stretch / (args.width * args.height),
-        kt: 1.0,
-        width: args.width,
-        height: args.height,
-        boundary,
-    };
-    Ok((params, mesh))
+    Ok(mesh)
 }
 
 /// The area query: validates the flags ([`area_params`]) and evaluates the exact theory.

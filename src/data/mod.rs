@@ -80,7 +80,7 @@ pub use npy::{NpyWriter, read_npy};
 pub use table::{Table, TrajectoryFile, read_table};
 
 use crate::dynamics::IntegratorKind;
-use crate::error::{Error, Result, shown_value};
+use crate::error::{Error, Result, shown_number};
 use crate::fem::noise::NoiseModel;
 use crate::input::{MAX_METADATA_BYTES, read_text};
 use crate::params::FilamentParams;
@@ -514,10 +514,7 @@ impl Discretization {
         {
             return Err((
                 key("dt"),
-                format!(
-                    "must be a positive finite time, got {}",
-                    shown_value(&dt.to_string())
-                ),
+                format!("must be a positive finite time, got {}", shown_number(dt)),
             ));
         }
         if !self.is_modelled() {
@@ -739,7 +736,7 @@ impl DataSidecar {
                     format!("{table}.{key}"),
                     format!(
                         "must be a finite number in [1e-30, 1e30], got {}",
-                        shown_value(&v.to_string())
+                        shown_number(v)
                     ),
                 ));
             }
@@ -750,7 +747,7 @@ impl DataSidecar {
                     "membrane.tension".into(),
                     format!(
                         "must be a finite number in [-1e30, 1e30], got {}",
-                        shown_value(&m.tension.to_string())
+                        shown_number(m.tension)
                     ),
                 ));
             }
@@ -786,10 +783,58 @@ impl DataRun {
         &self,
         k: usize,
         object: &DataObject,
-        mut earlier: impl Iterator<Item = &'a DataRun>,
+        earlier: impl Iterator<Item = &'a DataRun>,
     ) -> std::result::Result<(), (String, String)> {
         let key = |s: &str| format!("runs[{k}].{s}");
-        let membrane = matches!(object, DataObject::Membrane(_));
+        self.validate_kind(k, matches!(object, DataObject::Membrane(_)))?;
+        self.validate_name(k, earlier)?;
+        if let Some(r) = self.strain_ratio
+            && !(r.is_finite() && (-1e6..=1e6).contains(&r))
+        {
+            return Err((
+                key("strain_ratio"),
+                format!(
+                    "must be a finite ratio in [-1e6, 1e6], got {}",
+                    shown_number(r)
+                ),
+            ));
+        }
+        let tau1 = object.tau1();
+        let (lo, hi) = (MIN_SAMPLE_TAU1 * tau1, MAX_SAMPLE_TAU1 * tau1);
+        if !(self.dt_sample.is_finite() && (lo..=hi).contains(&self.dt_sample)) {
+            return Err((
+                key("dt_sample"),
+                format!(
+                    "must be a time between rows in [{MIN_SAMPLE_TAU1:e}, {MAX_SAMPLE_TAU1:e}] tau1 = [{lo:e}, {hi:e}] (tau1 = {} = {tau1:e}), got {:e}",
+                    match object {
+                        DataObject::Filament(_) => "xi L^4/(pi^4 EI) from the filament",
+                        DataObject::Membrane(_) => "xi/c_q of the membrane's slowest mode",
+                    },
+                    self.dt_sample
+                ),
+            ));
+        }
+        if !(self.burn_in.is_finite() && self.burn_in >= 0.0) {
+            return Err((
+                key("burn_in"),
+                format!(
+                    "must be a finite time >= 0, got {}",
+                    shown_number(self.burn_in)
+                ),
+            ));
+        }
+        self.validate_layout(k, object.line_length())?;
+        match &self.discretization {
+            Some(d) => d.validate(k, self.dt_sample, tau1),
+            None => Ok(()),
+        }
+    }
+
+    /// The optional columns of run `k` against its kind of data (`membrane` or a
+    /// filament; compression data when it has a strain ratio): tangent modes, rigid
+    /// coordinates and a mesh along y only where they exist; on failure (key, message).
+    fn validate_kind(&self, k: usize, membrane: bool) -> std::result::Result<(), (String, String)> {
+        let key = |s: &str| format!("runs[{k}].{s}");
         if self.tangent_modes > MAX_TANGENT_MODES || (membrane && self.tangent_modes > 0) {
             return Err((
                 key("tangent_modes"),
@@ -821,6 +866,17 @@ impl DataRun {
                 "must be left out for compression data (columns t, force, stored_length)".into(),
             ));
         }
+        Ok(())
+    }
+
+    /// The name of run `k`: a path component, not used twice at one strain ratio among
+    /// the runs before it (`earlier`); on failure (key, message).
+    fn validate_name<'a>(
+        &self,
+        k: usize,
+        mut earlier: impl Iterator<Item = &'a DataRun>,
+    ) -> std::result::Result<(), (String, String)> {
+        let key = |s: &str| format!("runs[{k}].{s}");
         if !crate::scene::validate::is_path_name(&self.name) {
             return Err((
                 key("name"),
@@ -846,46 +902,7 @@ impl DataRun {
                 ),
             ));
         }
-        if let Some(r) = self.strain_ratio
-            && !(r.is_finite() && (-1e6..=1e6).contains(&r))
-        {
-            return Err((
-                key("strain_ratio"),
-                format!(
-                    "must be a finite ratio in [-1e6, 1e6], got {}",
-                    shown_value(&r.to_string())
-                ),
-            ));
-        }
-        let tau1 = object.tau1();
-        let (lo, hi) = (MIN_SAMPLE_TAU1 * tau1, MAX_SAMPLE_TAU1 * tau1);
-        if !(self.dt_sample.is_finite() && (lo..=hi).contains(&self.dt_sample)) {
-            return Err((
-                key("dt_sample"),
-                format!(
-                    "must be a time between rows in [{MIN_SAMPLE_TAU1:e}, {MAX_SAMPLE_TAU1:e}] tau1 = [{lo:e}, {hi:e}] (tau1 = {} = {tau1:e}), got {:e}",
-                    match object {
-                        DataObject::Filament(_) => "xi L^4/(pi^4 EI) from the filament",
-                        DataObject::Membrane(_) => "xi/c_q of the membrane's slowest mode",
-                    },
-                    self.dt_sample
-                ),
-            ));
-        }
-        if !(self.burn_in.is_finite() && self.burn_in >= 0.0) {
-            return Err((
-                key("burn_in"),
-                format!(
-                    "must be a finite time >= 0, got {}",
-                    shown_value(&self.burn_in.to_string())
-                ),
-            ));
-        }
-        self.validate_layout(k, object.line_length())?;
-        match &self.discretization {
-            Some(d) => d.validate(k, self.dt_sample, tau1),
-            None => Ok(()),
-        }
+        Ok(())
     }
 
     /// The columns and files of run `k` (for a filament of length `length`): positions
@@ -908,7 +925,7 @@ impl DataRun {
                     format!("runs[{k}].positions[{j}]"),
                     format!(
                         "must be in [0, {length}] (the filament's [0, L], or a membrane's midline x in [0, a]), got {}",
-                        shown_value(&x.to_string())
+                        shown_number(x)
                     ),
                 ));
             }

@@ -9,7 +9,7 @@
 //! cross-checked with NumPy itself by the example simulator in `examples/` (it reads
 //! what `run` writes and writes what `check` reads).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, shown_text};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -189,8 +189,10 @@ fn header_entries(header: &str) -> std::result::Result<Vec<(&str, &str)>, String
         .strip_prefix('{')
         .and_then(|s| s.strip_suffix('}'))
         .ok_or_else(|| {
-            let shown: String = literal.chars().take(80).collect();
-            format!("the header {shown:?} is not a complete Python dictionary literal {{...}}")
+            format!(
+                "the header {:?} is not a complete Python dictionary literal {{...}}",
+                shown_text(literal, 80)
+            )
         })?;
     let mut entries = Vec::new();
     let (mut depth, mut quote, mut from) = (0i32, None::<char>, 0usize);
@@ -277,7 +279,7 @@ fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), Strin
         // A structured dtype is a list: shown whole, up to its closing bracket.
         let shown = match descr.strip_prefix('[') {
             Some(rest) => format!("[{}]", rest.split(']').next().unwrap_or("")),
-            None => descr.chars().take(40).collect(),
+            None => shown_text(descr, 40),
         };
         return Err(format!(
             "descr (dtype) {shown}: float64 ('<f8' or '>f8') needed"
@@ -299,10 +301,7 @@ fn parse_header(header: &str) -> std::result::Result<(bool, usize, usize), Strin
         .filter(|s| !s.is_empty())
         .map(|s| s.trim_end_matches('L').parse::<usize>())
         .collect::<std::result::Result<_, _>>()
-        .map_err(|_| {
-            let shown: String = inner.chars().take(40).collect();
-            format!("shape ({shown})")
-        })?;
+        .map_err(|_| format!("shape ({})", shown_text(inner, 40)))?;
     match dims.as_slice() {
         [r] => Ok((big, *r, 1)),
         [r, c] => Ok((big, *r, *c)),

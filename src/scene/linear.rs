@@ -1458,12 +1458,14 @@ impl LinearRun {
             .map(|m| memory(m.multiplier))
             .fold(0.0, f64::max);
         let floor = slowest.max(1e-3);
-        let worst = self
+        let (worst, kept) = self
             .reference
             .modes
             .iter()
-            .filter(|m| m.multiplier < 0.0 && memory(m.multiplier) > floor)
-            .max_by(|a, b| memory(a.multiplier).total_cmp(&memory(b.multiplier)))?;
+            .filter(|m| m.multiplier < 0.0)
+            .map(|m| (m, memory(m.multiplier)))
+            .filter(|&(_, kept)| kept > floor)
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
         // With m ≈ −(1 − 4/(λΔt)) the memory is e^{−4 t_b/(λΔt²)} (t_b the burn-in
         // time, fixed in τ₁): it is the allowed F at Δt = √(4 t_b/(λ ln(1/F))); 0.9 of
         // that, for the approximation.
@@ -1472,7 +1474,7 @@ impl LinearRun {
         Some(UnforgettingMode {
             n: worst.n,
             multiplier: worst.multiplier,
-            memory: memory(worst.multiplier),
+            memory: kept,
             slowest: floor,
             burn_in_steps: self.burn_in_steps,
             dt_bound,

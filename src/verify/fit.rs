@@ -857,12 +857,16 @@ mod tests {
     fn the_joint_fit_solved_in_the_law_has_no_linearization_bias() {
         let shares = [0.9, 0.75, 0.6, 0.45, 0.3, 0.2];
         let x: Vec<[f64; 2]> = shares.iter().map(|s| [*s, (1.0 - s) / 20.0]).collect();
-        let r: Vec<ModeRatio> = (x.iter().enumerate())
-            .map(|(k, [s, u])| {
-                let g = 1.5 * s + 40.0 * u;
-                ModeRatio::new(format!("n={}", k + 1), 1.0 / g, 1e-3 / g)
-            })
-            .collect();
+        // Variance ratios 1/gₙ (errors 0.1 %) of the law gₙ = c·sₙ + σ·uₙ.
+        let law = |c: f64, sigma: f64| -> Vec<ModeRatio> {
+            (x.iter().enumerate())
+                .map(|(k, [s, u])| {
+                    let g = c * s + sigma * u;
+                    ModeRatio::new(format!("n={}", k + 1), 1.0 / g, 1e-3 / g)
+                })
+                .collect()
+        };
+        let r = law(1.5, 40.0);
         let j = JointFit::solved(&r, &x, 2.0, 20.0).unwrap();
         assert!((j.bending_rigidity.value / 3.0 - 1.0).abs() < 1e-9, "{j:?}");
         assert!((j.tension.value - 40.0).abs() < 1e-8, "{j:?}");
@@ -870,12 +874,7 @@ mod tests {
         let first = JointFit::of(&r, &x, 2.0, 20.0).unwrap();
         assert!((first.tension.value / 40.0 - 1.0).abs() > 0.05, "{first:?}");
         // σ far below: the first step would leave gₙ ≤ 0 for the tension-dominated modes.
-        let soft: Vec<ModeRatio> = (x.iter().enumerate())
-            .map(|(k, [s, u])| {
-                let g = 0.9 * s + 2.0 * u;
-                ModeRatio::new(format!("n={}", k + 1), 1.0 / g, 1e-3 / g)
-            })
-            .collect();
+        let soft = law(0.9, 2.0);
         let j = JointFit::solved(&soft, &x, 2.0, 20.0).unwrap();
         assert!((j.tension.value - 2.0).abs() < 1e-8, "{j:?}");
         assert!((j.bending_rigidity.value / 1.8 - 1.0).abs() < 1e-9, "{j:?}");

@@ -240,10 +240,10 @@ impl MembraneParams {
         }
         let stiffness = self.bending_rigidity * q2 * q2;
         if !(stiffness.is_normal() && (self.bending_rigidity * q2).is_normal()) {
-            let (lo, hi) = (
-                f64::MIN_POSITIVE / (q2 * q2).min(1.0),
-                f64::MAX / (q2 * q2).max(1.0),
-            );
+            // κq² and κq⁴ both normal: the smaller power sets the floor, the larger
+            // the ceiling.
+            let (small, large) = (q2.min(q2 * q2), q2.max(q2 * q2));
+            let (lo, hi) = (f64::MIN_POSITIVE / small, f64::MAX / large);
             return Err(Error::invalid(
                 "bending_rigidity",
                 self.bending_rigidity,
