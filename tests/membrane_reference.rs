@@ -970,6 +970,7 @@ fn theory_membrane_prints_the_library_values() {
     assert_eq!(num(p, "value"), pv.value);
     assert_eq!(num(p, "truncation_error"), pv.truncation_error);
     assert_eq!(p["terms"].as_u64(), Some(pv.n_modes as u64));
+    assert_eq!(p["method"], "lattice");
     let ea = mb.excess_area(60.0).unwrap();
     let e = &out["excess_area"];
     assert_eq!(num(e, "mean"), ea.mean);
@@ -990,6 +991,62 @@ fn theory_membrane_prints_the_library_values() {
         shape: ModeShape::SineSine,
     };
     assert_eq!(num(&out, "variance"), ss.mode_variance(mode));
+}
+
+/// What: far above κq_min² `theory membrane` takes the proper-time form: a periodic unit
+/// square at σ = 10⁸ κ (q_min² = 4π²) in a few hundred nodes, its tolerance met, equal to
+/// the library's value and to the closed form of the torus Green's function; at
+/// σ = 10³⁰⁰ (beyond what f64 resolves) it says no tolerance can be met, and why, rather
+/// than print a value without a warning.
+/// Reference: σ⟨h²⟩/kT = (1/2π)[ln(k/2) + γ − ln(2πη(i)²)] + 1/(Ak²), k² = σ/κ,
+/// η(i) = Γ(¼)/(2π^{3/4}) (Kronecker's limit formula; images e^{−k} nil).
+/// Tolerance: the reported bound (1.8e-12 relative at the default --tolerance) plus
+/// 1e-14 relative against the closed form; exact against the library.
+#[test]
+fn theory_membrane_far_above_kappa_q_min_squared() {
+    let out = Value::Object(theory_membrane(&[
+        "--boundary",
+        "periodic",
+        "--tension",
+        "1e8",
+    ]));
+    let p = &out["point_variance"];
+    assert_eq!(p["method"], "proper-time");
+    assert_eq!(p["tolerance_met"], true);
+    assert!(p["terms"].as_u64().unwrap() < 1000, "{p}");
+    let mb = Membrane::new(MembraneParams {
+        boundary: PERIODIC,
+        tension: 1e8,
+        ..MembraneParams::default()
+    })
+    .unwrap();
+    assert_eq!(
+        num(p, "value"),
+        mb.point_variance(0.5, 0.5, 1e-10).unwrap().value
+    );
+    let eta = 3.625_609_908_221_908 / (2.0 * PI.powf(0.75));
+    let k = 1e4_f64;
+    let two_pi = 2.0 * PI;
+    let want =
+        ((k / 2.0).ln() + 0.577_215_664_901_532_9 - (two_pi * eta * eta).ln()) / two_pi / 1e8
+            + 1.0 / 1e16;
+    let gap = (num(p, "value") - want).abs();
+    assert!(
+        gap <= num(p, "truncation_error") + 1e-14 * want,
+        "{p} vs {want:e}"
+    );
+
+    let full = ["theory", "membrane", "--tension", "1e300"];
+    let o = run(&full);
+    assert_no_panic(&full, &o);
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&full, &o));
+    let err = stderr_of(&o);
+    assert!(
+        err.contains("is not met") && err.contains("no --tolerance in (0, 1) is met"),
+        "{}",
+        describe(&full, &o)
+    );
+    assert!(stdout_of(&o).contains("\"tolerance_met\":false"));
 }
 
 /// What: bad input to `theory membrane` exits 2, prints no result and names the flag,

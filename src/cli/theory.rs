@@ -740,19 +740,32 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
         return Err(Error::invalid("--tolerance", args.tolerance, "in (0, 1)"));
     }
     let pv = mb.point_variance(x, y, args.tolerance).map_err(as_flag)?;
-    // At the term caps (a tension far above κq_min², where the slowest mode's variance,
-    // the tolerance's scale, is small) the bound reached may exceed the one asked for:
-    // said, not hidden.
+    // At the lattice form's term caps, or at the proper-time form's smallest t (σ/κ
+    // beyond about 1e270), the bound reached may exceed the one asked for: said, not
+    // hidden.
     let target = args.tolerance * mb.variance_scale();
     let tolerance_met = pv.truncation_error <= target;
     if !tolerance_met {
+        let met_at = args.tolerance * pv.truncation_error / target * 1.5;
+        let advice = if met_at < 1.0 {
+            format!("raise --tolerance to {met_at:.0e} or more to have it met")
+        } else {
+            format!(
+                "no --tolerance in (0, 1) is met at sigma/(kappa q_min^2) = {:.1e}, beyond what f64 resolves",
+                params.tension / (params.bending_rigidity * params.min_wavenumber_sq())
+            )
+        };
         eprintln!(
-            "warning: point_variance: --tolerance {:e} ({target:e} absolute) is not met within {} terms; the bound reached is {:e} ({:.1e} of the value): raise --tolerance to {:.0e} or more to have it met",
+            "warning: point_variance: --tolerance {:e} ({target:e} absolute) is not met within {} {}; the bound reached is {:e} ({:.1e} of the value): {advice}",
             args.tolerance,
             pv.n_modes,
+            if mb.point_variance_by_proper_time() {
+                "quadrature nodes"
+            } else {
+                "terms"
+            },
             pv.truncation_error,
             pv.truncation_error / pv.value.abs(),
-            args.tolerance * pv.truncation_error / target * 1.5
         );
     }
     let [qx, qy] = mb.wavevector(mode);
@@ -773,6 +786,7 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
             "truncation_error": pv.truncation_error,
             "tolerance_met": tolerance_met,
             "terms": pv.n_modes,
+            "method": if mb.point_variance_by_proper_time() { "proper-time" } else { "lattice" },
         },
     });
     if boundary == MembraneBoundary::Periodic {

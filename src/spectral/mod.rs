@@ -68,13 +68,15 @@ pub const MAX_MODES: usize = 100_000;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SeriesValue {
     /// The partial sum over modes 1..=`n_modes` (for the membrane: over the modes below
-    /// a wavenumber cutoff, see each function).
+    /// a wavenumber cutoff, see each function; for its proper-time point variance the
+    /// quadrature sum).
     pub value: f64,
     /// Rigorous upper bound on |exact − value| due to the omitted modes n > `n_modes`
-    /// (membrane: the modes beyond the cutoff; floating-point rounding of the partial sum,
-    /// of relative order 10⁻¹⁶, is not included).
+    /// (membrane: the modes beyond the cutoff; the proper-time point variance: the nodes
+    /// left out and the trapezoidal rule's discretization; floating-point rounding of the
+    /// partial sum, of relative order 10⁻¹⁶, is not included).
     pub truncation_error: f64,
-    /// Number of modes (or series terms) summed.
+    /// Number of modes (or series terms, or quadrature nodes) summed.
     pub n_modes: usize,
 }
 

@@ -59,6 +59,11 @@ use crate::error::{Result, require_positive};
 use crate::spectral::{SeriesValue, sin_pi};
 use std::f64::consts::PI;
 
+/// σ/(κq_min²) above which [`Membrane::point_variance`] sums the proper-time integral
+/// (M5c) instead of the lattice form ⟨h²⟩₀ − C_σ. Every built-in scene but the extreme
+/// `membrane-tension-dominated` (σ/(κq_min²) = 253) lies below it.
+pub const PROPER_TIME_TENSION_RATIO: f64 = 10.0;
+
 /// ζ(3), Apéry's constant.
 pub(crate) const ZETA3: f64 = 1.202_056_903_159_594_3;
 
@@ -97,12 +102,24 @@ fn row_excess(c: f64) -> f64 {
 }
 
 impl Membrane {
+    /// Whether [`Membrane::point_variance`] takes the proper-time form (`heat.rs`, cost
+    /// independent of σ) rather than the lattice form of this module: for a tension above
+    /// [`PROPER_TIME_TENSION_RATIO`]·κq_min², where the tension correction's lattice sum
+    /// grows long (millions of terms from σ ≈ 10³ κq_min²).
+    pub fn point_variance_by_proper_time(&self) -> bool {
+        let p = &self.params;
+        p.tension > PROPER_TIME_TENSION_RATIO * p.bending_rigidity * p.min_wavenumber_sq()
+    }
+
     /// (M5) in the fast form of the module docs: ⟨h²(x, y)⟩ = ⟨h²⟩₀ − C_σ, each part
     /// summed until its rigorous bound is at most half of `tolerance`·scale
     /// (scale = [`Membrane::variance_scale`]; all of it when σ = 0), or at the caps
     /// ([`MAX_MEMBRANE_MODES`] terms each), in which case the achieved bound is reported.
     /// `n_modes` is the number of terms summed: single-series terms of ⟨h²⟩₀ plus real
-    /// modes of C_σ. The periodic value does not depend on (x, y).
+    /// modes of C_σ. The periodic value does not depend on (x, y). Above
+    /// [`PROPER_TIME_TENSION_RATIO`]·κq_min² it is
+    /// [`Membrane::point_variance_proper_time`] instead (`n_modes` then counts its
+    /// quadrature nodes).
     ///
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming `x` or `y` outside the rectangle, or
@@ -114,7 +131,8 @@ impl Membrane {
     /// [`Membrane::point_variance`] with at most about `cap` terms in each part instead
     /// of [`MAX_MEMBRANE_MODES`] (the bound reached is reported): for a figure's curve,
     /// whose points must not each cost a second where a tension far above κq_min² makes
-    /// the sums long.
+    /// the sums long. The proper-time form (above [`PROPER_TIME_TENSION_RATIO`]·κq_min²)
+    /// needs no cap.
     ///
     /// # Errors
     /// As [`Membrane::point_variance`].
@@ -125,6 +143,9 @@ impl Membrane {
         tolerance: f64,
         cap: usize,
     ) -> Result<SeriesValue> {
+        if self.point_variance_by_proper_time() {
+            return self.point_variance_proper_time(x, y, tolerance);
+        }
         self.check_point("x", "y", (x, y))?;
         require_positive("tolerance", tolerance)?;
         let target = tolerance * self.variance_scale();
@@ -313,8 +334,10 @@ mod tests {
     }
 
     // What: the capped point variance. Where the cap does not bind it sums the same terms
-    // to the same value, bit for bit; where it binds (σ = 10⁶, far above κq_min², 10⁴ terms) its reported
-    // bound still covers the distance to the full value (itself within its own bound).
+    // to the same value, bit for bit; where it binds (σ just below
+    // PROPER_TIME_TENSION_RATIO·κq_min², 300 terms, tolerance 1e-9) its reported bound
+    // still covers the distance to the full value (itself within its own bound); above
+    // that tension the proper-time form, which has no cap, is returned whatever the cap.
     // Reference: `point_variance` at the full caps. Tolerance: the two bounds.
     #[test]
     fn the_capped_point_variance_reports_an_honest_bound() {
@@ -335,9 +358,10 @@ mod tests {
                 "{boundary:?}"
             );
             assert!((capped.truncation_error / full.truncation_error - 1.0).abs() < 1e-5);
-            let m = mb(1e6);
-            let full = m.point_variance(0.3, 0.2, 1e-5).unwrap();
-            let capped = m.point_variance_capped(0.3, 0.2, 1e-5, 10_000).unwrap();
+            let q2 = m.params.min_wavenumber_sq();
+            let m = mb(0.99 * PROPER_TIME_TENSION_RATIO * q2);
+            let full = m.point_variance(0.3, 0.2, 1e-9).unwrap();
+            let capped = m.point_variance_capped(0.3, 0.2, 1e-9, 300).unwrap();
             assert!(
                 capped.n_modes < full.n_modes,
                 "{boundary:?}: {capped:?} {full:?}"
@@ -346,6 +370,11 @@ mod tests {
             assert!(
                 gap <= capped.truncation_error + full.truncation_error,
                 "{boundary:?}: {gap:e} against {capped:?}, {full:?}"
+            );
+            let m = mb(1.01 * PROPER_TIME_TENSION_RATIO * q2);
+            assert_eq!(
+                m.point_variance_capped(0.3, 0.2, 1e-9, 300).unwrap(),
+                m.point_variance_proper_time(0.3, 0.2, 1e-9).unwrap()
             );
         }
     }

@@ -78,7 +78,8 @@
 //!   ([`Membrane::stationary_correlation`]);
 //! - (M5) point variance ⟨h²(r)⟩ = Σ_φ ⟨a²⟩ φ(r)² (mode sum
 //!   [`Membrane::point_variance_series`]; fast single-series form
-//!   [`Membrane::point_variance`], derived in `levy.rs`);
+//!   [`Membrane::point_variance`], derived in `levy.rs`; far above κq_min² the
+//!   proper-time integral [`Membrane::point_variance_proper_time`], derived in `heat.rs`);
 //! - (M6) excess area ΔA = ½∫|∇h|² = Σ_φ ½q²‖φ‖² a², with ⟨ΔA⟩ = (kT/2) Σ_φ 1/(κq² + σ)
 //!   and Var ΔA = (kT)²/2 · Σ_φ (κq² + σ)⁻² ([`Membrane::excess_area`]);
 //! - (M7) per-mode spectra: the Lorentzian and the exact sampled (AR(1)) spectrum, as for
@@ -95,10 +96,12 @@
 //!   §§ 28–30 (Navier and Lévy series of the simply supported plate, the centre deflection
 //!   under a central point load, 0.01160·Pa²/D for a square).
 
+mod heat;
 mod levy;
 pub mod simulator;
 mod sums;
 
+pub use levy::PROPER_TIME_TENSION_RATIO;
 pub use simulator::MembraneSimulator;
 pub use sums::ExcessArea;
 
