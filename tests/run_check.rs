@@ -385,7 +385,9 @@ fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// the run's files wait in a staging folder until it succeeds).
 /// Set-up: a passing check of 8 trajectories × 40 τ1, then compression data of 2
 /// trajectories × 2 τ1 checked into the same `--out` (33 samples of the force: too
-/// short for its integrated autocorrelation time). Tolerance: exact bytes.
+/// short for its integrated autocorrelation time, even pooled over the trajectories: the
+/// message names the strain and says to record longer trajectories). Tolerance: exact
+/// bytes; substrings.
 #[test]
 fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
     let dir = TempDir::new("run-check-failed");
@@ -420,6 +422,13 @@ fn a_failed_or_refused_check_leaves_the_earlier_report_as_it_was() {
     ];
     let o = run(&args);
     assert_eq!(o.status.code(), Some(3), "{}", describe(&args, &o));
+    // The message names the strain whose series are too short, even pooled, and what to do.
+    let err = stderr_of(&o);
+    assert!(
+        err.contains("<F> at strain ") && err.contains("record longer trajectories"),
+        "{}",
+        describe(&args, &o)
+    );
     assert_eq!(tree_bytes(Path::new(&report)), before, "after exit 3");
     let data = tree_bytes(Path::new(&good));
     let (o, args) = check(&good, &good);

@@ -1430,7 +1430,7 @@ pub struct ForceEstimates {
 pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
     let mut out = ForceEstimates::default();
     let (mut prop, mut acc) = (0u64, 0u64);
-    for point in records {
+    for (k, point) in records.iter().enumerate() {
         let own: Result<Vec<_>> = point
             .iter()
             .map(|r| stats::mean_with_error(&r.force_ratio))
@@ -1440,7 +1440,10 @@ pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
             Err(e) => {
                 let series: Vec<&[f64]> = point.iter().map(|r| r.force_ratio.as_slice()).collect();
                 let tau = stats::pooled_integrated_autocorrelation_time(&series)
-                    .map_err(|_| e)?
+                    .map_err(|_| {
+                        let at = format!("<F> at strain {} of {}", k + 1, records.len());
+                        too_short_to_pool(&at, &series, e)
+                    })?
                     .tau_int;
                 point
                     .iter()
@@ -1461,6 +1464,24 @@ pub fn force_estimates(records: &[Vec<ForceRecord>]) -> Result<ForceEstimates> {
         acc as f64 / prop as f64
     };
     Ok(out)
+}
+
+/// The error of a strain whose series of F are too short for the autocorrelation window
+/// even pooled over its trajectories (`e`, the window's error for one of them): `what`
+/// (the strain, the check) named, and what to change.
+pub(crate) fn too_short_to_pool(what: &str, series: &[&[f64]], e: Error) -> Error {
+    let detail = match e {
+        Error::Numerical { detail, .. } => detail,
+        other => other.to_string(),
+    };
+    Error::Numerical {
+        routine: what.to_string(),
+        detail: format!(
+            "{detail}, even pooled over its {} trajectories (the window needs about {} tau_int samples per trajectory): record longer trajectories (F relaxes slowest near buckling)",
+            series.len(),
+            2.0 * stats::moments::SOKAL_C
+        ),
+    }
 }
 
 /// Metropolis acceptance rates below this are named as the likely cause of a failed

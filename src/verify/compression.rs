@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::scene::CheckKind;
 use crate::scene::compression::{
-    CompressionRun, CompressionTheoryTable, ForceEstimates, ForceRecord,
+    CompressionRun, CompressionTheoryTable, ForceEstimates, ForceRecord, too_short_to_pool,
 };
 use crate::stats;
 use crate::verify::summary::{CheckResult, LargestDeviation};
@@ -517,7 +517,14 @@ fn force_distribution_check(x: &CompressionInputs<'_>, out: &mut Vec<CheckResult
                     .map(|r| r.force_ratio.as_slice())
                     .collect();
                 let tau = stats::pooled_integrated_autocorrelation_time(&series)
-                    .map_err(|_| e)?
+                    .map_err(|_| {
+                        let ratio = x.theory.strain_ratios[i];
+                        too_short_to_pool(
+                            &format!("{name}/force-ks/strain_ratio={ratio}"),
+                            &series,
+                            e,
+                        )
+                    })?
                     .tau_int;
                 vec![tau]
             }
