@@ -64,6 +64,13 @@ use std::f64::consts::PI;
 /// `membrane-tension-dominated` (σ/(κq_min²) = 253) lies below it.
 pub const PROPER_TIME_TENSION_RATIO: f64 = 10.0;
 
+/// Aspect ratio max(a, b)/min(a, b) above which [`Membrane::point_variance`] also takes
+/// the proper-time form: on a 10⁴ × 1 strip under a tension of 3 κq_min² the lattice
+/// form reaches its caps with a bound of 6·10⁻⁶ of the value, the proper-time form meets
+/// 10⁻⁹ of the slowest mode's variance in 279 nodes. Every built-in scene has an aspect
+/// ratio of 1 or 2.
+pub const PROPER_TIME_ASPECT_RATIO: f64 = 10.0;
+
 /// ζ(3), Apéry's constant.
 pub(crate) const ZETA3: f64 = 1.202_056_903_159_594_3;
 
@@ -103,12 +110,15 @@ fn row_excess(c: f64) -> f64 {
 
 impl Membrane {
     /// Whether [`Membrane::point_variance`] takes the proper-time form (`heat.rs`, cost
-    /// independent of σ) rather than the lattice form of this module: for a tension above
-    /// [`PROPER_TIME_TENSION_RATIO`]·κq_min², where the tension correction's lattice sum
-    /// grows long (millions of terms from σ ≈ 10³ κq_min²).
+    /// independent of σ and of the aspect ratio) rather than the lattice form of this
+    /// module: for a tension above [`PROPER_TIME_TENSION_RATIO`]·κq_min², where the
+    /// tension correction's lattice sum grows long (millions of terms from σ ≈ 10³ κq_min²),
+    /// or an aspect ratio above [`PROPER_TIME_ASPECT_RATIO`], where the single series does.
     pub fn point_variance_by_proper_time(&self) -> bool {
         let p = &self.params;
+        let aspect = p.width.max(p.height) / p.width.min(p.height);
         p.tension > PROPER_TIME_TENSION_RATIO * p.bending_rigidity * p.min_wavenumber_sq()
+            || aspect > PROPER_TIME_ASPECT_RATIO
     }
 
     /// (M5) in the fast form of the module docs: ⟨h²(x, y)⟩ = ⟨h²⟩₀ − C_σ, each part
@@ -117,9 +127,9 @@ impl Membrane {
     /// ([`MAX_MEMBRANE_MODES`] terms each), in which case the achieved bound is reported.
     /// `n_modes` is the number of terms summed: single-series terms of ⟨h²⟩₀ plus real
     /// modes of C_σ. The periodic value does not depend on (x, y). Above
-    /// [`PROPER_TIME_TENSION_RATIO`]·κq_min² it is
-    /// [`Membrane::point_variance_proper_time`] instead (`n_modes` then counts its
-    /// quadrature nodes).
+    /// [`PROPER_TIME_TENSION_RATIO`]·κq_min², or above an aspect ratio of
+    /// [`PROPER_TIME_ASPECT_RATIO`], it is [`Membrane::point_variance_proper_time`]
+    /// instead (`n_modes` then counts its quadrature nodes).
     ///
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming `x` or `y` outside the rectangle, or
@@ -131,7 +141,7 @@ impl Membrane {
     /// [`Membrane::point_variance`] with at most about `cap` terms in each part instead
     /// of [`MAX_MEMBRANE_MODES`] (the bound reached is reported): for a figure's curve,
     /// whose points must not each cost a second where a tension far above κq_min² makes
-    /// the sums long. The proper-time form (above [`PROPER_TIME_TENSION_RATIO`]·κq_min²)
+    /// the sums long. The proper-time form ([`Membrane::point_variance_by_proper_time`])
     /// needs no cap.
     ///
     /// # Errors

@@ -101,7 +101,7 @@ mod levy;
 pub mod simulator;
 mod sums;
 
-pub use levy::PROPER_TIME_TENSION_RATIO;
+pub use levy::{PROPER_TIME_ASPECT_RATIO, PROPER_TIME_TENSION_RATIO};
 pub use simulator::MembraneSimulator;
 pub use sums::ExcessArea;
 
