@@ -743,6 +743,7 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
     // At the lattice form's term caps, or at the proper-time form's smallest t (σ/κ
     // beyond about 1e270), the bound reached may exceed the one asked for: said, not
     // hidden.
+    let proper_time = mb.point_variance_by_proper_time();
     let target = args.tolerance * mb.variance_scale();
     let tolerance_met = pv.truncation_error <= target;
     if !tolerance_met {
@@ -752,14 +753,14 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
         } else {
             format!(
                 "no --tolerance in (0, 1) is met at sigma/(kappa q_min^2) = {:.1e}, beyond what f64 resolves",
-                params.tension / (params.bending_rigidity * params.min_wavenumber_sq())
+                params.tension_ratio()
             )
         };
         eprintln!(
             "warning: point_variance: --tolerance {:e} ({target:e} absolute) is not met within {} {}; the bound reached is {:e} ({:.1e} of the value): {advice}",
             args.tolerance,
             pv.n_modes,
-            if mb.point_variance_by_proper_time() {
+            if proper_time {
                 "quadrature nodes"
             } else {
                 "terms"
@@ -786,7 +787,7 @@ fn membrane(args: &MembraneArgs) -> Result<serde_json::Value> {
             "truncation_error": pv.truncation_error,
             "tolerance_met": tolerance_met,
             "terms": pv.n_modes,
-            "method": if mb.point_variance_by_proper_time() { "proper-time" } else { "lattice" },
+            "method": if proper_time { "proper-time" } else { "lattice" },
         },
     });
     if boundary == MembraneBoundary::Periodic {

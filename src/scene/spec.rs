@@ -884,7 +884,6 @@ impl DescribeScene for Scene {
 /// time, (M2)), the buckling tension −κq_min² and σ/(κq_min²).
 fn membrane_record(m: &MembraneParams) -> ParameterRecord {
     let q = |k: &str, v: f64, unit: &str| (k.to_string(), Quantity::new(v, unit));
-    let q2 = m.min_wavenumber_sq();
     ParameterRecord {
         unit_system: "consistent".to_string(),
         given: BTreeMap::new(),
@@ -901,7 +900,7 @@ fn membrane_record(m: &MembraneParams) -> ParameterRecord {
         groups: [
             q("tau1", m.tau1(), "[T]"),
             q("buckling_tension", m.buckling_tension(), "[E]/[L]^2"),
-            q("tension_ratio", m.tension / (m.bending_rigidity * q2), "1"),
+            q("tension_ratio", m.tension_ratio(), "1"),
         ]
         .into_iter()
         .collect(),

@@ -78,8 +78,9 @@
 //!   ([`Membrane::stationary_correlation`]);
 //! - (M5) point variance ⟨h²(r)⟩ = Σ_φ ⟨a²⟩ φ(r)² (mode sum
 //!   [`Membrane::point_variance_series`]; fast single-series form
-//!   [`Membrane::point_variance`], derived in `levy.rs`; far above κq_min² the
-//!   proper-time integral [`Membrane::point_variance_proper_time`], derived in `heat.rs`);
+//!   [`Membrane::point_variance`], derived in `levy.rs`; far above κq_min² or on a long
+//!   strip the proper-time integral [`Membrane::point_variance_proper_time`], derived in
+//!   `heat.rs`);
 //! - (M6) excess area ΔA = ½∫|∇h|² = Σ_φ ½q²‖φ‖² a², with ⟨ΔA⟩ = (kT/2) Σ_φ 1/(κq² + σ)
 //!   and Var ΔA = (kT)²/2 · Σ_φ (κq² + σ)⁻² ([`Membrane::excess_area`]);
 //! - (M7) per-mode spectra: the Lorentzian and the exact sampled (AR(1)) spectrum, as for
@@ -290,6 +291,11 @@ impl MembraneParams {
     /// The buckling tension −κ q_min²: the tension must be strictly above it.
     pub fn buckling_tension(&self) -> f64 {
         -self.bending_rigidity * self.min_wavenumber_sq()
+    }
+
+    /// The tension ratio σ/(κ q_min²): −1 at buckling, ≫ 1 where the tension dominates.
+    pub fn tension_ratio(&self) -> f64 {
+        self.tension / (self.bending_rigidity * self.min_wavenumber_sq())
     }
 }
 
